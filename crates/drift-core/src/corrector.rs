@@ -1,0 +1,291 @@
+//! The run-time corrector: immutable model (tables) + small per-unit state, one call per sample.
+
+use crate::error::{Error, Location, Problem};
+use crate::flags::Flags;
+use crate::model::{AxisModel, Model};
+use crate::settings::Settings;
+use crate::AXES;
+
+/// One 3-axis sample as the firmware reads it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Sample {
+    /// Time since switch-on, milliseconds (an integer, so hours of operation lose no resolution).
+    pub since_power_on_ms: u32,
+    /// Measured angular rate per axis, °/s.
+    pub rate_dps: [f32; AXES],
+    /// Raw temperature-sensor reading per axis, sensor units (see [`Settings`]).
+    pub temperature_raw: [f32; AXES],
+}
+
+/// The corrector's answer for one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Output {
+    /// Rate with the estimated zero drift removed, °/s.
+    pub corrected_dps: [f32; AXES],
+    /// Estimated zero drift that was removed, °/s: initial (switch-on) bias plus the heating drift
+    /// since switch-on.
+    pub bias_dps: [f32; AXES],
+    /// What was clamped, held or passed through, per axis.
+    pub flags: [Flags; AXES],
+}
+
+/// Run-time state of one axis. Plain data: copy it to persist, restore it to resume.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AxisState<S> {
+    switch_on_raw: f32,
+    initial_bias_dps: f32,
+    /// Last good drift estimate, held through sensor faults.
+    drift_dps: f32,
+    last_raw: f32,
+    /// How many samples in a row repeated `last_raw` exactly.
+    repeats: u16,
+    /// Flags that hold for the whole activation (from switch-on).
+    activation_flags: Flags,
+    model: S,
+}
+
+impl<S> AxisState<S> {
+    /// Initial bias located at switch-on, °/s.
+    pub fn initial_bias_dps(&self) -> f32 {
+        self.initial_bias_dps
+    }
+
+    /// Raw temperature reading at switch-on.
+    pub fn switch_on_raw(&self) -> f32 {
+        self.switch_on_raw
+    }
+
+    /// The model's own per-axis state.
+    pub fn model(&self) -> &S {
+        &self.model
+    }
+}
+
+/// Per-unit run-time state, separate from the immutable tables: the same tables can serve several
+/// units, and swapping tables never corrupts a state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CorrectorState<S> {
+    axes: [AxisState<S>; AXES],
+    powered_on: bool,
+}
+
+impl<S: Copy + Default> CorrectorState<S> {
+    /// A state that has not been powered on: `correct` passes rates through, flagged.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The per-axis states, X, Y, Z.
+    pub fn axes(&self) -> &[AxisState<S>; AXES] {
+        &self.axes
+    }
+
+    /// Whether `power_on` has succeeded since the last `power_off`.
+    pub fn is_powered_on(&self) -> bool {
+        self.powered_on
+    }
+
+    /// Starts an activation from the raw temperature readings at switch-on.
+    ///
+    /// Returns the flags that hold for the whole activation (e.g. an ambient outside the calibrated
+    /// range). A non-finite reading is rejected, naming the axis, and the state is left unchanged.
+    pub fn power_on<M>(&mut self, model: &M, switch_on_raw: [f32; AXES]) -> Result<[Flags; AXES], Error>
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        if let Some(axis) = switch_on_raw.iter().position(|raw| !raw.is_finite()) {
+            return Err(Error::new(
+                "switch_on_raw",
+                Location::axis(axis),
+                Problem::NonFinite,
+            ));
+        }
+        let settings = model.settings();
+        let mut flags = [Flags::NONE; AXES];
+        for (((state, axis), raw), flags) in self
+            .axes
+            .iter_mut()
+            .zip(model.axes())
+            .zip(switch_on_raw)
+            .zip(&mut flags)
+        {
+            *state = AxisState {
+                switch_on_raw: raw,
+                last_raw: raw,
+                ..AxisState::default()
+            };
+            let (initial_bias, mut activation) =
+                axis.power_on(settings, settings.celsius(raw), &mut state.model);
+            if initial_bias.is_finite() {
+                state.initial_bias_dps = initial_bias;
+            } else {
+                activation |= Flags::MODEL_INVALID;
+            }
+            state.activation_flags = activation;
+            *flags = activation;
+        }
+        self.powered_on = true;
+        Ok(flags)
+    }
+
+    /// Ends the activation: further samples pass through, flagged, until the next `power_on`.
+    pub fn power_off(&mut self) {
+        self.powered_on = false;
+    }
+
+    /// Corrects one sample. Total: never panics, never allocates; every clamp, hold and fault is in
+    /// the returned flags.
+    pub fn correct<M>(&mut self, model: &M, sample: &Sample) -> Output
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        let mut output = Output::default();
+        let settings = model.settings();
+        let lanes = self
+            .axes
+            .iter_mut()
+            .zip(model.axes())
+            .zip(sample.rate_dps)
+            .zip(sample.temperature_raw)
+            .zip(output.corrected_dps.iter_mut())
+            .zip(output.bias_dps.iter_mut())
+            .zip(output.flags.iter_mut());
+        for ((((((state, axis), rate), raw), corrected), bias), flags) in lanes {
+            (*corrected, *bias, *flags) = if self.powered_on {
+                correct_axis(axis, settings, state, sample.since_power_on_ms, rate, raw)
+            } else {
+                (rate, 0.0, Flags::NOT_POWERED_ON | rate_flag(rate))
+            };
+        }
+        output
+    }
+}
+
+fn rate_flag(rate: f32) -> Flags {
+    if rate.is_finite() {
+        Flags::NONE
+    } else {
+        Flags::RATE_INVALID
+    }
+}
+
+/// The part every model shares: sensor-fault checks, rise, hold of the last good drift, flags.
+#[inline]
+fn correct_axis<A: AxisModel>(
+    axis: &A,
+    settings: &Settings,
+    state: &mut AxisState<A::State>,
+    since_power_on_ms: u32,
+    rate: f32,
+    raw: f32,
+) -> (f32, f32, Flags) {
+    let mut flags = state.activation_flags | rate_flag(rate);
+    if raw.is_finite() {
+        if raw.to_bits() == state.last_raw.to_bits() {
+            state.repeats = state.repeats.saturating_add(1);
+        } else {
+            state.repeats = 0;
+            state.last_raw = raw;
+        }
+        let stuck =
+            settings.stuck_after_samples != 0 && state.repeats >= settings.stuck_after_samples;
+        if stuck {
+            flags |= Flags::TEMPERATURE_STUCK;
+        } else {
+            let rise = (raw - state.switch_on_raw) / settings.raw_per_celsius;
+            let (drift, model_flags) = axis.drift(
+                settings,
+                &mut state.model,
+                since_power_on_ms,
+                settings.celsius(raw),
+                rise,
+            );
+            flags |= model_flags;
+            if drift.is_finite() {
+                state.drift_dps = drift;
+            } else {
+                flags |= Flags::MODEL_INVALID;
+            }
+        }
+    } else {
+        flags |= Flags::TEMPERATURE_INVALID;
+    }
+    let bias = state.initial_bias_dps + state.drift_dps;
+    (rate - bias, bias, flags)
+}
+
+/// A model together with one unit's state: the convenient way to run a corrector.
+///
+/// ```
+/// use drift_core::{Corrector, PolynomialAxis, PolynomialTables, Sample, Settings};
+/// let axis = PolynomialAxis {
+///     range_celsius: [20.0, 40.0],
+///     coefficients: heapless::Vec::from_slice(&[0.5, 0.01]).unwrap(),
+/// };
+/// let model = PolynomialTables::try_new(Settings::default(), [axis.clone(), axis.clone(), axis])?;
+/// let mut corrector = Corrector::new(&model)?;
+/// corrector.power_on([6000.0; 3])?; // 30 °C at 200 raw units per °C
+/// let out = corrector.correct(&Sample {
+///     since_power_on_ms: 1,
+///     rate_dps: [0.5; 3],
+///     temperature_raw: [6000.0; 3],
+/// });
+/// assert!(out.corrected_dps[0].abs() < 1e-6);
+/// # Ok::<(), drift_core::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Corrector<'a, M: Model> {
+    model: &'a M,
+    state: CorrectorState<<M::Axis as AxisModel>::State>,
+}
+
+impl<'a, M: Model> Corrector<'a, M> {
+    /// Validates the model once, so that the per-sample path works on checked tables.
+    pub fn new(model: &'a M) -> Result<Self, Error> {
+        model.validate()?;
+        Ok(Self {
+            model,
+            state: CorrectorState::default(),
+        })
+    }
+
+    /// The model in use.
+    pub fn model(&self) -> &'a M {
+        self.model
+    }
+
+    /// The unit's run-time state.
+    pub fn state(&self) -> &CorrectorState<<M::Axis as AxisModel>::State> {
+        &self.state
+    }
+
+    /// See [`CorrectorState::power_on`].
+    pub fn power_on(&mut self, switch_on_raw: [f32; AXES]) -> Result<[Flags; AXES], Error> {
+        self.state.power_on(self.model, switch_on_raw)
+    }
+
+    /// See [`CorrectorState::power_off`].
+    pub fn power_off(&mut self) {
+        self.state.power_off();
+    }
+
+    /// See [`CorrectorState::correct`].
+    pub fn correct(&mut self, sample: &Sample) -> Output {
+        self.state.correct(self.model, sample)
+    }
+
+    /// Corrects a block of samples into `outputs`; returns how many were corrected (the shorter of
+    /// the two lengths).
+    pub fn correct_block(&mut self, samples: &[Sample], outputs: &mut [Output]) -> usize {
+        let mut count = 0_usize;
+        for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
+            *output = self.correct(sample);
+            count = count.saturating_add(1);
+        }
+        count
+    }
+}

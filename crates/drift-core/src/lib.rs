@@ -1,0 +1,45 @@
+#![doc = include_str!("../README.md")]
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+#![cfg_attr(
+    test,
+    allow(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic,
+        clippy::float_cmp,
+        clippy::arithmetic_side_effects
+    )
+)]
+
+#[cfg(test)]
+extern crate std;
+
+#[cfg(feature = "serde")]
+pub mod blob;
+mod corrector;
+mod error;
+mod flags;
+mod interp;
+mod model;
+mod polynomial;
+mod settings;
+mod stage;
+mod table;
+
+pub use corrector::{AxisState, Corrector, CorrectorState, Output, Sample};
+pub use error::{Error, Location, Problem};
+pub use flags::Flags;
+pub use model::{AxisModel, Model};
+pub use polynomial::{
+    PolynomialAxis, PolynomialAxisState, PolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
+};
+pub use settings::Settings;
+pub use stage::ambient::AmbientPosition;
+pub use stage::since_power_on::TimePosition;
+pub use table::{AmbientCurves, AxisTable, Curve, ModifiedAxisState, ModifiedTables};
+
+/// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.
+pub const AXES: usize = 3;

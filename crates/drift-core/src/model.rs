@@ -1,0 +1,53 @@
+//! The interface every drift model implements, so the paper's method and its baselines are run,
+//! flagged and compared the same way, in firmware and in analysis.
+
+use crate::error::Error;
+use crate::flags::Flags;
+use crate::settings::Settings;
+use crate::AXES;
+
+/// One axis of a drift model: what it needs at switch-on and per sample.
+///
+/// Implementations are pure functions of their (immutable) calibration data and the small per-axis
+/// `State`; the [`Corrector`](crate::Corrector) adds the shared parts (raw-to-°C conversion, rise,
+/// sensor-fault holds, flags).
+pub trait AxisModel {
+    /// Per-axis run-time state the model keeps between switch-on and each sample.
+    type State: Copy + Default + core::fmt::Debug;
+
+    /// Prepares `state` at switch-on from the switch-on temperature (°C); returns the initial bias
+    /// (°/s) and any envelope flags that hold for the whole activation.
+    fn power_on(
+        &self,
+        settings: &Settings,
+        switch_on_celsius: f32,
+        state: &mut Self::State,
+    ) -> (f32, Flags);
+
+    /// The drift since switch-on (°/s, excluding the initial bias) at `since_power_on_ms`, for the
+    /// current temperature (°C) and its rise since switch-on (°C), with envelope flags.
+    /// May return a non-finite value only for corrupt tables; the corrector then holds and flags.
+    fn drift(
+        &self,
+        settings: &Settings,
+        state: &mut Self::State,
+        since_power_on_ms: u32,
+        temperature_celsius: f32,
+        rise_celsius: f32,
+    ) -> (f32, Flags);
+}
+
+/// A drift model for a whole unit: settings plus one [`AxisModel`] per axis.
+pub trait Model {
+    /// The per-axis model.
+    type Axis: AxisModel;
+
+    /// Sensor conversion and envelope settings.
+    fn settings(&self) -> &Settings;
+
+    /// The per-axis models, X, Y, Z.
+    fn axes(&self) -> &[Self::Axis; AXES];
+
+    /// Checks every value; the error names the field and where it sits.
+    fn validate(&self) -> Result<(), Error>;
+}

@@ -1,0 +1,78 @@
+//! Settings shared by every model: how raw temperature maps to °C and when to flag.
+
+use crate::error::{Error, Location, Problem};
+
+/// Sensor conversion and envelope settings, stored with the tables.
+///
+/// | field | meaning | unit | default |
+/// |---|---|---|---|
+/// | `raw_per_celsius` | temperature-sensor scale | raw units / °C | 200 |
+/// | `raw_at_zero_celsius` | temperature-sensor reading at 0 °C | raw units | 0 |
+/// | `ambient_margin_celsius` | how far outside the calibrated range before flagging | °C | 0.5 |
+/// | `rise_margin_celsius` | how far outside the stored curves' rise span before flagging | °C | 0.05 |
+/// | `stuck_after_samples` | identical raw readings in a row that count as a stuck sensor (0: never) | samples | 2000 |
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Settings {
+    /// Temperature-sensor scale, raw units per °C (the paper's unit: 200).
+    pub raw_per_celsius: f32,
+    /// Temperature-sensor reading at 0 °C, raw units.
+    pub raw_at_zero_celsius: f32,
+    /// Switch-on temperatures (and polynomial temperatures) further than this outside the calibrated
+    /// range are flagged; inside it, the clamp is considered part of the calibration.
+    pub ambient_margin_celsius: f32,
+    /// Rises further than this outside the span of the stored curves are flagged. Covers sensor
+    /// quantisation and noise near switch-on, where the rise is close to zero.
+    pub rise_margin_celsius: f32,
+    /// Number of identical raw temperature readings in a row after which the sensor counts as stuck.
+    /// At 1000 Hz and 200 raw units per °C a live sensor's noise changes the reading far more often.
+    /// 0 disables the check.
+    pub stuck_after_samples: u16,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            raw_per_celsius: 200.0,
+            raw_at_zero_celsius: 0.0,
+            ambient_margin_celsius: 0.5,
+            rise_margin_celsius: 0.05,
+            stuck_after_samples: 2000,
+        }
+    }
+}
+
+impl Settings {
+    /// Checks that every value is finite and in its documented range.
+    pub fn validate(&self) -> Result<(), Error> {
+        let at = Location::default();
+        let finite = [
+            ("raw_per_celsius", self.raw_per_celsius),
+            ("raw_at_zero_celsius", self.raw_at_zero_celsius),
+            ("ambient_margin_celsius", self.ambient_margin_celsius),
+            ("rise_margin_celsius", self.rise_margin_celsius),
+        ];
+        for (field, value) in finite {
+            if !value.is_finite() {
+                return Err(Error::new(field, at, Problem::NonFinite));
+            }
+        }
+        if self.raw_per_celsius <= 0.0 {
+            return Err(Error::new("raw_per_celsius", at, Problem::NotPositive));
+        }
+        for (field, value) in [
+            ("ambient_margin_celsius", self.ambient_margin_celsius),
+            ("rise_margin_celsius", self.rise_margin_celsius),
+        ] {
+            if value < 0.0 {
+                return Err(Error::new(field, at, Problem::NotPositive));
+            }
+        }
+        Ok(())
+    }
+
+    /// Converts a raw temperature reading to °C.
+    pub fn celsius(&self, raw: f32) -> f32 {
+        (raw - self.raw_at_zero_celsius) / self.raw_per_celsius
+    }
+}

@@ -1,0 +1,28 @@
+//! The `gyrodrift` subcommands, one per file.
+
+use clap::{Parser, Subcommand};
+
+pub mod demo;
+
+/// Temperature-drift correction for MEMS gyroscopes.
+#[derive(Debug, Parser)]
+#[command(name = "gyrodrift", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run the built-in demonstration (the README's main job).
+    Demo(demo::Args),
+}
+
+/// Runs one parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Demo(args) => demo::run(&args),
+    }
+}
