@@ -52,11 +52,11 @@ pub struct AxisTable<const R: usize, const A: usize, const C: usize> {
 
 /// The paper's ("modified") model for a whole unit: settings and one table per axis.
 ///
-/// Default capacities (16 reference times, 8 ambients, 32 curves per ambient) suit host analysis;
+/// Default capacities (16 reference times, 12 ambients, 32 curves per ambient) suit host analysis;
 /// firmware names its own, e.g. `ModifiedTables<8, 3, 16>`.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct ModifiedTables<const R: usize = 16, const A: usize = 8, const C: usize = 32> {
+pub struct ModifiedTables<const R: usize = 16, const A: usize = 12, const C: usize = 32> {
     /// Sensor conversion and envelope settings.
     pub settings: Settings,
     /// One table per axis (X, Y, Z).
@@ -193,6 +193,21 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         _temperature_celsius: f32,
         rise_celsius: f32,
     ) -> (f32, Flags) {
+        let (k, flags) = self.correlation(settings, &state.ambient, since_power_on_ms, rise_celsius);
+        (k * rise_celsius, flags)
+    }
+}
+
+impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
+    /// The correlation `k` ((°/s) per °C) after all three stages: time since switch-on, heating
+    /// dynamics by the current rise, and ambient, with the envelope flags. The drift is `k · rise`.
+    pub fn correlation(
+        &self,
+        settings: &Settings,
+        ambient: &AmbientPosition,
+        since_power_on_ms: u32,
+        rise_celsius: f32,
+    ) -> (f32, Flags) {
         let time = TimePosition::locate(&self.reference_ms, since_power_on_ms);
         let margin = settings.rise_margin_celsius;
         let k_in = |i: u8| {
@@ -200,7 +215,6 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
                 heating::k_at(&a.curves, &time, rise_celsius, margin)
             })
         };
-        let ambient = state.ambient;
         let (k_lo, mut out_of_span) = k_in(ambient.lo);
         let k = if ambient.hi == ambient.lo {
             k_lo
@@ -216,7 +230,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         if time.past_last {
             flags |= Flags::PAST_LAST_REFERENCE;
         }
-        (k * rise_celsius, flags)
+        (k, flags)
     }
 }
 

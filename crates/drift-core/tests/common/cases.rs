@@ -1,0 +1,287 @@
+//! The test-vector cases: activations that exercise every stage, clamp, hold and fault.
+//!
+//! Inputs are synthesised deterministically (a tiny LCG for noise), expected outputs come from
+//! running drift-core's corrector; `tests/reference.rs` checks those outputs against an independent
+//! f64 restatement of the method, so the file is not merely self-consistent.
+
+use drift_core::blob::{encode, Image};
+use drift_core::{Corrector, Model, Sample};
+
+use super::fixture;
+use super::format::{Case, NamedModel, VectorFile};
+
+/// Deterministic pseudo-noise in [−1, 1).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+/// How an activation's inputs evolve.
+struct Scenario {
+    name: &'static str,
+    description: &'static str,
+    model: &'static str,
+    /// Switch-on temperature per axis, °C (None: never powered on; NaN: power-on must fail).
+    switch_on_celsius: Option<[f32; 3]>,
+    /// Final rise after 120 s, °C, per axis.
+    final_rise: [f64; 3],
+    /// Sample times, ms.
+    times: Vec<u32>,
+    /// Per-sample input override (sample index, ms) → optional (rates, raw temperatures).
+    tamper: fn(usize, u32, &mut [f32; 3], &mut [f32; 3]),
+}
+
+fn untouched(_: usize, _: u32, _: &mut [f32; 3], _: &mut [f32; 3]) {}
+
+fn every(step_ms: u32, until_ms: u32) -> Vec<u32> {
+    let mut times: Vec<u32> = (0..=until_ms).step_by(step_ms as usize).collect();
+    // Exactly on, just before and just after every reference time: the knots of stage 1.
+    for &t in &fixture::REFERENCE_MS {
+        if t <= until_ms {
+            times.extend([t - 1, t, t + 1]);
+        }
+    }
+    times.sort_unstable();
+    times.dedup();
+    times
+}
+
+fn scenarios() -> Vec<Scenario> {
+    vec![
+        Scenario {
+            name: "modified-between-ambients",
+            description: "switch-on at 33 °C (between the 30 and 40 °C tables), rise between stored curves, 2 min",
+            model: "modified",
+            switch_on_celsius: Some([33.0, 33.2, 32.9]),
+            final_rise: [4.1, 3.3, 5.2],
+            times: every(500, 120_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "modified-on-calibration-ambient",
+            description: "switch-on exactly at a calibration ambient (30 °C): stage 2 uses one table",
+            model: "modified",
+            switch_on_celsius: Some([30.0, 30.0, 30.0]),
+            final_rise: [2.4, 4.6, 6.0],
+            times: every(1000, 120_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "modified-ambient-below-range",
+            description: "switch-on at 10 °C, below the calibrated 20–40 °C: clamped to 20 °C and flagged",
+            model: "modified",
+            switch_on_celsius: Some([10.0, 10.0, 10.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(4000, 120_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "modified-ambient-above-range",
+            description: "switch-on at 50 °C, above the calibrated range: clamped to 40 °C and flagged",
+            model: "modified",
+            switch_on_celsius: Some([50.0, 50.0, 50.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(4000, 120_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "modified-rise-out-of-span",
+            description: "X heats faster than any stored curve, Y cools (negative rise), Z inside: clamp and flag",
+            model: "modified",
+            switch_on_celsius: Some([25.0, 25.0, 25.0]),
+            final_rise: [9.0, -1.5, 3.0],
+            times: every(2000, 120_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "modified-past-last-reference",
+            description: "runs 5 min: after 120 s k is held at its last value and flagged",
+            model: "modified",
+            switch_on_celsius: Some([35.0, 35.0, 35.0]),
+            final_rise: [3.0, 4.0, 5.0],
+            times: every(3000, 300_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "modified-temperature-faults",
+            description: "X temperature NaN then +inf for a while, Y stuck for 30 samples, Z fine: hold last good drift and flag",
+            model: "modified",
+            switch_on_celsius: Some([31.0, 31.0, 31.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: (0..=120).map(|i| i * 250).collect(),
+            tamper: |i, _, _, raw| {
+                if (40..45).contains(&i) {
+                    raw[0] = f32::NAN;
+                }
+                if (45..50).contains(&i) {
+                    raw[0] = f32::INFINITY;
+                }
+                if (60..90).contains(&i) {
+                    raw[1] = 6400.0;
+                }
+            },
+        },
+        Scenario {
+            name: "modified-rate-faults",
+            description: "NaN, ±inf and saturated (±500 °/s) rates: non-finite rates pass through flagged",
+            model: "modified",
+            switch_on_celsius: Some([36.0, 36.0, 36.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: (0..40).map(|i| i * 100).collect(),
+            tamper: |i, _, rate, _| match i {
+                10 => rate[0] = f32::NAN,
+                11 => rate[1] = f32::INFINITY,
+                12 => rate[2] = f32::NEG_INFINITY,
+                13 => *rate = [500.0, -500.0, 500.0],
+                _ => {}
+            },
+        },
+        Scenario {
+            name: "modified-not-powered-on",
+            description: "samples without power_on pass through, flagged",
+            model: "modified",
+            switch_on_celsius: None,
+            final_rise: [4.0, 4.0, 4.0],
+            times: (0..10).map(|i| i * 100).collect(),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "modified-power-on-rejects-nan",
+            description: "power_on with a NaN switch-on temperature (axis Y) fails; samples pass through, flagged",
+            model: "modified",
+            switch_on_celsius: Some([30.0, f32::NAN, 30.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: (0..10).map(|i| i * 100).collect(),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "standard-nominal",
+            description: "the standard (Lagrange, degree 2) baseline over a 2-min activation at 27 °C",
+            model: "standard",
+            switch_on_celsius: Some([27.0, 27.5, 26.5]),
+            final_rise: [4.0, 5.0, 3.0],
+            times: every(2000, 120_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "standard-out-of-range",
+            description: "the standard baseline heated past its fitted range (40 °C): clamped and flagged",
+            model: "standard",
+            switch_on_celsius: Some([37.0, 37.0, 37.0]),
+            final_rise: [6.0, 6.0, 6.0],
+            times: every(4000, 120_000),
+            tamper: untouched,
+        },
+        Scenario {
+            name: "third-order-nominal",
+            description: "the 3rd-order baseline over a 2-min activation at 33 °C",
+            model: "third_order",
+            switch_on_celsius: Some([33.0, 33.0, 33.0]),
+            final_rise: [4.0, 5.0, 3.0],
+            times: every(2000, 120_000),
+            tamper: untouched,
+        },
+    ]
+}
+
+fn bits3(values: [f32; 3]) -> [u32; 3] {
+    values.map(f32::to_bits)
+}
+
+fn run<M: Model>(model: &M, scenario: &Scenario, seed: u64) -> Case
+where
+    M::Axis: drift_core::AxisModel,
+{
+    let mut noise = Lcg(seed);
+    let mut corrector = Corrector::new(model).unwrap();
+    let switch_on_raw = scenario.switch_on_celsius.map(|c| c.map(|c| (c * 200.0).round()));
+    let mut power_on_fails = false;
+    if let Some(raw) = switch_on_raw {
+        power_on_fails = corrector.power_on(raw).is_err();
+    }
+    let base_raw = switch_on_raw.unwrap_or([6000.0; 3]).map(|r| if r.is_finite() { r } else { 6000.0 });
+    let mut samples = Vec::new();
+    let mut expected = Vec::new();
+    for (i, &ms) in scenario.times.iter().enumerate() {
+        let t = f64::from(ms) / 1000.0;
+        let shape = (1.0 - (-t / 60.0).exp()) / (1.0 - (-2.0_f64).exp());
+        let mut raw = [0.0_f32; 3];
+        let mut rate = [0.0_f32; 3];
+        for axis in 0..3 {
+            let rise = scenario.final_rise[axis] * shape;
+            // Quantised sensor with about one raw unit of noise.
+            raw[axis] = (f64::from(base_raw[axis]) + 200.0 * rise + noise.next()).round() as f32;
+            let bias = 0.1 * (axis as f64 - 1.0) + 0.004 * rise;
+            rate[axis] = (bias + 0.002 * noise.next()) as f32;
+        }
+        (scenario.tamper)(i, ms, &mut rate, &mut raw);
+        let sample = Sample { since_power_on_ms: ms, rate_dps: rate, temperature_raw: raw };
+        let out = corrector.correct(&sample);
+        let [rx, ry, rz] = bits3(rate);
+        let [tx, ty, tz] = bits3(raw);
+        samples.push([ms, rx, ry, rz, tx, ty, tz]);
+        let [cx, cy, cz] = bits3(out.corrected_dps);
+        let [bx, by, bz] = bits3(out.bias_dps);
+        let [fx, fy, fz] = out.flags.map(|f| u32::from(f.0));
+        expected.push([cx, cy, cz, bx, by, bz, fx, fy, fz]);
+    }
+    Case {
+        name: scenario.name.into(),
+        description: scenario.description.into(),
+        model: scenario.model.into(),
+        switch_on_raw: switch_on_raw.map(bits3),
+        power_on_fails,
+        samples,
+        expected,
+    }
+}
+
+fn named<M: Image + serde::Serialize>(name: &str, kind: &str, model: &M) -> NamedModel {
+    let mut buffer = vec![0_u8; 64 * 1024];
+    let len = encode(model, &mut buffer).unwrap();
+    NamedModel {
+        name: name.into(),
+        kind: kind.into(),
+        image_hex: buffer[..len].iter().map(|b| format!("{b:02x}")).collect(),
+        // Through text, so the JSON holds the short decimals an f32 prints as, not widened f64s.
+        tables: serde_json::from_str(&serde_json::to_string(model).unwrap()).unwrap(),
+    }
+}
+
+/// Builds the whole vector file.
+pub fn build() -> VectorFile {
+    let modified = fixture::modified();
+    let standard = fixture::standard();
+    let third_order = fixture::third_order();
+    let cases = scenarios()
+        .iter()
+        .enumerate()
+        .map(|(i, scenario)| match scenario.model {
+            "modified" => run(&modified, scenario, i as u64 + 1),
+            "standard" => run(&standard, scenario, i as u64 + 1),
+            _ => run(&third_order, scenario, i as u64 + 1),
+        })
+        .collect();
+    VectorFile {
+        format: "gyrodrift-test-vectors".into(),
+        version: 1,
+        description: vec![
+            "Shared test vectors for every implementation of the gyrodrift corrector (Rust host, Cortex-M4 firmware, Python).".into(),
+            "Each model is given as its firmware image (canonical, bit-exact) and as JSON (readable).".into(),
+            "Each case: optional power_on(switch_on_raw), then correct() per sample, in order, on one fresh state.".into(),
+            "samples: [since_power_on_ms, rate x,y,z (°/s), temperature_raw x,y,z]; expected: [corrected x,y,z, bias x,y,z, flags x,y,z].".into(),
+            "Floats are IEEE-754 binary32 bit patterns. Expected outputs must match bit for bit; a NaN matches any NaN.".into(),
+            "Regenerate with: GYRODRIFT_BLESS=1 cargo test -p drift-core --test vectors".into(),
+        ],
+        models: vec![
+            named("modified", "modified", &modified),
+            named("standard", "polynomial", &standard),
+            named("third_order", "polynomial", &third_order),
+        ],
+        cases,
+    }
+}
