@@ -2,6 +2,16 @@
 
 use core::fmt;
 
+/// `usize` to `u8`, saturating (capacities above 255 are documented as unsupported).
+pub(crate) fn saturating_u8(value: usize) -> u8 {
+    u8::try_from(value).unwrap_or(u8::MAX)
+}
+
+/// `usize` to `u16`, saturating.
+pub(crate) fn saturating_u16(value: usize) -> u16 {
+    u16::try_from(value).unwrap_or(u16::MAX)
+}
+
 /// Where in a table a bad value sits. Unused levels are `None`.
 ///
 /// Displayed as a path such as `axes[1].ambients[0].curves[3].rise_celsius[2]`.
@@ -19,9 +29,9 @@ pub struct Location {
 
 impl Location {
     /// A location on one axis.
-    pub const fn axis(axis: usize) -> Self {
+    pub fn axis(axis: usize) -> Self {
         Self {
-            axis: Some(axis as u8),
+            axis: Some(saturating_u8(axis)),
             ambient: None,
             curve: None,
             index: None,
@@ -30,22 +40,22 @@ impl Location {
 
     /// The same location, one level down: a calibration ambient.
     #[must_use]
-    pub const fn ambient(mut self, ambient: usize) -> Self {
-        self.ambient = Some(ambient as u8);
+    pub fn ambient(mut self, ambient: usize) -> Self {
+        self.ambient = Some(saturating_u8(ambient));
         self
     }
 
     /// The same location, one level down: a heating-dynamics curve.
     #[must_use]
-    pub const fn curve(mut self, curve: usize) -> Self {
-        self.curve = Some(curve as u8);
+    pub fn curve(mut self, curve: usize) -> Self {
+        self.curve = Some(saturating_u8(curve));
         self
     }
 
     /// The same location, at an index of the named field.
     #[must_use]
-    pub const fn index(mut self, index: usize) -> Self {
-        self.index = Some(index as u16);
+    pub fn index(mut self, index: usize) -> Self {
+        self.index = Some(saturating_u16(index));
         self
     }
 }
@@ -107,9 +117,7 @@ impl fmt::Display for Error {
         }
         match self.problem {
             Problem::NonFinite => f.write_str(": value is NaN or infinite"),
-            Problem::NotIncreasing => {
-                f.write_str(": not strictly greater than the previous value")
-            }
+            Problem::NotIncreasing => f.write_str(": not strictly greater than the previous value"),
             Problem::NotPositive => f.write_str(": must be greater than zero"),
             Problem::Empty => f.write_str(": needs at least one entry"),
             Problem::LengthMismatch { expected, found } => {
@@ -166,8 +174,8 @@ pub(crate) fn check_len(
             field,
             at,
             Problem::LengthMismatch {
-                expected: expected as u16,
-                found: found as u16,
+                expected: saturating_u16(expected),
+                found: saturating_u16(found),
             },
         ))
     }

@@ -37,7 +37,8 @@ impl PolynomialAxis {
         let [low, high] = self.range_celsius;
         // `max`/`min` rather than `clamp`: `clamp` panics on an inverted range.
         let clamped = celsius.max(low).min(high);
-        let outside = !(celsius >= low - margin_celsius && celsius <= high + margin_celsius);
+        let outside =
+            celsius.is_nan() || celsius < low - margin_celsius || celsius > high + margin_celsius;
         let half_span = 0.5 * (high - low);
         let x = (clamped - (low + half_span)) / half_span;
         let value = self

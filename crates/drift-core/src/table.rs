@@ -80,7 +80,11 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             return Err(Error::new("reference_ms", at, Problem::Empty));
         }
         if self.reference_ms.first() == Some(&0) {
-            return Err(Error::new("reference_ms", at.index(0), Problem::NotPositive));
+            return Err(Error::new(
+                "reference_ms",
+                at.index(0),
+                Problem::NotPositive,
+            ));
         }
         if let Some(index) = self
             .reference_ms
@@ -103,7 +107,9 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         )?;
         for (a, ambient) in self.ambients.iter().enumerate() {
             let at = at.ambient(a);
-            check_finite("initial_bias_dps", at, [ambient.initial_bias_dps])?;
+            if !ambient.initial_bias_dps.is_finite() {
+                return Err(Error::new("initial_bias_dps", at, Problem::NonFinite));
+            }
             if ambient.curves.is_empty() {
                 return Err(Error::new("curves", at, Problem::Empty));
             }
@@ -193,7 +199,8 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         _temperature_celsius: f32,
         rise_celsius: f32,
     ) -> (f32, Flags) {
-        let (k, flags) = self.correlation(settings, &state.ambient, since_power_on_ms, rise_celsius);
+        let (k, flags) =
+            self.correlation(settings, &state.ambient, since_power_on_ms, rise_celsius);
         (k * rise_celsius, flags)
     }
 }
@@ -211,9 +218,11 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         let time = TimePosition::locate(&self.reference_ms, since_power_on_ms);
         let margin = settings.rise_margin_celsius;
         let k_in = |i: u8| {
-            self.ambients.get(usize::from(i)).map_or((f32::NAN, false), |a| {
-                heating::k_at(&a.curves, &time, rise_celsius, margin)
-            })
+            self.ambients
+                .get(usize::from(i))
+                .map_or((f32::NAN, false), |a| {
+                    heating::k_at(&a.curves, &time, rise_celsius, margin)
+                })
         };
         let (k_lo, mut out_of_span) = k_in(ambient.lo);
         let k = if ambient.hi == ambient.lo {

@@ -1,8 +1,13 @@
 //! An independent f64 restatement of the method, written from the docs (linear scans, no shared
 //! code with the crate), checked against the shared test vectors. This is what makes the vectors
 //! evidence of correctness rather than a snapshot of whatever the corrector does.
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
-#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, missing_docs)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
 
 mod common;
 
@@ -95,8 +100,15 @@ fn poly(axis: &Value, celsius: f64, margin: f64) -> (f64, bool) {
     let mid = (range[0] + range[1]) / 2.0;
     let half = (range[1] - range[0]) / 2.0;
     let x = (t - mid) / half;
-    let value: f64 = coefficients.iter().enumerate().map(|(i, c)| c * x.powi(i as i32)).sum();
-    (value, celsius < range[0] - margin || celsius > range[1] + margin)
+    let value: f64 = coefficients
+        .iter()
+        .enumerate()
+        .map(|(i, c)| c * x.powi(i as i32))
+        .sum();
+    (
+        value,
+        celsius < range[0] - margin || celsius > range[1] + margin,
+    )
 }
 
 fn power_on(axis: &Axis, s: &Settings, raw: f64) -> State {
@@ -148,14 +160,24 @@ fn k_at(ambient: &Value, refs: &[f64], ms: f64, rise: f64, margin: f64) -> (f64,
     let curves = ambient["curves"].as_array().unwrap();
     let at_time = |values: &[f64], is_rise: bool| -> f64 {
         if ms < refs[0] {
-            if is_rise { values[0] * ms / refs[0] } else { values[0] }
+            if is_rise {
+                values[0] * ms / refs[0]
+            } else {
+                values[0]
+            }
         } else {
             let (lo, hi, w, _) = bracket(refs, ms);
             lerp(values[lo], values[hi], w)
         }
     };
-    let rises: Vec<f64> = curves.iter().map(|c| at_time(&list(&c["rise_celsius"]), true)).collect();
-    let ks: Vec<f64> = curves.iter().map(|c| at_time(&list(&c["k_dps_per_celsius"]), false)).collect();
+    let rises: Vec<f64> = curves
+        .iter()
+        .map(|c| at_time(&list(&c["rise_celsius"]), true))
+        .collect();
+    let ks: Vec<f64> = curves
+        .iter()
+        .map(|c| at_time(&list(&c["k_dps_per_celsius"]), false))
+        .collect();
     let n = rises.len();
     if rise < rises[0] {
         return (ks[0], rise < rises[0] - margin);
@@ -163,12 +185,28 @@ fn k_at(ambient: &Value, refs: &[f64], ms: f64, rise: f64, margin: f64) -> (f64,
     if rise >= rises[n - 1] {
         return (ks[n - 1], rise > rises[n - 1] + margin);
     }
-    let c = (0..n - 1).find(|&c| rises[c] <= rise && rise < rises[c + 1]).unwrap();
-    (lerp(ks[c], ks[c + 1], (rise - rises[c]) / (rises[c + 1] - rises[c])), false)
+    let c = (0..n - 1)
+        .find(|&c| rises[c] <= rise && rise < rises[c + 1])
+        .unwrap();
+    (
+        lerp(
+            ks[c],
+            ks[c + 1],
+            (rise - rises[c]) / (rises[c + 1] - rises[c]),
+        ),
+        false,
+    )
 }
 
 /// One sample on one axis: (corrected, bias, flags).
-fn correct(axis: &Axis, s: &Settings, st: &mut State, ms: u32, rate: f32, raw: f32) -> (f64, f64, u32) {
+fn correct(
+    axis: &Axis,
+    s: &Settings,
+    st: &mut State,
+    ms: u32,
+    rate: f32,
+    raw: f32,
+) -> (f64, f64, u32) {
     let mut flags = st.activation;
     if !rate.is_finite() {
         flags |= RATE_INVALID;
@@ -190,7 +228,12 @@ fn correct(axis: &Axis, s: &Settings, st: &mut State, ms: u32, rate: f32, raw: f
             let celsius = (raw - s.zero) / s.per;
             match axis {
                 Axis::Modified(table) => {
-                    let refs: Vec<f64> = table["reference_ms"].as_array().unwrap().iter().map(f).collect();
+                    let refs: Vec<f64> = table["reference_ms"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .map(f)
+                        .collect();
                     let ambients = table["ambients"].as_array().unwrap();
                     let ms = f64::from(ms);
                     if ms > refs[refs.len() - 1] {
@@ -238,9 +281,16 @@ fn vectors_agree_with_an_independent_f64_reference() {
             .collect();
         let switch_on = case.switch_on_raw.map(|raw| raw.map(f32::from_bits));
         let powered = matches!(switch_on, Some(raw) if raw.iter().all(|r| r.is_finite()));
-        assert_eq!(case.power_on_fails, switch_on.is_some() && !powered, "{}", case.name);
+        assert_eq!(
+            case.power_on_fails,
+            switch_on.is_some() && !powered,
+            "{}",
+            case.name
+        );
         let mut states: Vec<State> = match switch_on {
-            Some(raw) if powered => (0..3).map(|i| power_on(&axes[i], &s, f64::from(raw[i]))).collect(),
+            Some(raw) if powered => (0..3)
+                .map(|i| power_on(&axes[i], &s, f64::from(raw[i])))
+                .collect(),
             _ => Vec::new(),
         };
         for (i, (input, expected)) in case.samples.iter().zip(&case.expected).enumerate() {
@@ -250,7 +300,11 @@ fn vectors_agree_with_an_independent_f64_reference() {
                 let (corrected, bias, flags) = if powered {
                     correct(&axes[axis], &s, &mut states[axis], input[0], rate, raw)
                 } else {
-                    (f64::from(rate), 0.0, NOT_POWERED_ON | if rate.is_finite() { 0 } else { RATE_INVALID })
+                    (
+                        f64::from(rate),
+                        0.0,
+                        NOT_POWERED_ON | if rate.is_finite() { 0 } else { RATE_INVALID },
+                    )
                 };
                 let got_corrected = f64::from(f32::from_bits(expected[axis]));
                 let got_bias = f64::from(f32::from_bits(expected[3 + axis]));
@@ -259,11 +313,18 @@ fn vectors_agree_with_an_independent_f64_reference() {
                 if corrected.is_finite() {
                     // The corrected rate is itself an f32: allow its own rounding at large rates.
                     let rounding = f64::from(f32::EPSILON) * f64::from(rate).abs();
-                    let error = ((got_corrected - corrected).abs() - rounding).max((got_bias - bias).abs());
-                    assert!(error <= TOLERANCE_DPS, "{at}: f32 {got_corrected} vs f64 {corrected} (bias {got_bias} vs {bias})");
+                    let error =
+                        ((got_corrected - corrected).abs() - rounding).max((got_bias - bias).abs());
+                    assert!(
+                        error <= TOLERANCE_DPS,
+                        "{at}: f32 {got_corrected} vs f64 {corrected} (bias {got_bias} vs {bias})"
+                    );
                     worst = worst.max(error);
                 } else {
-                    assert!(!got_corrected.is_finite() && got_corrected.is_nan() == corrected.is_nan(), "{at}");
+                    assert!(
+                        !got_corrected.is_finite() && got_corrected.is_nan() == corrected.is_nan(),
+                        "{at}"
+                    );
                 }
                 checked += 1;
             }

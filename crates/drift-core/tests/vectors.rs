@@ -1,7 +1,12 @@
 //! The shared test vectors: the committed file is current, and the corrector reproduces it bit for
 //! bit from the firmware images (what the Cortex-M4 run and the Python tests check too).
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
-#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, missing_docs)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
 
 mod common;
 
@@ -12,12 +17,16 @@ use drift_core::{Corrector, Model, ModifiedTables, PolynomialTables, Sample};
 const PATH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/vectors.json");
 
 fn load() -> VectorFile {
-    let text = std::fs::read_to_string(PATH).expect("testdata/vectors.json (regenerate: GYRODRIFT_BLESS=1)");
+    let text = std::fs::read_to_string(PATH)
+        .expect("testdata/vectors.json (regenerate: GYRODRIFT_BLESS=1)");
     serde_json::from_str(&text).unwrap()
 }
 
 fn unhex(hex: &str) -> Vec<u8> {
-    (0..hex.len()).step_by(2).map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap()).collect()
+    (0..hex.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap())
+        .collect()
 }
 
 #[test]
@@ -38,7 +47,12 @@ fn same(expected: u32, got: u32) -> bool {
 fn check_case<M: Model>(model: &M, case: &Case) -> usize {
     let mut corrector = Corrector::new(model).unwrap();
     if let Some(raw) = case.switch_on_raw {
-        assert_eq!(corrector.power_on(raw.map(f32::from_bits)).is_err(), case.power_on_fails, "{}", case.name);
+        assert_eq!(
+            corrector.power_on(raw.map(f32::from_bits)).is_err(),
+            case.power_on_fails,
+            "{}",
+            case.name
+        );
     }
     let mut mismatches = 0;
     for (i, (input, expected)) in case.samples.iter().zip(&case.expected).enumerate() {
@@ -58,7 +72,10 @@ fn check_case<M: Model>(model: &M, case: &Case) -> usize {
         for (k, (&e, &g)) in expected.iter().zip(&got).enumerate() {
             if !same(e, g) {
                 mismatches += 1;
-                eprintln!("{} sample {i} output {k}: expected {e:#010x}, got {g:#010x}", case.name);
+                eprintln!(
+                    "{} sample {i} output {k}: expected {e:#010x}, got {g:#010x}",
+                    case.name
+                );
             }
         }
     }
@@ -98,12 +115,24 @@ fn json_tables_equal_the_images() {
         let bytes = unhex(&named.image_hex);
         match named.kind.as_str() {
             "modified" => {
-                let from_json: ModifiedTables = serde_json::from_value(named.tables.clone()).unwrap();
-                assert_eq!(from_json, decode::<ModifiedTables>(&bytes).unwrap(), "{}", named.name);
+                let from_json: ModifiedTables =
+                    serde_json::from_value(named.tables.clone()).unwrap();
+                assert_eq!(
+                    from_json,
+                    decode::<ModifiedTables>(&bytes).unwrap(),
+                    "{}",
+                    named.name
+                );
             }
             "polynomial" => {
-                let from_json: PolynomialTables = serde_json::from_value(named.tables.clone()).unwrap();
-                assert_eq!(from_json, decode::<PolynomialTables>(&bytes).unwrap(), "{}", named.name);
+                let from_json: PolynomialTables =
+                    serde_json::from_value(named.tables.clone()).unwrap();
+                assert_eq!(
+                    from_json,
+                    decode::<PolynomialTables>(&bytes).unwrap(),
+                    "{}",
+                    named.name
+                );
             }
             other => panic!("unknown kind {other}"),
         }
@@ -135,4 +164,3 @@ fn every_case_name_and_flag_kind_is_covered() {
         assert!(seen.contains(flag), "no vector exercises flag {flag:?}");
     }
 }
-

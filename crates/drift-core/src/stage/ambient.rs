@@ -1,6 +1,7 @@
 //! Stage 2: ambient temperature. Locates the switch-on temperature among the calibration ambients,
 //! once per activation.
 
+use crate::error::saturating_u8;
 use crate::interp::{bracket, lerp, Bracket};
 
 /// The two calibration ambients that bracket the switch-on temperature, and the blend between them.
@@ -30,19 +31,23 @@ impl AmbientPosition {
     ) -> Self {
         let first = ambients.first().map_or(f32::NAN, &ambient);
         let last = ambients.last().map_or(f32::NAN, &ambient);
-        let last_index = ambients.len().saturating_sub(1) as u8;
+        let last_index = saturating_u8(ambients.len().saturating_sub(1));
         match bracket(ambients, celsius, ambient) {
             Bracket::Below => Self {
                 lo: 0,
                 hi: 0,
                 weight: 0.0,
-                out_of_range: !(celsius >= first - margin_celsius),
+                out_of_range: celsius.is_nan() || celsius < first - margin_celsius,
             },
             Bracket::Inside { lo, fraction } => {
-                let lo = lo as u8;
+                let lo = saturating_u8(lo);
                 Self {
                     lo,
-                    hi: if fraction > 0.0 { lo.saturating_add(1) } else { lo },
+                    hi: if fraction > 0.0 {
+                        lo.saturating_add(1)
+                    } else {
+                        lo
+                    },
                     weight: fraction,
                     out_of_range: false,
                 }
@@ -51,7 +56,7 @@ impl AmbientPosition {
                 lo: last_index,
                 hi: last_index,
                 weight: 0.0,
-                out_of_range: !(celsius <= last + margin_celsius),
+                out_of_range: celsius > last + margin_celsius,
             },
         }
     }

@@ -15,7 +15,10 @@ struct Lcg(u64);
 
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     }
 }
@@ -198,12 +201,16 @@ where
 {
     let mut noise = Lcg(seed);
     let mut corrector = Corrector::new(model).unwrap();
-    let switch_on_raw = scenario.switch_on_celsius.map(|c| c.map(|c| (c * 200.0).round()));
+    let switch_on_raw = scenario
+        .switch_on_celsius
+        .map(|c| c.map(|c| (c * 200.0).round()));
     let mut power_on_fails = false;
     if let Some(raw) = switch_on_raw {
         power_on_fails = corrector.power_on(raw).is_err();
     }
-    let base_raw = switch_on_raw.unwrap_or([6000.0; 3]).map(|r| if r.is_finite() { r } else { 6000.0 });
+    let base_raw = switch_on_raw
+        .unwrap_or([6000.0; 3])
+        .map(|r| if r.is_finite() { r } else { 6000.0 });
     let mut samples = Vec::new();
     let mut expected = Vec::new();
     for (i, &ms) in scenario.times.iter().enumerate() {
@@ -219,7 +226,11 @@ where
             rate[axis] = (bias + 0.002 * noise.next()) as f32;
         }
         (scenario.tamper)(i, ms, &mut rate, &mut raw);
-        let sample = Sample { since_power_on_ms: ms, rate_dps: rate, temperature_raw: raw };
+        let sample = Sample {
+            since_power_on_ms: ms,
+            rate_dps: rate,
+            temperature_raw: raw,
+        };
         let out = corrector.correct(&sample);
         let [rx, ry, rz] = bits3(rate);
         let [tx, ty, tz] = bits3(raw);

@@ -6,10 +6,14 @@
 //! slightly larger for curves that heat more. Values are rounded to 5 decimals so their JSON text
 //! round-trips to the same f32 in every language.
 
-use drift_core::{AmbientCurves, AxisTable, Curve, ModifiedTables, PolynomialAxis, PolynomialTables, Settings};
+use drift_core::{
+    AmbientCurves, AxisTable, Curve, ModifiedTables, PolynomialAxis, PolynomialTables, Settings,
+};
 
 /// Reference times, ms.
-pub const REFERENCE_MS: [u32; 8] = [2_000, 5_000, 10_000, 20_000, 30_000, 60_000, 90_000, 120_000];
+pub const REFERENCE_MS: [u32; 8] = [
+    2_000, 5_000, 10_000, 20_000, 30_000, 60_000, 90_000, 120_000,
+];
 /// Calibration ambients, °C.
 pub const AMBIENTS: [f32; 3] = [20.0, 30.0, 40.0];
 /// Curves per ambient.
@@ -37,7 +41,11 @@ fn round_sig(x: f64) -> f32 {
 }
 
 /// Per-axis character: (k scale (°/s)/°C, initial bias °/s, initial-bias slope (°/s)/°C).
-const AXIS: [(f64, f64, f64); 3] = [(0.0042, 0.120, 0.0020), (-0.0031, -0.045, 0.0012), (0.0055, 0.010, -0.0016)];
+const AXIS: [(f64, f64, f64); 3] = [
+    (0.0042, 0.120, 0.0020),
+    (-0.0031, -0.045, 0.0012),
+    (0.0055, 0.010, -0.0016),
+];
 
 /// Final rise of curve `c` at ambient `ambient` after 2 min, °C.
 pub fn final_rise(c: usize, ambient: f32) -> f64 {
@@ -48,8 +56,10 @@ pub fn final_rise(c: usize, ambient: f32) -> f64 {
 pub fn modified() -> FixtureTables {
     let axes = core::array::from_fn(|axis| {
         let (k_scale, bias0, bias_slope) = AXIS[axis];
-        let mut table = AxisTable::default();
-        table.reference_ms = heapless::Vec::from_slice(&REFERENCE_MS).unwrap();
+        let mut table = AxisTable {
+            reference_ms: heapless::Vec::from_slice(&REFERENCE_MS).unwrap(),
+            ..AxisTable::default()
+        };
         for &ambient in &AMBIENTS {
             let mut at = AmbientCurves {
                 ambient_celsius: ambient,
@@ -60,7 +70,8 @@ pub fn modified() -> FixtureTables {
                 let mut curve = Curve::default();
                 for &ms in &REFERENCE_MS {
                     let t = f64::from(ms) / 1000.0;
-                    let rise = final_rise(c, ambient) * (1.0 - (-t / 60.0).exp()) / (1.0 - (-2.0_f64).exp());
+                    let rise = final_rise(c, ambient) * (1.0 - (-t / 60.0).exp())
+                        / (1.0 - (-2.0_f64).exp());
                     let k = k_scale
                         * (1.0 + 0.4 * (-t / 20.0).exp())
                         * (0.85 + 0.15 * c as f64 / (CURVES - 1) as f64)
@@ -83,7 +94,12 @@ pub fn standard() -> PolynomialTables {
         let (_, bias0, slope) = AXIS[axis];
         PolynomialAxis {
             range_celsius: [20.0, 40.0],
-            coefficients: heapless::Vec::from_slice(&[round5(bias0 + 0.004), round5(slope * 10.0), round5(0.003)]).unwrap(),
+            coefficients: heapless::Vec::from_slice(&[
+                round5(bias0 + 0.004),
+                round5(slope * 10.0),
+                round5(0.003),
+            ])
+            .unwrap(),
         }
     });
     PolynomialTables::try_new(settings(), axes).unwrap()

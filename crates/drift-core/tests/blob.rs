@@ -1,0 +1,225 @@
+//! The firmware table image: round trip, and a distinct error (never a panic) for every kind of bad
+//! byte string.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
+
+mod common;
+
+use common::fixture::{self, FixtureTables};
+use drift_core::blob::{decode, encode, BlobError, FORMAT_VERSION, HEADER_LEN, MAGIC};
+use drift_core::{ModifiedTables, PolynomialTables, Problem};
+use proptest::prelude::*;
+
+fn image() -> Vec<u8> {
+    let mut buffer = vec![0; 64 * 1024];
+    let len = encode(&fixture::modified(), &mut buffer).unwrap();
+    buffer.truncate(len);
+    buffer
+}
+
+/// Recomputes the CRC after deliberate tampering, so the test reaches the check behind it.
+fn reseal(bytes: &mut [u8]) {
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
+    let body = bytes.len() - 4;
+    let sum = crc.checksum(&bytes[..body]);
+    bytes[body..].copy_from_slice(&sum.to_le_bytes());
+}
+
+#[test]
+fn round_trips_every_model_kind() {
+    let bytes = image();
+    assert_eq!(
+        decode::<FixtureTables>(&bytes).unwrap(),
+        fixture::modified()
+    );
+    // A host build with larger capacities reads the same image.
+    let host: ModifiedTables = decode(&bytes).unwrap();
+    assert_eq!(
+        host.axes[2].ambients[1].curves[7].k_dps_per_celsius,
+        fixture::modified().axes[2].ambients[1].curves[7].k_dps_per_celsius
+    );
+    let mut buffer = vec![0; 4096];
+    for model in [fixture::standard(), fixture::third_order()] {
+        let len = encode(&model, &mut buffer).unwrap();
+        assert_eq!(decode::<PolynomialTables>(&buffer[..len]).unwrap(), model);
+    }
+    // A realistic table (3 axes, 3 ambients, 16 curves, 8 reference times) is a few KiB of flash.
+    assert!(bytes.len() < 10_000, "image is {} bytes", bytes.len());
+}
+
+#[test]
+fn each_bad_input_gets_its_own_error() {
+    let good = image();
+
+    let mut bytes = good.clone();
+    bytes[0] = b'X';
+    assert!(matches!(
+        decode::<FixtureTables>(&bytes),
+        Err(BlobError::BadMagic { .. })
+    ));
+    assert!(matches!(
+        decode::<FixtureTables>(b"PNG"),
+        Err(BlobError::Truncated {
+            needed: 16,
+            found: 3
+        })
+    ));
+    assert!(matches!(
+        decode::<FixtureTables>(b"\x89PNG\r\n\x1a\n"),
+        Err(BlobError::BadMagic { .. })
+    ));
+
+    let mut bytes = good.clone();
+    bytes[4..6].copy_from_slice(&(FORMAT_VERSION + 1).to_le_bytes());
+    assert_eq!(
+        decode::<FixtureTables>(&bytes),
+        Err(BlobError::UnsupportedVersion {
+            found: FORMAT_VERSION + 1
+        })
+    );
+
+    assert_eq!(
+        decode::<PolynomialTables>(&good),
+        Err(BlobError::WrongKind {
+            expected: 2,
+            found: 1
+        })
+    );
+
+    let mut bytes = good.clone();
+    bytes.push(0);
+    assert_eq!(
+        decode::<FixtureTables>(&bytes),
+        Err(BlobError::TrailingBytes { count: 1 })
+    );
+
+    let mut bytes = good.clone();
+    bytes[HEADER_LEN + 20] ^= 0x10;
+    assert!(matches!(
+        decode::<FixtureTables>(&bytes),
+        Err(BlobError::CrcMismatch { .. })
+    ));
+
+    // Oversized counts: more curves than this build's capacity.
+    assert!(matches!(
+        decode::<ModifiedTables<8, 3, 8>>(&good),
+        Err(BlobError::Malformed(_))
+    ));
+
+    // Declared payload length larger than the bytes.
+    let mut bytes = good.clone();
+    bytes[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+    assert!(matches!(
+        decode::<FixtureTables>(&bytes),
+        Err(BlobError::Truncated { .. })
+    ));
+}
+
+#[test]
+fn invalid_contents_are_named() {
+    let mut tables = fixture::modified();
+    tables.axes[1].ambients[2].curves[4].rise_celsius[3] = f32::NAN;
+    let mut buffer = vec![0; 64 * 1024];
+    // The encoder refuses to write what the firmware would reject...
+    let error = encode(&tables, &mut buffer).unwrap_err();
+    let BlobError::Invalid(inner) = error else {
+        panic!("{error:?}")
+    };
+    assert_eq!(inner.problem, Problem::NonFinite);
+    assert_eq!(
+        inner.to_string(),
+        "axes[1].ambients[2].curves[4].rise_celsius[3]: value is NaN or infinite"
+    );
+    // ...and the decoder refuses a forged image that holds it.
+    let mut bytes = image();
+    let nan = f32::NAN.to_le_bytes();
+    let good_value = fixture::modified().axes[0].ambients[0]
+        .initial_bias_dps
+        .to_le_bytes();
+    let at = bytes.windows(4).position(|w| w == good_value).unwrap();
+    bytes[at..at + 4].copy_from_slice(&nan);
+    reseal(&mut bytes);
+    let error = decode::<FixtureTables>(&bytes).unwrap_err();
+    assert_eq!(error.to_string(), "table image contents are invalid: axes[0].ambients[0].initial_bias_dps: value is NaN or infinite");
+}
+
+#[test]
+fn every_truncation_and_every_bit_flip_is_caught() {
+    let good = image();
+    for len in 0..good.len() {
+        assert!(
+            decode::<FixtureTables>(&good[..len]).is_err(),
+            "truncated to {len} bytes accepted"
+        );
+    }
+    let mut bytes = good.clone();
+    for byte in 0..good.len() {
+        for bit in 0..8 {
+            bytes[byte] ^= 1 << bit;
+            assert!(
+                decode::<FixtureTables>(&bytes).is_err(),
+                "bit {bit} of byte {byte} flipped, accepted"
+            );
+            bytes[byte] ^= 1 << bit;
+        }
+    }
+}
+
+#[test]
+fn messages_say_what_is_wrong() {
+    let cases = [
+        (
+            BlobError::BadMagic {
+                found: *b"PK\x03\x04",
+            },
+            "not a gyrodrift table image",
+        ),
+        (
+            BlobError::UnsupportedVersion { found: 9 },
+            "version 9 is not supported",
+        ),
+        (
+            BlobError::CrcMismatch {
+                stored: 1,
+                computed: 2,
+            },
+            "CRC mismatch",
+        ),
+        (
+            BlobError::Truncated {
+                needed: 100,
+                found: 10,
+            },
+            "needs 100 bytes, got 10",
+        ),
+    ];
+    for (error, text) in cases {
+        assert!(error.to_string().contains(text), "{error}");
+    }
+    assert_eq!(&MAGIC, b"GYDT");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// Arbitrary bytes, and arbitrary bytes behind a valid header, decode to an error, not a panic.
+    #[test]
+    fn arbitrary_bytes_never_panic(tail in prop::collection::vec(any::<u8>(), 0..600), keep_header in any::<bool>()) {
+        let mut bytes = Vec::new();
+        if keep_header {
+            bytes.extend_from_slice(&image()[..HEADER_LEN]);
+        }
+        bytes.extend_from_slice(&tail);
+        let _ = decode::<FixtureTables>(&bytes);
+        let _ = decode::<PolynomialTables>(&bytes);
+        if bytes.len() >= 16 {
+            reseal(&mut bytes);
+            let _ = decode::<FixtureTables>(&bytes);
+        }
+    }
+}

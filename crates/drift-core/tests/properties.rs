@@ -1,0 +1,186 @@
+//! Property tests of the three interpolation stages on random valid tables: the interpolation
+//! reproduces the table at its knots, stays between neighbouring table values, and is continuous
+//! across knots.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
+
+use drift_core::{AmbientCurves, AmbientPosition, AxisTable, Curve, Settings};
+use proptest::prelude::*;
+
+type Table = AxisTable<6, 3, 5>;
+
+/// Smallest gap between neighbouring curves' rises, °C, and between reference times, ms.
+const RISE_GAP: f32 = 0.2;
+const TIME_GAP_MS: u32 = 10_000;
+
+fn table() -> impl Strategy<Value = Table> {
+    (2usize..=6, 1usize..=3, 1usize..=5).prop_flat_map(|(refs, ambients, curves)| {
+        (
+            prop::collection::vec(0u32..20_000, refs),
+            prop::collection::vec(1u32..40, ambients),
+            prop::collection::vec(
+                prop::collection::vec((0.0f32..1.0, -0.01f32..0.01), refs * curves),
+                ambients,
+            ),
+            prop::collection::vec(-0.5f32..0.5, ambients),
+        )
+            .prop_map(move |(time_steps, ambient_steps, points, biases)| {
+                let mut table = Table::default();
+                let mut t = 0;
+                for step in time_steps {
+                    t += TIME_GAP_MS + step;
+                    table.reference_ms.push(t).unwrap();
+                }
+                // Ambients on a 0.5 °C grid, so 200 raw units per °C hit them exactly.
+                let mut ambient = -10.0;
+                for ((step, points), bias) in ambient_steps.into_iter().zip(points).zip(biases) {
+                    ambient += step as f32 * 0.5;
+                    let mut at = AmbientCurves {
+                        ambient_celsius: ambient,
+                        initial_bias_dps: bias,
+                        curves: heapless::Vec::new(),
+                    };
+                    // Ordered by rise at every reference time: curve c sits at least RISE_GAP above c − 1.
+                    let mut rise: Vec<f32> = (0..refs).map(|j| j as f32 * 0.5).collect();
+                    for c in 0..curves {
+                        let mut curve = Curve::default();
+                        for (j, rise) in rise.iter_mut().enumerate() {
+                            let (spread, k) = points[c * refs + j];
+                            if c > 0 {
+                                *rise += RISE_GAP + spread;
+                            }
+                            curve.rise_celsius.push(*rise).unwrap();
+                            curve.k_dps_per_celsius.push(k).unwrap();
+                        }
+                        at.curves.push(curve).unwrap();
+                    }
+                    table.ambients.push(at).unwrap();
+                }
+                table
+            })
+    })
+}
+
+fn settings() -> Settings {
+    Settings::default()
+}
+
+fn position(table: &Table, celsius: f32) -> AmbientPosition {
+    AmbientPosition::locate(&table.ambients, celsius, 0.5, |a| a.ambient_celsius)
+}
+
+fn k(table: &Table, celsius: f32, ms: u32, rise: f32) -> f32 {
+    table
+        .correlation(&settings(), &position(table, celsius), ms, rise)
+        .0
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn table_is_valid(table in table()) {
+        prop_assert!(table.validate(drift_core::Location::axis(0)).is_ok());
+    }
+
+    /// At a calibration ambient, a reference time and a stored curve's rise, `k` is the stored value
+    /// exactly.
+    #[test]
+    fn reproduces_table_values_at_knots(table in table(), a in 0usize..3, c in 0usize..5, j in 0usize..6) {
+        let a = a % table.ambients.len();
+        let j = j % table.reference_ms.len();
+        let ambient = &table.ambients[a];
+        let c = c % ambient.curves.len();
+        let curve = &ambient.curves[c];
+        let got = k(&table, ambient.ambient_celsius, table.reference_ms[j], curve.rise_celsius[j]);
+        prop_assert_eq!(got, curve.k_dps_per_celsius[j]);
+    }
+
+    /// Anywhere inside the envelope, `k` lies between the smallest and largest stored `k` of the
+    /// bracketing ambients and reference times.
+    #[test]
+    fn stays_between_neighbouring_values(table in table(), ambient_u in 0.0f32..1.0, time_u in 0.0f32..1.0, rise_u in 0.0f32..1.0) {
+        let first = table.ambients.first().unwrap().ambient_celsius;
+        let last = table.ambients.last().unwrap().ambient_celsius;
+        let celsius = first + (last - first) * ambient_u;
+        let t0 = table.reference_ms[0];
+        let t1 = *table.reference_ms.last().unwrap();
+        let ms = t0 + ((t1 - t0) as f32 * time_u) as u32;
+        let j = table.reference_ms.iter().rposition(|&t| t <= ms).unwrap();
+        let j1 = (j + 1).min(table.reference_ms.len() - 1);
+        let p = position(&table, celsius);
+        let mut lo = f32::INFINITY;
+        let mut hi = f32::NEG_INFINITY;
+        let mut rise_lo = f32::INFINITY;
+        let mut rise_hi = f32::NEG_INFINITY;
+        for a in [p.lo, p.hi] {
+            for curve in &table.ambients[usize::from(a)].curves {
+                for jj in [j, j1] {
+                    lo = lo.min(curve.k_dps_per_celsius[jj]);
+                    hi = hi.max(curve.k_dps_per_celsius[jj]);
+                    rise_lo = rise_lo.min(curve.rise_celsius[jj]);
+                    rise_hi = rise_hi.max(curve.rise_celsius[jj]);
+                }
+            }
+        }
+        let rise = rise_lo + (rise_hi - rise_lo) * rise_u;
+        let got = k(&table, celsius, ms, rise);
+        let slack = 1e-6 * (hi - lo).abs().max(1e-3);
+        prop_assert!(got >= lo - slack && got <= hi + slack, "k {} outside [{}, {}]", got, lo, hi);
+    }
+
+    /// Across each curve's rise (stage 3) `k` has no jump: its change over ±δ is bounded by the
+    /// steepest slope between neighbouring curves.
+    #[test]
+    fn continuous_across_curve_rises(table in table(), a in 0usize..3, c in 0usize..5, time_u in 0.0f32..1.0) {
+        let a = a % table.ambients.len();
+        let ambient = &table.ambients[a];
+        let t0 = table.reference_ms[0];
+        let t1 = *table.reference_ms.last().unwrap();
+        let ms = t0 + ((t1 - t0) as f32 * time_u) as u32;
+        let j = table.reference_ms.iter().rposition(|&t| t <= ms).unwrap();
+        let j1 = (j + 1).min(table.reference_ms.len() - 1);
+        let span = (table.reference_ms[j1] - table.reference_ms[j]).max(1) as f32;
+        let w = (ms - table.reference_ms[j]) as f32 / span;
+        let at = |v: &[f32]| v[j] + (v[j1] - v[j]) * w;
+        let c = c % ambient.curves.len();
+        let rise = at(&ambient.curves[c].rise_celsius);
+        let mut slope = 0.0f32;
+        for pair in ambient.curves.windows(2) {
+            let dk = (at(&pair[1].k_dps_per_celsius) - at(&pair[0].k_dps_per_celsius)).abs();
+            let dr = at(&pair[1].rise_celsius) - at(&pair[0].rise_celsius);
+            slope = slope.max(dk / dr);
+        }
+        let delta = 1e-3;
+        let below = k(&table, ambient.ambient_celsius, ms, rise - delta);
+        let above = k(&table, ambient.ambient_celsius, ms, rise + delta);
+        prop_assert!((above - below).abs() <= 2.0 * delta * slope * 1.01 + 1e-6, "jump {} at rise {}", above - below, rise);
+    }
+
+    /// Across each reference time (stage 1) `k` has no jump: one millisecond either side moves it by
+    /// no more than the table's steepest rates of change allow.
+    #[test]
+    fn continuous_across_reference_times(table in table(), a in 0usize..3, j in 1usize..6, rise_u in 0.0f32..1.0) {
+        let a = a % table.ambients.len();
+        let ambient = &table.ambients[a];
+        let j = j % table.reference_ms.len();
+        let t = table.reference_ms[j];
+        let top = ambient.curves.last().unwrap().rise_celsius[j];
+        let rise = top * rise_u;
+        let dt = 1.0 / TIME_GAP_MS as f32; // per ms, the steepest a segment can be, per unit change
+        let k_range = 0.02;
+        let rise_range = 0.5 + 4.0 * (RISE_GAP + 1.0);
+        // dk/dt ≤ 3·(k change rate) + 2·|Δk|·2·(rise change rate)/gap, from k = k_lo + w (k_hi − k_lo).
+        let bound_per_ms = 3.0 * k_range * dt + 2.0 * k_range * 2.0 * rise_range * dt / RISE_GAP;
+        let here = k(&table, ambient.ambient_celsius, t, rise);
+        for neighbour in [t - 1, t + 1] {
+            let there = k(&table, ambient.ambient_celsius, neighbour, rise);
+            prop_assert!((there - here).abs() <= bound_per_ms + 1e-6, "jump {} at t {}", there - here, t);
+        }
+    }
+}
