@@ -1,6 +1,7 @@
 //! An independent f64 restatement of the method, written from the docs (linear scans, no shared
 //! code with the crate), checked against the shared test vectors. This is what makes the vectors
 //! evidence of correctness rather than a snapshot of whatever the corrector does.
+#![allow(clippy::print_stderr)]
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,

@@ -1,5 +1,6 @@
 //! The shared test vectors: the committed file is current, and the corrector reproduces it bit for
 //! bit from the firmware images (what the Cortex-M4 run and the Python tests check too).
+#![allow(clippy::print_stderr)]
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
