@@ -14,7 +14,7 @@ pub(crate) fn saturating_u16(value: usize) -> u16 {
 
 /// Where in a table a bad value sits. Unused levels are `None`.
 ///
-/// Displayed as a path such as `axes[1].ambients[0].curves[3].rise_celsius[2]`.
+/// Displayed as a path such as `axes[1].ambients[0].curves[3].points[2].rise_celsius`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Location {
     /// Axis index (0 = X, 1 = Y, 2 = Z).
@@ -23,6 +23,8 @@ pub struct Location {
     pub ambient: Option<u8>,
     /// Index into the heating-dynamics curves of that ambient.
     pub curve: Option<u8>,
+    /// Index into that curve's points (one per reference time).
+    pub point: Option<u8>,
     /// Index into the named field itself (a reference time, a coefficient, ...).
     pub index: Option<u16>,
 }
@@ -34,6 +36,7 @@ impl Location {
             axis: Some(saturating_u8(axis)),
             ambient: None,
             curve: None,
+            point: None,
             index: None,
         }
     }
@@ -49,6 +52,13 @@ impl Location {
     #[must_use]
     pub fn curve(mut self, curve: usize) -> Self {
         self.curve = Some(saturating_u8(curve));
+        self
+    }
+
+    /// The same location, one level down: a point of a curve.
+    #[must_use]
+    pub fn point(mut self, point: usize) -> Self {
+        self.point = Some(saturating_u8(point));
         self
     }
 
@@ -110,6 +120,9 @@ impl fmt::Display for Error {
         }
         if let Some(curve) = self.at.curve {
             write!(f, "curves[{curve}].")?;
+        }
+        if let Some(point) = self.at.point {
+            write!(f, "points[{point}].")?;
         }
         f.write_str(self.field)?;
         if let Some(index) = self.at.index {

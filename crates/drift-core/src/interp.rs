@@ -7,7 +7,7 @@
 /// Linear interpolation from `lo` (at `fraction = 0`) to `hi` (at `fraction = 1`).
 ///
 /// Exact at `fraction = 0`, so a table value is reproduced bit for bit at its knot.
-#[inline]
+#[inline(always)]
 pub(crate) fn lerp(lo: f32, hi: f32, fraction: f32) -> f32 {
     lo + (hi - lo) * fraction
 }
@@ -49,15 +49,6 @@ pub(crate) fn bracket<T>(knots: &[T], x: f32, position: impl Fn(&T) -> f32) -> B
     }
 }
 
-/// Value of `values` at a bracket position, holding the end values outside the knots.
-#[inline]
-pub(crate) fn value_at(values: &[f32], lo: usize, hi: usize, fraction: f32) -> f32 {
-    match (values.get(lo), values.get(hi)) {
-        (Some(&lo), Some(&hi)) => lerp(lo, hi, fraction),
-        _ => f32::NAN,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,7 +87,5 @@ mod tests {
     #[test]
     fn lerp_is_exact_at_the_lower_knot() {
         assert_eq!(lerp(0.1, 0.7, 0.0), 0.1);
-        assert_eq!(value_at(&[0.1, 0.7], 0, 1, 0.5), 0.1 + (0.7 - 0.1) * 0.5);
-        assert!(value_at(&[0.1], 0, 1, 0.5).is_nan());
     }
 }

@@ -39,7 +39,7 @@ pub use polynomial::{
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::TimePosition;
-pub use table::{AmbientCurves, AxisTable, Curve, ModifiedAxisState, ModifiedTables};
+pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedAxisState, ModifiedTables};
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.
 pub const AXES: usize = 3;

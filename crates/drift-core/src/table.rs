@@ -2,24 +2,34 @@
 
 use heapless::Vec;
 
-use crate::error::{check_finite, check_increasing, check_len, Error, Location, Problem};
+use crate::error::{check_increasing, check_len, Error, Location, Problem};
 use crate::flags::Flags;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
 use crate::stage::ambient::AmbientPosition;
-use crate::stage::heating;
+use crate::stage::heating::BlendedCurves;
 use crate::stage::since_power_on::TimePosition;
 use crate::AXES;
 
+/// One point of a heating-dynamics curve: where the curve stood at one reference time.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct CurvePoint {
+    /// Temperature rise since switch-on that the curve had reached, °C.
+    pub rise_celsius: f32,
+    /// Correlation `k = drift / rise` there, (°/s) per °C.
+    pub k_dps_per_celsius: f32,
+}
+
 /// One heating-dynamics curve (one activation curve of the calibration: an interval × activation
-/// number, or the merged "independent" first activations), sampled at the axis's reference times.
+/// number, or the merged "independent" first activations): one point per reference time of its axis.
+///
+/// Rise and `k` sit side by side because the corrector always reads them together.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Curve<const R: usize> {
-    /// Temperature rise since switch-on that this curve had reached at each reference time, °C.
-    pub rise_celsius: Vec<f32, R>,
-    /// Correlation `k = drift / rise` at each reference time, (°/s) per °C.
-    pub k_dps_per_celsius: Vec<f32, R>,
+    /// The curve at each reference time.
+    pub points: Vec<CurvePoint, R>,
 }
 
 /// All curves of one axis at one calibration ambient, and the initial bias there.
@@ -113,21 +123,22 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             if ambient.curves.is_empty() {
                 return Err(Error::new("curves", at, Problem::Empty));
             }
+            // Curve c of every ambient is the same activation scenario: stage 2 blends them.
+            let first_count = self.ambients.first().map_or(0, |a| a.curves.len());
+            check_len("curves", at, first_count, ambient.curves.len())?;
             for (c, curve) in ambient.curves.iter().enumerate() {
                 let at = at.curve(c);
-                check_len("rise_celsius", at, references, curve.rise_celsius.len())?;
-                check_len(
-                    "k_dps_per_celsius",
-                    at,
-                    references,
-                    curve.k_dps_per_celsius.len(),
-                )?;
-                check_finite("rise_celsius", at, curve.rise_celsius.iter().copied())?;
-                check_finite(
-                    "k_dps_per_celsius",
-                    at,
-                    curve.k_dps_per_celsius.iter().copied(),
-                )?;
+                check_len("points", at, references, curve.points.len())?;
+                for (j, point) in curve.points.iter().enumerate() {
+                    for (field, value) in [
+                        ("rise_celsius", point.rise_celsius),
+                        ("k_dps_per_celsius", point.k_dps_per_celsius),
+                    ] {
+                        if !value.is_finite() {
+                            return Err(Error::new(field, at.point(j), Problem::NonFinite));
+                        }
+                    }
+                }
             }
             // At every reference time the curves must be ordered by rise, for the heating stage's
             // bracket search.
@@ -135,13 +146,13 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
                 let rises = ambient
                     .curves
                     .iter()
-                    .map(|curve| curve.rise_celsius.get(j).copied().unwrap_or(f32::NAN));
+                    .map(|curve| curve.points.get(j).map_or(f32::NAN, |p| p.rise_celsius));
                 let mut previous = f32::NEG_INFINITY;
                 for (c, rise) in rises.enumerate() {
                     if rise <= previous {
                         return Err(Error::new(
                             "rise_celsius",
-                            at.curve(c).index(j),
+                            at.curve(c).point(j),
                             Problem::NotIncreasing,
                         ));
                     }
@@ -154,11 +165,17 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
 }
 
 /// Per-axis run-time state of the modified model: where the switch-on temperature fell among the
-/// calibration ambients (fixed for the activation).
+/// calibration ambients (fixed for the activation), and where the previous sample's searches ended.
+///
+/// The search hints only make the next search shorter; any hint gives the same result.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ModifiedAxisState {
     /// Stage 2's position, located at switch-on.
     pub ambient: AmbientPosition,
+    /// Stage 1's last reference-time segment.
+    pub segment_hint: u8,
+    /// Stage 3's last curve bracket.
+    pub curve_hint: u8,
 }
 
 impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, A, C> {
@@ -176,7 +193,10 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
             settings.ambient_margin_celsius,
             |a| a.ambient_celsius,
         );
-        state.ambient = ambient;
+        *state = ModifiedAxisState {
+            ambient,
+            ..ModifiedAxisState::default()
+        };
         let bias_at = |i: u8| {
             self.ambients
                 .get(usize::from(i))
@@ -199,39 +219,36 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         _temperature_celsius: f32,
         rise_celsius: f32,
     ) -> (f32, Flags) {
-        let (k, flags) =
-            self.correlation(settings, &state.ambient, since_power_on_ms, rise_celsius);
+        let (k, flags) = self.correlation(settings, state, since_power_on_ms, rise_celsius);
         (k * rise_celsius, flags)
     }
 }
 
 impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
-    /// The correlation `k` ((°/s) per °C) after all three stages: time since switch-on, heating
-    /// dynamics by the current rise, and ambient, with the envelope flags. The drift is `k · rise`.
+    /// The correlation `k` ((°/s) per °C) after the paper's three stages in its order: time since
+    /// switch-on (stage 1), ambient (stage 2: the two bracketing calibration ambients' curves are
+    /// blended curve by curve), heating dynamics (stage 3: the blended curves whose rises bracket the
+    /// current rise). The drift is `k · rise`.
+    ///
+    /// `state` comes from this axis's power-on (its ambient position); its search hints are updated.
     pub fn correlation(
         &self,
         settings: &Settings,
-        ambient: &AmbientPosition,
+        state: &mut ModifiedAxisState,
         since_power_on_ms: u32,
         rise_celsius: f32,
     ) -> (f32, Flags) {
-        let time = TimePosition::locate(&self.reference_ms, since_power_on_ms);
-        let margin = settings.rise_margin_celsius;
-        let k_in = |i: u8| {
-            self.ambients
-                .get(usize::from(i))
-                .map_or((f32::NAN, false), |a| {
-                    heating::k_at(&a.curves, &time, rise_celsius, margin)
-                })
-        };
-        let (k_lo, mut out_of_span) = k_in(ambient.lo);
-        let k = if ambient.hi == ambient.lo {
-            k_lo
-        } else {
-            let (k_hi, hi_out_of_span) = k_in(ambient.hi);
-            out_of_span |= hi_out_of_span;
-            ambient.blend(k_lo, k_hi)
-        };
+        let time = TimePosition::locate(
+            &self.reference_ms,
+            since_power_on_ms,
+            &mut state.segment_hint,
+        );
+        let curves = BlendedCurves::new(&self.ambients, &state.ambient, time);
+        let (k, out_of_span) = curves.k_at(
+            rise_celsius,
+            settings.rise_margin_celsius,
+            &mut state.curve_hint,
+        );
         let mut flags = Flags::NONE;
         if out_of_span {
             flags |= Flags::RISE_OUT_OF_SPAN;

@@ -6,7 +6,12 @@
     clippy::indexing_slicing,
     clippy::panic
 )]
-#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
+#![allow(
+    clippy::arithmetic_side_effects,
+    clippy::float_cmp,
+    clippy::cast_possible_truncation,
+    missing_docs
+)]
 
 mod common;
 
@@ -40,8 +45,8 @@ fn round_trips_every_model_kind() {
     // A host build with larger capacities reads the same image.
     let host: ModifiedTables = decode(&bytes).unwrap();
     assert_eq!(
-        host.axes[2].ambients[1].curves[7].k_dps_per_celsius,
-        fixture::modified().axes[2].ambients[1].curves[7].k_dps_per_celsius
+        host.axes[2].ambients[1].curves[7].points,
+        fixture::modified().axes[2].ambients[1].curves[7].points
     );
     let mut buffer = vec![0; 4096];
     for model in [fixture::standard(), fixture::third_order()] {
@@ -123,7 +128,7 @@ fn each_bad_input_gets_its_own_error() {
 #[test]
 fn invalid_contents_are_named() {
     let mut tables = fixture::modified();
-    tables.axes[1].ambients[2].curves[4].rise_celsius[3] = f32::NAN;
+    tables.axes[1].ambients[2].curves[4].points[3].rise_celsius = f32::NAN;
     let mut buffer = vec![0; 64 * 1024];
     // The encoder refuses to write what the firmware would reject...
     let error = encode(&tables, &mut buffer).unwrap_err();
@@ -133,7 +138,7 @@ fn invalid_contents_are_named() {
     assert_eq!(inner.problem, Problem::NonFinite);
     assert_eq!(
         inner.to_string(),
-        "axes[1].ambients[2].curves[4].rise_celsius[3]: value is NaN or infinite"
+        "axes[1].ambients[2].curves[4].points[3].rise_celsius: value is NaN or infinite"
     );
     // ...and the decoder refuses a forged image that holds it.
     let mut bytes = image();

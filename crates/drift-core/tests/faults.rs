@@ -5,7 +5,12 @@
     clippy::indexing_slicing,
     clippy::panic
 )]
-#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
+#![allow(
+    clippy::arithmetic_side_effects,
+    clippy::float_cmp,
+    clippy::cast_possible_truncation,
+    missing_docs
+)]
 
 mod common;
 
@@ -157,7 +162,7 @@ fn validation_names_field_and_index() {
     );
 
     let mut tables = fixture::modified();
-    tables.axes[0].ambients[1].curves[3].k_dps_per_celsius.pop();
+    tables.axes[0].ambients[1].curves[3].points.pop();
     let error = tables.validate().unwrap_err();
     assert_eq!(
         error.problem,
@@ -168,17 +173,17 @@ fn validation_names_field_and_index() {
     );
     assert_eq!(
         error.to_string(),
-        "axes[0].ambients[1].curves[3].k_dps_per_celsius: has 7 entries, expected 8"
+        "axes[0].ambients[1].curves[3].points: has 7 entries, expected 8"
     );
 
     let mut tables = fixture::modified();
     let (a, b) = (
-        tables.axes[1].ambients[0].curves[6].rise_celsius[2],
-        tables.axes[1].ambients[0].curves[7].rise_celsius[2],
+        tables.axes[1].ambients[0].curves[6].points[2].rise_celsius,
+        tables.axes[1].ambients[0].curves[7].points[2].rise_celsius,
     );
-    tables.axes[1].ambients[0].curves[6].rise_celsius[2] = b;
-    tables.axes[1].ambients[0].curves[7].rise_celsius[2] = a;
-    assert_eq!(tables.validate().unwrap_err().to_string(), "axes[1].ambients[0].curves[7].rise_celsius[2]: not strictly greater than the previous value");
+    tables.axes[1].ambients[0].curves[6].points[2].rise_celsius = b;
+    tables.axes[1].ambients[0].curves[7].points[2].rise_celsius = a;
+    assert_eq!(tables.validate().unwrap_err().to_string(), "axes[1].ambients[0].curves[7].points[2].rise_celsius: not strictly greater than the previous value");
 
     let mut tables = fixture::modified();
     tables.axes[0].ambients[2].ambient_celsius = 25.0;

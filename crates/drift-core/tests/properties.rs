@@ -7,9 +7,16 @@
     clippy::indexing_slicing,
     clippy::panic
 )]
-#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
+#![allow(
+    clippy::arithmetic_side_effects,
+    clippy::float_cmp,
+    clippy::cast_possible_truncation,
+    missing_docs
+)]
 
-use drift_core::{AmbientCurves, AmbientPosition, AxisTable, Curve, Settings};
+use drift_core::{
+    AmbientCurves, AmbientPosition, AxisTable, Curve, CurvePoint, ModifiedAxisState, Settings,
+};
 use proptest::prelude::*;
 
 type Table = AxisTable<6, 3, 5>;
@@ -54,8 +61,13 @@ fn table() -> impl Strategy<Value = Table> {
                             if c > 0 {
                                 *rise += RISE_GAP + spread;
                             }
-                            curve.rise_celsius.push(*rise).unwrap();
-                            curve.k_dps_per_celsius.push(k).unwrap();
+                            curve
+                                .points
+                                .push(CurvePoint {
+                                    rise_celsius: *rise,
+                                    k_dps_per_celsius: k,
+                                })
+                                .unwrap();
                         }
                         at.curves.push(curve).unwrap();
                     }
@@ -74,10 +86,30 @@ fn position(table: &Table, celsius: f32) -> AmbientPosition {
     AmbientPosition::locate(&table.ambients, celsius, 0.5, |a| a.ambient_celsius)
 }
 
+/// `k` from a fresh state (no search hints), checked to be the same from states whose hints point
+/// elsewhere: hints may only shorten the search.
 fn k(table: &Table, celsius: f32, ms: u32, rise: f32) -> f32 {
-    table
-        .correlation(&settings(), &position(table, celsius), ms, rise)
-        .0
+    let fresh = ModifiedAxisState {
+        ambient: position(table, celsius),
+        ..ModifiedAxisState::default()
+    };
+    let fresh_k = table
+        .correlation(&settings(), &mut fresh.clone(), ms, rise)
+        .0;
+    for hint in [1, 4, 255] {
+        let mut hinted = ModifiedAxisState {
+            segment_hint: hint,
+            curve_hint: hint,
+            ..fresh
+        };
+        let hinted_k = table.correlation(&settings(), &mut hinted, ms, rise).0;
+        assert_eq!(
+            hinted_k.to_bits(),
+            fresh_k.to_bits(),
+            "hint {hint} changed the result"
+        );
+    }
+    fresh_k
 }
 
 proptest! {
@@ -97,8 +129,8 @@ proptest! {
         let ambient = &table.ambients[a];
         let c = c % ambient.curves.len();
         let curve = &ambient.curves[c];
-        let got = k(&table, ambient.ambient_celsius, table.reference_ms[j], curve.rise_celsius[j]);
-        prop_assert_eq!(got, curve.k_dps_per_celsius[j]);
+        let got = k(&table, ambient.ambient_celsius, table.reference_ms[j], curve.points[j].rise_celsius);
+        prop_assert_eq!(got, curve.points[j].k_dps_per_celsius);
     }
 
     /// Anywhere inside the envelope, `k` lies between the smallest and largest stored `k` of the
@@ -121,10 +153,10 @@ proptest! {
         for a in [p.lo, p.hi] {
             for curve in &table.ambients[usize::from(a)].curves {
                 for jj in [j, j1] {
-                    lo = lo.min(curve.k_dps_per_celsius[jj]);
-                    hi = hi.max(curve.k_dps_per_celsius[jj]);
-                    rise_lo = rise_lo.min(curve.rise_celsius[jj]);
-                    rise_hi = rise_hi.max(curve.rise_celsius[jj]);
+                    lo = lo.min(curve.points[jj].k_dps_per_celsius);
+                    hi = hi.max(curve.points[jj].k_dps_per_celsius);
+                    rise_lo = rise_lo.min(curve.points[jj].rise_celsius);
+                    rise_hi = rise_hi.max(curve.points[jj].rise_celsius);
                 }
             }
         }
@@ -147,13 +179,16 @@ proptest! {
         let j1 = (j + 1).min(table.reference_ms.len() - 1);
         let span = (table.reference_ms[j1] - table.reference_ms[j]).max(1) as f32;
         let w = (ms - table.reference_ms[j]) as f32 / span;
-        let at = |v: &[f32]| v[j] + (v[j1] - v[j]) * w;
+        let at = |curve: &drift_core::Curve<6>, rise: bool| {
+            let v = |jj: usize| if rise { curve.points[jj].rise_celsius } else { curve.points[jj].k_dps_per_celsius };
+            v(j) + (v(j1) - v(j)) * w
+        };
         let c = c % ambient.curves.len();
-        let rise = at(&ambient.curves[c].rise_celsius);
+        let rise = at(&ambient.curves[c], true);
         let mut slope = 0.0f32;
         for pair in ambient.curves.windows(2) {
-            let dk = (at(&pair[1].k_dps_per_celsius) - at(&pair[0].k_dps_per_celsius)).abs();
-            let dr = at(&pair[1].rise_celsius) - at(&pair[0].rise_celsius);
+            let dk = (at(&pair[1], false) - at(&pair[0], false)).abs();
+            let dr = at(&pair[1], true) - at(&pair[0], true);
             slope = slope.max(dk / dr);
         }
         let delta = 1e-3;
@@ -170,7 +205,7 @@ proptest! {
         let ambient = &table.ambients[a];
         let j = j % table.reference_ms.len();
         let t = table.reference_ms[j];
-        let top = ambient.curves.last().unwrap().rise_celsius[j];
+        let top = ambient.curves.last().unwrap().points[j].rise_celsius;
         let rise = top * rise_u;
         let dt = 1.0 / TIME_GAP_MS as f32; // per ms, the steepest a segment can be, per unit change
         let k_range = 0.02;

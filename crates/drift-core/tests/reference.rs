@@ -8,7 +8,12 @@
     clippy::indexing_slicing,
     clippy::panic
 )]
-#![allow(clippy::arithmetic_side_effects, clippy::float_cmp, clippy::cast_possible_truncation, missing_docs)]
+#![allow(
+    clippy::arithmetic_side_effects,
+    clippy::float_cmp,
+    clippy::cast_possible_truncation,
+    missing_docs
+)]
 
 mod common;
 
@@ -156,9 +161,18 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64) -> State {
     state
 }
 
-/// `k` from one ambient's curves at time `ms` and `rise`.
-fn k_at(ambient: &Value, refs: &[f64], ms: f64, rise: f64, margin: f64) -> (f64, bool) {
-    let curves = ambient["curves"].as_array().unwrap();
+/// `k` at time `ms` and `rise`: each curve is read at the time (stage 1), blended between the two
+/// bracketing ambients with weight `w` (stage 2), then the blended curves bracketing `rise` are
+/// interpolated (stage 3). Returns (k, rise beyond the span by more than the margin).
+fn k_at(
+    lower: &Value,
+    upper: &Value,
+    w: f64,
+    refs: &[f64],
+    ms: f64,
+    rise: f64,
+    margin: f64,
+) -> (f64, bool) {
     let at_time = |values: &[f64], is_rise: bool| -> f64 {
         if ms < refs[0] {
             if is_rise {
@@ -167,18 +181,31 @@ fn k_at(ambient: &Value, refs: &[f64], ms: f64, rise: f64, margin: f64) -> (f64,
                 values[0]
             }
         } else {
-            let (lo, hi, w, _) = bracket(refs, ms);
-            lerp(values[lo], values[hi], w)
+            let (lo, hi, weight, _) = bracket(refs, ms);
+            lerp(values[lo], values[hi], weight)
         }
     };
-    let rises: Vec<f64> = curves
-        .iter()
-        .map(|c| at_time(&list(&c["rise_celsius"]), true))
-        .collect();
-    let ks: Vec<f64> = curves
-        .iter()
-        .map(|c| at_time(&list(&c["k_dps_per_celsius"]), false))
-        .collect();
+    let blended = |field: &str, is_rise: bool| -> Vec<f64> {
+        let lower = lower["curves"].as_array().unwrap();
+        let upper = upper["curves"].as_array().unwrap();
+        lower
+            .iter()
+            .zip(upper)
+            .map(|(l, u)| {
+                let values = |curve: &Value| -> Vec<f64> {
+                    let points = curve["points"].as_array().unwrap();
+                    points.iter().map(|point| f(&point[field])).collect()
+                };
+                lerp(
+                    at_time(&values(l), is_rise),
+                    at_time(&values(u), is_rise),
+                    w,
+                )
+            })
+            .collect()
+    };
+    let rises = blended("rise_celsius", true);
+    let ks = blended("k_dps_per_celsius", false);
     let n = rises.len();
     if rise < rises[0] {
         return (ks[0], rise < rises[0] - margin);
@@ -241,14 +268,19 @@ fn correct(
                         flags |= PAST_LAST_REFERENCE;
                     }
                     let (lo, hi, w) = st.ambient;
-                    let (k_lo, out_lo) = k_at(&ambients[lo], &refs, ms, rise, s.rise_margin);
-                    let (k_hi, out_hi) = k_at(&ambients[hi], &refs, ms, rise, s.rise_margin);
-                    // Only ambients that contribute (weight > 0) can flag the rise span.
-                    let out = out_lo || (w > 0.0 && out_hi);
+                    let (k, out) = k_at(
+                        &ambients[lo],
+                        &ambients[hi],
+                        w,
+                        &refs,
+                        ms,
+                        rise,
+                        s.rise_margin,
+                    );
                     if out {
                         flags |= RISE_OUT_OF_SPAN;
                     }
-                    st.drift = lerp(k_lo, k_hi, w) * rise;
+                    st.drift = k * rise;
                 }
                 Axis::Polynomial(p) => {
                     let (value, outside) = poly(p, celsius, s.ambient_margin);
@@ -266,6 +298,9 @@ fn correct(
 
 #[test]
 fn vectors_agree_with_an_independent_f64_reference() {
+    if std::env::var_os("GYRODRIFT_BLESS").is_some() {
+        return; // the vectors are being rewritten; check them on the next run
+    }
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/vectors.json");
     let file: VectorFile = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     let mut worst = 0.0_f64;

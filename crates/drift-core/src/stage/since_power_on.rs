@@ -1,6 +1,8 @@
 //! Stage 1: time since switch-on. Locates the current time among the table's reference times.
 
-use crate::interp::{bracket, value_at, Bracket};
+use crate::error::saturating_u8;
+use crate::interp::lerp;
+use crate::table::CurvePoint;
 
 /// Where the current time since switch-on falls among the reference times, shared by every curve of
 /// an axis (the curves are all sampled at the same reference times).
@@ -30,50 +32,66 @@ pub struct TimePosition {
 }
 
 impl TimePosition {
-    /// Locates `since_power_on_ms` among strictly increasing `reference_ms`.
+    /// Locates `since_power_on_ms` among strictly increasing `reference_ms`, starting the search at
+    /// `hint` (the previous sample's segment, updated here): time moves forward a millisecond at a
+    /// time, so the search usually ends where it starts.
     ///
     /// Time stays an integer (milliseconds) until it is made relative to the bracketing reference
     /// time, so hours of operation lose no resolution.
-    pub fn locate(reference_ms: &[u32], since_power_on_ms: u32) -> Self {
-        let first = reference_ms.first().copied().unwrap_or(0);
-        let last_index = reference_ms.len().saturating_sub(1);
-        // Offsets from the first reference time fit f32 exactly up to 2^24 ms (4.6 h); beyond the
-        // last reference time the position is held, so larger offsets never reach the division.
-        let held = |past_last| TimePosition {
-            lo: if past_last { last_index } else { 0 },
-            hi: if past_last { last_index } else { 0 },
-            fraction: 0.0,
-            rise_scale: 1.0,
-            past_last,
-        };
+    pub fn locate(reference_ms: &[u32], since_power_on_ms: u32, hint: &mut u8) -> Self {
+        let last = reference_ms.len().saturating_sub(1);
+        let at = |j: usize| reference_ms.get(j).copied().unwrap_or(u32::MAX);
+        let first = at(0);
         if since_power_on_ms < first {
+            *hint = 0;
             return TimePosition {
+                lo: 0,
+                hi: 0,
+                fraction: 0.0,
+                // Both below 2^24 in practice (reference times are seconds to minutes), so exact.
                 rise_scale: since_power_on_ms as f32 / first as f32,
-                ..held(false)
+                past_last: false,
             };
         }
-        let x = since_power_on_ms.saturating_sub(first) as f32;
-        match bracket(reference_ms, x, |&t| t.saturating_sub(first) as f32) {
-            Bracket::Below => held(false),
-            Bracket::Inside { lo, fraction } => TimePosition {
+        let mut lo = usize::from(*hint).min(last);
+        while lo > 0 && at(lo) > since_power_on_ms {
+            lo = lo.saturating_sub(1);
+        }
+        while lo < last && at(lo.saturating_add(1)) <= since_power_on_ms {
+            lo = lo.saturating_add(1);
+        }
+        *hint = saturating_u8(lo);
+        let offset = since_power_on_ms.saturating_sub(at(lo));
+        if lo == last {
+            return TimePosition {
                 lo,
-                hi: if fraction > 0.0 {
-                    lo.saturating_add(1)
-                } else {
-                    lo
-                },
-                fraction,
+                hi: lo,
+                fraction: 0.0,
                 rise_scale: 1.0,
-                past_last: false,
-            },
-            Bracket::Above => held(true),
+                past_last: offset > 0,
+            };
+        }
+        let hi = lo.saturating_add(1);
+        // Offsets within one segment are far below 2^24 ms, so the conversion is exact.
+        let span = at(hi).saturating_sub(at(lo));
+        TimePosition {
+            lo,
+            hi: if offset > 0 { hi } else { lo },
+            fraction: offset as f32 / span as f32,
+            rise_scale: 1.0,
+            past_last: false,
         }
     }
 
-    /// A curve's value (`k` or rise) at this time, by linear interpolation between reference times.
-    #[inline]
-    pub fn value(&self, values: &[f32]) -> f32 {
-        value_at(values, self.lo, self.hi, self.fraction)
+    /// A curve's point (rise and `k`) at this time, by linear interpolation between reference
+    /// times; `None` if the curve is too short (only for tables that skipped validation).
+    #[inline(always)]
+    pub fn point(&self, points: &[CurvePoint]) -> Option<CurvePoint> {
+        let (lo, hi) = (points.get(self.lo)?, points.get(self.hi)?);
+        Some(CurvePoint {
+            rise_celsius: lerp(lo.rise_celsius, hi.rise_celsius, self.fraction),
+            k_dps_per_celsius: lerp(lo.k_dps_per_celsius, hi.k_dps_per_celsius, self.fraction),
+        })
     }
 }
 
@@ -85,26 +103,26 @@ mod tests {
 
     #[test]
     fn before_first_reference_scales_rise_and_holds_k() {
-        let p = TimePosition::locate(&REFS, 500);
+        let p = TimePosition::locate(&REFS, 500, &mut 0);
         assert_eq!((p.lo, p.hi, p.fraction, p.past_last), (0, 0, 0.0, false));
         assert_eq!(p.rise_scale, 0.25);
-        assert_eq!(TimePosition::locate(&REFS, 0).rise_scale, 0.0);
+        assert_eq!(TimePosition::locate(&REFS, 0, &mut 0).rise_scale, 0.0);
     }
 
     #[test]
     fn between_and_on_reference_times() {
-        let p = TimePosition::locate(&REFS, 3_500);
+        let p = TimePosition::locate(&REFS, 3_500, &mut 2);
         assert_eq!((p.lo, p.hi, p.fraction, p.rise_scale), (0, 1, 0.5, 1.0));
-        let p = TimePosition::locate(&REFS, 5_000);
+        let p = TimePosition::locate(&REFS, 5_000, &mut 0);
         assert_eq!((p.lo, p.hi, p.fraction), (1, 1, 0.0));
-        let p = TimePosition::locate(&REFS, 30_000);
+        let p = TimePosition::locate(&REFS, 30_000, &mut 1);
         assert_eq!((p.lo, p.hi, p.fraction, p.past_last), (2, 2, 0.0, false));
     }
 
     #[test]
     fn past_last_reference_holds_and_flags_even_after_hours() {
         for ms in [30_001, 3_600_000, u32::MAX] {
-            let p = TimePosition::locate(&REFS, ms);
+            let p = TimePosition::locate(&REFS, ms, &mut 0);
             assert_eq!((p.lo, p.hi, p.past_last), (2, 2, true));
         }
     }

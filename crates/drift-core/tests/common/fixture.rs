@@ -7,7 +7,8 @@
 //! round-trips to the same f32 in every language.
 
 use drift_core::{
-    AmbientCurves, AxisTable, Curve, ModifiedTables, PolynomialAxis, PolynomialTables, Settings,
+    AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, PolynomialAxis, PolynomialTables,
+    Settings,
 };
 
 /// Reference times, ms.
@@ -76,8 +77,11 @@ pub fn modified() -> FixtureTables {
                         * (1.0 + 0.4 * (-t / 20.0).exp())
                         * (0.85 + 0.15 * c as f64 / (CURVES - 1) as f64)
                         * (1.0 + 0.01 * (f64::from(ambient) - 30.0));
-                    curve.rise_celsius.push(round5(rise)).unwrap();
-                    curve.k_dps_per_celsius.push(round_sig(k)).unwrap();
+                    let point = CurvePoint {
+                        rise_celsius: round5(rise),
+                        k_dps_per_celsius: round_sig(k),
+                    };
+                    curve.points.push(point).unwrap();
                 }
                 at.curves.push(curve).unwrap();
             }

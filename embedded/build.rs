@@ -1,0 +1,56 @@
+//! Turns `testdata/vectors.json` into firmware data: the model images as binary files and the cases
+//! as `static` arrays, so the MCU decodes the very bytes the host tests decode.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+#[path = "../crates/drift-core/tests/common/format.rs"]
+#[allow(dead_code)]
+mod format;
+
+fn unhex(hex: &str) -> Vec<u8> {
+    (0..hex.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).expect("hex image"))
+        .collect()
+}
+
+fn main() {
+    let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
+    std::fs::copy("memory.x", out.join("memory.x")).expect("memory.x");
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed=memory.x");
+    println!("cargo:rerun-if-changed=../testdata/vectors.json");
+
+    let text = std::fs::read_to_string("../testdata/vectors.json").expect("testdata/vectors.json");
+    let file: format::VectorFile = serde_json::from_str(&text).expect("vector file");
+    let mut code = String::new();
+    for model in &file.models {
+        let path = out.join(format!("{}.bin", model.name));
+        std::fs::write(&path, unhex(&model.image_hex)).expect("write image");
+        writeln!(
+            code,
+            "pub static {}: &[u8] = include_bytes!({:?});",
+            model.name.to_uppercase(),
+            path.display().to_string()
+        )
+        .unwrap();
+    }
+    writeln!(code, "pub static CASES: &[Case] = &[").unwrap();
+    for case in &file.cases {
+        let model = match case.model.as_str() {
+            "modified" => "ModelName::Modified",
+            "standard" => "ModelName::Standard",
+            "third_order" => "ModelName::ThirdOrder",
+            other => panic!("unknown model {other}"),
+        };
+        writeln!(
+            code,
+            "Case {{ name: {:?}, model: {model}, switch_on_raw: {:?}, power_on_fails: {}, samples: &{:?}, expected: &{:?} }},",
+            case.name, case.switch_on_raw, case.power_on_fails, case.samples, case.expected
+        )
+        .unwrap();
+    }
+    writeln!(code, "];").unwrap();
+    std::fs::write(out.join("vectors.rs"), code).expect("write vectors.rs");
+}

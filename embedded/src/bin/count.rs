@@ -1,0 +1,93 @@
+//! Instruction counting: corrects 120 samples of a 2-min activation (between calibration ambients,
+//! inside the stored curves: the full three-stage path) with each model, between calls to `marker`.
+//! `scripts/count-instructions.sh` runs this under QEMU's single-step execution log and counts the
+//! instructions executed between consecutive markers.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use drift_core::blob::decode;
+use drift_core::{AxisModel, Corrector, Model, PolynomialTables, Sample};
+use gyrodrift_embedded::{FirmwareTables, MODIFIED, STANDARD};
+use panic_semihosting as _;
+
+/// Samples corrected between two markers.
+const SAMPLES: usize = 120;
+
+/// The script finds this function's entry address in the execution log. The inline assembly keeps
+/// LTO from removing or inlining a call that otherwise has no effect.
+#[inline(never)]
+#[no_mangle]
+pub extern "C" fn gyrodrift_marker(id: u32) {
+    black_box(id);
+    cortex_m::asm::nop();
+}
+
+fn activation() -> [Sample; SAMPLES] {
+    core::array::from_fn(|i| {
+        let t = i as f32;
+        // Rise follows an exponential approach, 4 °C after 2 min, kept inside the fixture's curves.
+        let shape = 1.0 - libm_free_exp(-t / 60.0);
+        Sample {
+            since_power_on_ms: 1000 * i as u32 + 1,
+            rate_dps: [0.1, -0.05, 0.02],
+            temperature_raw: [6600.0 + 200.0 * 4.0 * shape, 6640.0 + 200.0 * 3.5 * shape, 6580.0 + 200.0 * 5.0 * shape],
+        }
+    })
+}
+
+/// e^x for x ≤ 0 by a short series with range halving; only shapes test inputs.
+fn libm_free_exp(x: f32) -> f32 {
+    let mut y = x / 16.0;
+    y = 1.0 + y * (1.0 + y * (0.5 + y * (1.0 / 6.0 + y / 24.0)));
+    for _ in 0..4 {
+        y *= y;
+    }
+    y
+}
+
+fn measure<M: Model>(model: &M, samples: &[Sample], id: u32)
+where
+    M::Axis: AxisModel,
+{
+    let Ok(mut corrector) = Corrector::new(model) else { return };
+    let _ = corrector.power_on([6600.0, 6640.0, 6580.0]);
+    gyrodrift_marker(id);
+    for sample in samples {
+        black_box(corrector.correct(black_box(sample)));
+    }
+    gyrodrift_marker(id + 1);
+}
+
+#[entry]
+fn main() -> ! {
+    let samples = activation();
+    let modified: Result<FirmwareTables, _> = decode(black_box(MODIFIED));
+    let standard: Result<PolynomialTables, _> = decode(black_box(STANDARD));
+    match (modified, standard) {
+        (Ok(modified), Ok(standard)) => {
+            hprintln!("samples per interval: {}", SAMPLES);
+            hprintln!("interval 1: modified model");
+            measure(&modified, &samples, 1);
+            hprintln!("interval 3: standard polynomial");
+            measure(&standard, &samples, 3);
+            hprintln!("interval 5: harness only (loop, sample and output moves)");
+            gyrodrift_marker(5);
+            for sample in &samples {
+                black_box(black_box(sample).rate_dps);
+                black_box(drift_core::Output::default());
+            }
+            gyrodrift_marker(6);
+            debug::exit(debug::EXIT_SUCCESS);
+        }
+        _ => {
+            hprintln!("FAIL: images did not decode");
+            debug::exit(debug::EXIT_FAILURE);
+        }
+    }
+    #[allow(clippy::empty_loop)]
+    loop {}
+}

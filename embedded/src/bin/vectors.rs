@@ -1,0 +1,115 @@
+//! Runs every shared test vector through drift-core on the (emulated) Cortex-M4F and compares each
+//! output with the host's bit for bit. Exit status 0 only if all agree. Also reports the run-time
+//! state size and the stack used by decoding and by correcting.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use drift_core::blob::decode;
+use drift_core::{AxisModel, Corrector, CorrectorState, Model, ModifiedAxisState, PolynomialTables, Sample};
+use gyrodrift_embedded::{stack, Case, FirmwareTables, ModelName, CASES, MODIFIED, STANDARD, THIRD_ORDER};
+use panic_semihosting as _;
+
+fn fail(what: &str) -> ! {
+    hprintln!("FAIL: {}", what);
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+fn same(expected: u32, got: u32) -> bool {
+    expected == got || (f32::from_bits(expected).is_nan() && f32::from_bits(got).is_nan())
+}
+
+/// Runs one case; returns the number of outputs that differ from the host's.
+fn run<M: Model>(model: &M, case: &Case) -> usize
+where
+    M::Axis: AxisModel,
+{
+    let Ok(mut corrector) = Corrector::new(model) else { fail("model rejected") };
+    if let Some(raw) = case.switch_on_raw {
+        if corrector.power_on(raw.map(f32::from_bits)).is_err() != case.power_on_fails {
+            hprintln!("power_on outcome differs in {}", case.name);
+            return 1;
+        }
+    }
+    let mut mismatches = 0;
+    for (i, (input, expected)) in case.samples.iter().zip(case.expected).enumerate() {
+        let sample = Sample {
+            since_power_on_ms: input[0],
+            rate_dps: [input[1], input[2], input[3]].map(f32::from_bits),
+            temperature_raw: [input[4], input[5], input[6]].map(f32::from_bits),
+        };
+        let out = corrector.correct(&sample);
+        let got = [
+            out.corrected_dps[0].to_bits(),
+            out.corrected_dps[1].to_bits(),
+            out.corrected_dps[2].to_bits(),
+            out.bias_dps[0].to_bits(),
+            out.bias_dps[1].to_bits(),
+            out.bias_dps[2].to_bits(),
+            u32::from(out.flags[0].0),
+            u32::from(out.flags[1].0),
+            u32::from(out.flags[2].0),
+        ];
+        for (k, (&e, &g)) in expected.iter().zip(&got).enumerate() {
+            if !same(e, g) {
+                mismatches += 1;
+                hprintln!("{} sample {} output {}: expected {:#010x}, got {:#010x}", case.name, i, k, e, g);
+            }
+        }
+    }
+    mismatches
+}
+
+#[entry]
+fn main() -> ! {
+    let painted = stack::paint();
+    let modified: FirmwareTables = match decode(black_box(MODIFIED)) {
+        Ok(tables) => tables,
+        Err(_) => fail("modified image did not decode"),
+    };
+    let decode_stack = painted.used();
+    let Ok(standard) = decode::<PolynomialTables>(STANDARD) else { fail("standard image") };
+    let Ok(third_order) = decode::<PolynomialTables>(THIRD_ORDER) else { fail("third-order image") };
+
+    let mut samples = 0;
+    let mut mismatches = 0;
+    for case in CASES {
+        samples += case.samples.len();
+        mismatches += match case.model {
+            ModelName::Modified => run(&modified, case),
+            ModelName::Standard => run(&standard, case),
+            ModelName::ThirdOrder => run(&third_order, case),
+        };
+    }
+
+    // Stack of one power-on plus one corrected sample, measured on a fresh painting.
+    let Ok(mut corrector) = Corrector::new(&modified) else { fail("model rejected") };
+    let painted = stack::paint();
+    let _ = black_box(corrector.power_on(black_box([6600.0, 6640.0, 6580.0])));
+    let sample = Sample { since_power_on_ms: 33_333, rate_dps: [0.1; 3], temperature_raw: [6900.0, 6950.0, 6800.0] };
+    black_box(corrector.correct(black_box(&sample)));
+    let correct_stack = painted.used();
+
+    hprintln!("cases: {}", CASES.len());
+    hprintln!("samples: {}", samples);
+    hprintln!("outputs compared: {}", samples * 9);
+    hprintln!("mismatches: {}", mismatches);
+    hprintln!("modified image bytes: {}", MODIFIED.len());
+    hprintln!("modified tables in RAM, bytes: {}", core::mem::size_of::<FirmwareTables>());
+    hprintln!("corrector state bytes: {}", core::mem::size_of::<CorrectorState<ModifiedAxisState>>());
+    hprintln!("stack bytes, decode image: {}", decode_stack);
+    hprintln!("stack bytes, power_on + correct: {}", correct_stack);
+    if mismatches == 0 {
+        hprintln!("PASS: Cortex-M4F outputs are bit-identical to the host's");
+        debug::exit(debug::EXIT_SUCCESS);
+    } else {
+        fail("outputs differ from the host");
+    }
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
