@@ -7,7 +7,9 @@ Runs the firmware's `count` binary under QEMU with one instruction per translati
 model; the instructions between two marker entries, divided by N, are the cost per sample (the loop
 and call overhead included, so the figure is an upper bound of the corrector alone).
 
-Usage: scripts/count-instructions.py [path/to/count.elf]
+Usage: scripts/count-instructions.py [--max-modified N] [path/to/count.elf]
+With --max-modified, exits non-zero if the modified model needs more than N instructions per sample
+(instruction counts are deterministic for a given binary, so this is a regression gate, not a timing).
 """
 
 import os
@@ -34,7 +36,12 @@ def marker_address(elf):
 
 
 def main():
-    elf = sys.argv[1] if len(sys.argv) > 1 else ELF
+    args = sys.argv[1:]
+    limit = None
+    if args[:1] == ["--max-modified"]:
+        limit = float(args[1])
+        args = args[2:]
+    elf = args[0] if args else ELF
     marker = marker_address(elf)
     with tempfile.TemporaryDirectory() as tmp:
         log = os.path.join(tmp, "exec.log")
@@ -65,6 +72,8 @@ def main():
         label = labels.get(str(index + 1), f"interval {index + 1}")
         per_sample = (hits[index + 1] - hits[index]) / samples
         print(f"  {label}: {per_sample:.1f}")
+        if limit is not None and label.startswith("modified") and per_sample > limit:
+            sys.exit(f"modified model needs {per_sample:.1f} instructions per sample, more than {limit}")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,24 @@
+//! Flash footprint probe (base): `scripts/embedded-report.sh` compares the `.text` of
+//! footprint_base (runtime only), footprint_decode (+ image decoder and validation) and
+//! footprint_correct (+ corrector), so each part's code size is a difference of two builds.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m_rt::entry;
+use cortex_m_semihosting::debug;
+#[allow(unused_imports)]
+use drift_core::{blob::decode, Corrector, Sample};
+#[allow(unused_imports)]
+use gyrodrift_embedded::{FirmwareTables, MODIFIED};
+use panic_semihosting as _;
+
+#[entry]
+fn main() -> ! {
+    let image = black_box(MODIFIED);
+    black_box(image.len());
+    debug::exit(debug::EXIT_SUCCESS);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}

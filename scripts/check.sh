@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# The one test command (README): installs what it needs, then runs every check in order.
+# Idempotent; safe to re-run. Exits non-zero at the first failing check.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+step() { printf '\n=== %s\n' "$*"; }
+
+step "toolchain: Rust stable with rustfmt, clippy, llvm-tools and the Cortex-M4F target"
+rustup show active-toolchain >/dev/null
+rustup component add rustfmt clippy llvm-tools >/dev/null 2>&1 || true
+rustup target add thumbv7em-none-eabihf >/dev/null
+
+step "system packages: qemu-system-arm (emulated Cortex-M4)"
+if ! command -v qemu-system-arm >/dev/null; then
+    SUDO=""
+    [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq qemu-system-arm >/dev/null
+fi
+qemu-system-arm --version | head -n 1
+
+step "format"
+cargo fmt --all --check
+(cd embedded && cargo fmt --check)
+
+step "clippy: host workspace, all targets and features"
+cargo clippy --workspace --all-targets --all-features --locked -- -D warnings
+
+step "clippy: drift-core for thumbv7em-none-eabihf, each feature set"
+cargo clippy -p drift-core --target thumbv7em-none-eabihf --locked -- -D warnings
+cargo clippy -p drift-core --target thumbv7em-none-eabihf --no-default-features --locked -- -D warnings
+
+step "build: drift-core for thumbv7em-none-eabihf (release, no_std, no heap)"
+cargo build -p drift-core --target thumbv7em-none-eabihf --release --locked
+
+step "tests: workspace (all features) and drift-core without default features"
+cargo test --workspace --all-features --locked
+cargo test -p drift-core --no-default-features --locked --lib
+
+step "docs: rustdoc without warnings"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
+
+step "firmware: clippy, build, and the shared test vectors on QEMU mps2-an386 (Cortex-M4F)"
+(cd embedded && cargo clippy --release --locked -- -D warnings)
+(cd embedded && cargo build --release --locked && cargo run --release --locked --bin vectors)
+
+step "firmware: executed instructions per 3-axis sample (deterministic; floor 1500)"
+python3 scripts/count-instructions.py --max-modified 1500
+
+step "main job: README's demo command"
+cargo run --release --locked -- demo
+
+printf '\nAll checks passed.\n'
