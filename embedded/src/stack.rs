@@ -34,7 +34,9 @@ impl Painted {
     pub fn used(&self) -> usize {
         let mut address = self.top - DEPTH;
         // SAFETY: reads the same painted region.
-        while address < self.top - MARGIN && unsafe { read_volatile(address as *const u32) } == PATTERN {
+        while address < self.top - MARGIN
+            && unsafe { read_volatile(address as *const u32) } == PATTERN
+        {
             address += 4;
         }
         self.top - address

@@ -34,7 +34,11 @@ fn activation() -> [Sample; SAMPLES] {
         Sample {
             since_power_on_ms: 1000 * i as u32 + 1,
             rate_dps: [0.1, -0.05, 0.02],
-            temperature_raw: [6600.0 + 200.0 * 4.0 * shape, 6640.0 + 200.0 * 3.5 * shape, 6580.0 + 200.0 * 5.0 * shape],
+            temperature_raw: [
+                6600.0 + 200.0 * 4.0 * shape,
+                6640.0 + 200.0 * 3.5 * shape,
+                6580.0 + 200.0 * 5.0 * shape,
+            ],
         }
     })
 }
@@ -53,7 +57,9 @@ fn measure<M: Model>(model: &M, samples: &[Sample], id: u32)
 where
     M::Axis: AxisModel,
 {
-    let Ok(mut corrector) = Corrector::new(model) else { return };
+    let Ok(mut corrector) = Corrector::new(model) else {
+        return;
+    };
     let _ = corrector.power_on([6600.0, 6640.0, 6580.0]);
     gyrodrift_marker(id);
     for sample in samples {

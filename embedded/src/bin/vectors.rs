@@ -9,8 +9,12 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use drift_core::blob::decode;
-use drift_core::{AxisModel, Corrector, CorrectorState, Model, ModifiedAxisState, PolynomialTables, Sample};
-use gyrodrift_embedded::{stack, Case, FirmwareTables, ModelName, CASES, MODIFIED, STANDARD, THIRD_ORDER};
+use drift_core::{
+    AxisModel, Corrector, CorrectorState, Model, ModifiedAxisState, PolynomialTables, Sample,
+};
+use gyrodrift_embedded::{
+    stack, Case, FirmwareTables, ModelName, CASES, MODIFIED, STANDARD, THIRD_ORDER,
+};
 use panic_semihosting as _;
 
 fn fail(what: &str) -> ! {
@@ -29,7 +33,9 @@ fn run<M: Model>(model: &M, case: &Case) -> usize
 where
     M::Axis: AxisModel,
 {
-    let Ok(mut corrector) = Corrector::new(model) else { fail("model rejected") };
+    let Ok(mut corrector) = Corrector::new(model) else {
+        fail("model rejected")
+    };
     if let Some(raw) = case.switch_on_raw {
         if corrector.power_on(raw.map(f32::from_bits)).is_err() != case.power_on_fails {
             hprintln!("power_on outcome differs in {}", case.name);
@@ -58,7 +64,14 @@ where
         for (k, (&e, &g)) in expected.iter().zip(&got).enumerate() {
             if !same(e, g) {
                 mismatches += 1;
-                hprintln!("{} sample {} output {}: expected {:#010x}, got {:#010x}", case.name, i, k, e, g);
+                hprintln!(
+                    "{} sample {} output {}: expected {:#010x}, got {:#010x}",
+                    case.name,
+                    i,
+                    k,
+                    e,
+                    g
+                );
             }
         }
     }
@@ -73,8 +86,12 @@ fn main() -> ! {
         Err(_) => fail("modified image did not decode"),
     };
     let decode_stack = painted.used();
-    let Ok(standard) = decode::<PolynomialTables>(STANDARD) else { fail("standard image") };
-    let Ok(third_order) = decode::<PolynomialTables>(THIRD_ORDER) else { fail("third-order image") };
+    let Ok(standard) = decode::<PolynomialTables>(STANDARD) else {
+        fail("standard image")
+    };
+    let Ok(third_order) = decode::<PolynomialTables>(THIRD_ORDER) else {
+        fail("third-order image")
+    };
 
     let mut samples = 0;
     let mut mismatches = 0;
@@ -88,10 +105,16 @@ fn main() -> ! {
     }
 
     // Stack of one power-on plus one corrected sample, measured on a fresh painting.
-    let Ok(mut corrector) = Corrector::new(&modified) else { fail("model rejected") };
+    let Ok(mut corrector) = Corrector::new(&modified) else {
+        fail("model rejected")
+    };
     let painted = stack::paint();
     let _ = black_box(corrector.power_on(black_box([6600.0, 6640.0, 6580.0])));
-    let sample = Sample { since_power_on_ms: 33_333, rate_dps: [0.1; 3], temperature_raw: [6900.0, 6950.0, 6800.0] };
+    let sample = Sample {
+        since_power_on_ms: 33_333,
+        rate_dps: [0.1; 3],
+        temperature_raw: [6900.0, 6950.0, 6800.0],
+    };
     black_box(corrector.correct(black_box(&sample)));
     let correct_stack = painted.used();
 
@@ -100,8 +123,14 @@ fn main() -> ! {
     hprintln!("outputs compared: {}", samples * 9);
     hprintln!("mismatches: {}", mismatches);
     hprintln!("modified image bytes: {}", MODIFIED.len());
-    hprintln!("modified tables in RAM, bytes: {}", core::mem::size_of::<FirmwareTables>());
-    hprintln!("corrector state bytes: {}", core::mem::size_of::<CorrectorState<ModifiedAxisState>>());
+    hprintln!(
+        "modified tables in RAM, bytes: {}",
+        core::mem::size_of::<FirmwareTables>()
+    );
+    hprintln!(
+        "corrector state bytes: {}",
+        core::mem::size_of::<CorrectorState<ModifiedAxisState>>()
+    );
     hprintln!("stack bytes, decode image: {}", decode_stack);
     hprintln!("stack bytes, power_on + correct: {}", correct_stack);
     if mismatches == 0 {
