@@ -1,0 +1,267 @@
+//! Activations of one unit → the paper's tables and the two baselines.
+
+use std::collections::BTreeSet;
+
+use drift_core::{
+    AmbientCurves, AxisTable, Curve, CurvePoint, Model, ModifiedTables, PolynomialTables, Settings,
+};
+
+use crate::analyse::Analysed;
+use crate::baselines;
+use crate::curves::{group, CurveKey, SetPointCurves};
+use crate::error::FitError;
+use crate::knots::{choose, k_window, mean_window};
+use crate::settings::FitSettings;
+
+/// Capacities of the host table type (`ModifiedTables`'s defaults).
+const MAX_REFERENCES: usize = 16;
+const MAX_AMBIENTS: usize = 12;
+const MAX_CURVES: usize = 32;
+
+/// Everything fitted for one unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FittedUnit {
+    /// Unit id.
+    pub unit_id: String,
+    /// The paper's ("modified") tables.
+    pub modified: ModifiedTables,
+    /// The paper's standard calibration (Lagrange through the set points).
+    pub standard: PolynomialTables,
+    /// The least-squares polynomial baseline (3rd order by default).
+    pub third_order: PolynomialTables,
+    /// The averaged curves the tables were built from (for plots and diagnosis).
+    pub set_points: Vec<SetPointCurves>,
+    /// The curve keys kept, in table order before the per-reference-time sort.
+    pub curve_keys: Vec<CurveKey>,
+    /// Things the fit decided that a reader should know (dropped curves, nudged ties).
+    pub notes: Vec<String>,
+}
+
+fn check(settings: &FitSettings) -> Result<(), FitError> {
+    let bad = |field, problem: &str| {
+        Err(FitError::Settings {
+            field,
+            problem: problem.into(),
+        })
+    };
+    if settings.lowpass_window_samples == 0 {
+        return bad("lowpass_window_samples", "must be at least 1");
+    }
+    if settings.grid_ms == 0 {
+        return bad("grid_ms", "must be at least 1");
+    }
+    if !(2..=MAX_REFERENCES).contains(&settings.reference_count) {
+        return bad(
+            "reference_count",
+            "must be between 2 and 16 (the table's capacity)",
+        );
+    }
+    if settings.polynomial_degree > 7 {
+        return bad(
+            "polynomial_degree",
+            "must be at most 7 (8 coefficients in the image)",
+        );
+    }
+    if !(settings.first_reference_s > 0.0) || !(settings.initial_bias_window_s > 0.0) {
+        return bad(
+            "first_reference_s",
+            "first_reference_s and initial_bias_window_s must be > 0",
+        );
+    }
+    Ok(())
+}
+
+/// Makes `values` strictly increasing by nudging ties upwards by a relative 1e-6 (at most a few
+/// µ°C: far below the sensor's resolution). Returns how many were nudged.
+fn strictly_increasing(values: &mut [f32]) -> usize {
+    let mut nudged = 0;
+    for i in 1..values.len() {
+        if values[i] <= values[i - 1] {
+            values[i] = values[i - 1] + (values[i - 1].abs() * 1e-6).max(1e-6);
+            nudged += 1;
+        }
+    }
+    nudged
+}
+
+/// Fits one unit from its analysed activations (calibration set points only: the caller keeps the
+/// validation data out).
+pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<FittedUnit, FitError> {
+    check(settings)?;
+    let unit_id = activations
+        .first()
+        .map(|a| a.labels.unit_id.clone())
+        .unwrap_or_default();
+    let insufficient = |what: String| FitError::Insufficient {
+        unit: unit_id.clone(),
+        what,
+    };
+    if let Some(other) = activations.iter().find(|a| a.labels.unit_id != unit_id) {
+        return Err(insufficient(format!(
+            "activations of another unit ({}) were passed in",
+            other.labels.unit_id
+        )));
+    }
+    let mut set_points = group(activations, settings);
+    let mut notes = Vec::new();
+    if set_points.is_empty() {
+        return Err(insufficient("no protocol activations to fit".into()));
+    }
+    if set_points.len() > MAX_AMBIENTS {
+        return Err(insufficient(format!(
+            "{} set points exceed the table's {MAX_AMBIENTS} ambients",
+            set_points.len()
+        )));
+    }
+    // Curves must correspond across ambients: keep the keys every set point has.
+    let mut common: BTreeSet<CurveKey> = set_points[0].curves.iter().map(|c| c.key).collect();
+    for sp in &set_points[1..] {
+        let keys: BTreeSet<CurveKey> = sp.curves.iter().map(|c| c.key).collect();
+        common = common.intersection(&keys).copied().collect();
+    }
+    if !common.contains(&CurveKey::Independent) {
+        return Err(insufficient(
+            "a set point has no independent (first, fully cooled) activation".into(),
+        ));
+    }
+    for sp in &mut set_points {
+        let before = sp.curves.len();
+        sp.curves.retain(|c| common.contains(&c.key));
+        if sp.curves.len() < before {
+            notes.push(format!(
+                "{} °C: {} curves dropped (not present at every set point)",
+                sp.set_point_celsius,
+                before - sp.curves.len()
+            ));
+        }
+    }
+    if common.len() > MAX_CURVES {
+        return Err(insufficient(format!(
+            "{} curves exceed the table's {MAX_CURVES}",
+            common.len()
+        )));
+    }
+    let grid_ms = settings.grid_ms;
+    let first = (settings.first_reference_s * 1000.0 / f64::from(grid_ms)).round() as usize;
+    let shortest = set_points
+        .iter()
+        .flat_map(|sp| sp.curves.iter())
+        .map(|c| c.len())
+        .min()
+        .unwrap_or(0);
+    if shortest <= first + 1 {
+        return Err(insufficient(format!(
+            "activations end before the first reference time ({} s)",
+            settings.first_reference_s
+        )));
+    }
+    let window = settings.reference_window_points;
+    let mut axes: [AxisTable<MAX_REFERENCES, MAX_AMBIENTS, MAX_CURVES>; 3] = Default::default();
+    for (axis, table) in axes.iter_mut().enumerate() {
+        let knots = choose(&set_points, axis, first, settings.reference_count, window);
+        for &j in &knots {
+            let _ = table.reference_ms.push(j as u32 * grid_ms);
+        }
+        let mut last_ambient = f32::NEG_INFINITY;
+        for sp in &set_points {
+            let mut ambient = AmbientCurves {
+                ambient_celsius: sp.ambient_celsius[axis] as f32,
+                initial_bias_dps: sp.initial_bias_dps[axis] as f32,
+                curves: heapless::Vec::new(),
+            };
+            if ambient.ambient_celsius <= last_ambient {
+                return Err(insufficient(format!(
+                    "axis {axis}: switch-on temperature at {} °C ({:.3} °C) is not above the previous set point's",
+                    sp.set_point_celsius, ambient.ambient_celsius
+                )));
+            }
+            last_ambient = ambient.ambient_celsius;
+            // Points per reference time, then sorted by rise there (stage 3 needs them ordered).
+            let mut columns: Vec<Vec<(f32, f32)>> = knots
+                .iter()
+                .map(|&j| {
+                    sp.curves
+                        .iter()
+                        .map(|c| {
+                            (
+                                mean_window(&c.rise_celsius[axis], j, window) as f32,
+                                k_window(&c.drift_dps[axis], &c.rise_celsius[axis], j, window)
+                                    as f32,
+                            )
+                        })
+                        .collect()
+                })
+                .collect();
+            for (j, column) in columns.iter_mut().enumerate() {
+                column.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let mut rises: Vec<f32> = column.iter().map(|p| p.0).collect();
+                let nudged = strictly_increasing(&mut rises);
+                if nudged > 0 {
+                    notes.push(format!(
+                        "axis {axis}, {} °C, reference {j}: {nudged} tied rises nudged",
+                        sp.set_point_celsius
+                    ));
+                }
+                for (point, rise) in column.iter_mut().zip(rises) {
+                    point.0 = rise;
+                }
+            }
+            for c in 0..sp.curves.len() {
+                let mut curve = Curve::default();
+                for column in &columns {
+                    let (rise, k) = column[c];
+                    let _ = curve.points.push(CurvePoint {
+                        rise_celsius: rise,
+                        k_dps_per_celsius: k,
+                    });
+                }
+                let _ = ambient.curves.push(curve);
+            }
+            let _ = table.ambients.push(ambient);
+        }
+    }
+    let core_settings = Settings::default();
+    let modified = ModifiedTables {
+        settings: core_settings,
+        axes,
+    };
+    modified.validate().map_err(|source| FitError::Table {
+        unit: unit_id.clone(),
+        model: "modified",
+        source,
+    })?;
+
+    let protocol: Vec<&Analysed> = activations
+        .iter()
+        .filter(|a| CurveKey::of(a, settings).is_some())
+        .collect();
+    let by_set_point: Vec<Vec<&Analysed>> = set_points
+        .iter()
+        .map(|sp| {
+            protocol
+                .iter()
+                .copied()
+                .filter(|a| (a.labels.set_point_celsius - sp.set_point_celsius).abs() < 1e-6)
+                .collect()
+        })
+        .collect();
+    let standard = baselines::standard(&by_set_point, core_settings);
+    let third_order =
+        baselines::least_squares(&protocol, settings.polynomial_degree, core_settings);
+    for (model, tables) in [("standard", &standard), ("third_order", &third_order)] {
+        tables.validate().map_err(|source| FitError::Table {
+            unit: unit_id.clone(),
+            model,
+            source,
+        })?;
+    }
+    Ok(FittedUnit {
+        unit_id,
+        modified,
+        standard,
+        third_order,
+        curve_keys: common.into_iter().collect(),
+        set_points,
+        notes,
+    })
+}

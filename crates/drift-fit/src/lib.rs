@@ -1,0 +1,22 @@
+//! Fitting and evaluation, the std/f64 half of gyrodrift: segments → fitted tables → corrector →
+//! residual.
+//!
+//! - [`analyse`] turns one activation into its low-frequency drift and temperature-rise curves;
+//! - [`fit`] groups activations into the paper's curves, picks reference times, and builds the
+//!   paper's tables ([`drift_core::ModifiedTables`]) and the two polynomial baselines;
+//! - [`evaluate`] runs the fitted models through drift-core's f32 corrector (exactly what firmware
+//!   runs) on activations the fit did not see, and measures the paper's drift metric.
+
+pub mod analyse;
+pub mod baselines;
+pub mod curves;
+pub mod error;
+pub mod evaluate;
+pub mod fit;
+pub mod knots;
+pub mod lowpass;
+pub mod settings;
+
+pub use error::FitError;
+pub use fit::{fit_unit, FittedUnit};
+pub use settings::FitSettings;

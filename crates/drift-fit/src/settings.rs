@@ -1,0 +1,47 @@
+//! Fitting settings, in physical units, with the paper's values as defaults.
+
+use serde::{Deserialize, Serialize};
+
+/// How the tables are fitted. Every field has a unit in its name and a documented default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FitSettings {
+    /// Low-pass: centred moving average of this many samples ("a window at the operating
+    /// frequency (1000)": 1 s at 1000 Hz).
+    pub lowpass_window_samples: usize,
+    /// Analysis grid: the low-passed curves are kept every this many milliseconds.
+    pub grid_ms: u32,
+    /// The initial (switch-on) bias is the intercept of the rate against the temperature rise
+    /// over this first part of the activation, seconds.
+    pub initial_bias_window_s: f64,
+    /// The switch-on temperature is the mean of this first part of the activation, ms.
+    pub switch_on_window_ms: u32,
+    /// First reference time, s: where the rise has become measurable (the paper's first point: 2 s).
+    pub first_reference_s: f64,
+    /// Number of reference times per axis, the first included (greedy largest-error insertion).
+    pub reference_count: usize,
+    /// The value at a reference time is the mean of this many correlation samples around it
+    /// (the paper's `d_j = Σ gt_(i−5) / 10`), on the analysis grid.
+    pub reference_window_points: usize,
+    /// Series with an interval of at least this many minutes are "independent" (like a first
+    /// activation after a full cool-down) and merged into one curve.
+    pub independent_after_min: f64,
+    /// Degree of the PX4/ArduPilot-style least-squares polynomial baseline.
+    pub polynomial_degree: usize,
+}
+
+impl Default for FitSettings {
+    fn default() -> Self {
+        Self {
+            lowpass_window_samples: 1000,
+            grid_ms: 10,
+            initial_bias_window_s: 4.0,
+            switch_on_window_ms: 20,
+            first_reference_s: 2.0,
+            reference_count: 8,
+            reference_window_points: 10,
+            independent_after_min: 15.0,
+            polynomial_degree: 3,
+        }
+    }
+}

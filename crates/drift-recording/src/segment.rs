@@ -1,0 +1,107 @@
+//! One activation and its labels.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+/// Temperature-sensor scale: raw units per °C (the paper's sensor: 1 °C = 200 units).
+pub const RAW_PER_CELSIUS: f64 = 200.0;
+
+/// Which kind of series an activation belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeriesKind {
+    /// The paper's calibration protocol.
+    Protocol,
+    /// A field-like session.
+    Field,
+}
+
+impl SeriesKind {
+    /// The label written into recordings.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Protocol => "protocol",
+            Self::Field => "field",
+        }
+    }
+
+    /// Parses a label.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "protocol" => Some(Self::Protocol),
+            "field" => Some(Self::Field),
+            _ => None,
+        }
+    }
+}
+
+/// The labels of one activation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegmentLabels {
+    /// Unit id (from the recording metadata).
+    pub unit_id: String,
+    /// Chamber set point at switch-on (°C).
+    pub set_point_celsius: f64,
+    /// Protocol or field.
+    pub series_kind: SeriesKind,
+    /// Series number within the file (from 1).
+    pub series: u32,
+    /// Repeat of the interval (from 1).
+    pub repeat: u32,
+    /// Activation number within the series (from 1; 1..5 in the paper's protocol).
+    pub activation: u32,
+    /// Protocol off-time between activations (min); `None` for field sessions.
+    pub interval_min: Option<f64>,
+    /// Off-time before this switch-on as logged by the bench (s); `None` if unknown.
+    pub off_before_s: Option<f64>,
+}
+
+/// An auxiliary channel of one activation, at its own rate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AuxChannel {
+    /// Physical unit (`g`, `V`, `degC`).
+    pub unit: String,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: u32,
+    /// Samples; sample `k` is at `k / sample_rate_hz` seconds after switch-on.
+    pub values: Vec<f32>,
+}
+
+/// One activation (switch-on to switch-off): what the fitter consumes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Segment {
+    /// Labels.
+    pub labels: SegmentLabels,
+    /// Gyro/temperature sample rate (Hz).
+    pub sample_rate_hz: u32,
+    /// Switch-on time on the recording clock (ns).
+    pub power_on_ns: u64,
+    /// Per sample: index since switch-on (0 = switch-on); time = index / `sample_rate_hz`.
+    pub since_power_on: Vec<u32>,
+    /// Per sample: angular rate X, Y, Z (°/s).
+    pub rate_dps: [Vec<f32>; 3],
+    /// Per sample: raw temperature X, Y, Z (200 raw units per °C).
+    pub temperature_raw: [Vec<i16>; 3],
+    /// Auxiliary channels by name: `accel_x`, `accel_y`, `accel_z` (g), `supply_voltage`
+    /// (V), `chamber_set_point` (°C).
+    pub aux: BTreeMap<String, AuxChannel>,
+}
+
+impl Segment {
+    /// Number of gyro samples.
+    pub fn len(&self) -> usize {
+        self.since_power_on.len()
+    }
+
+    /// True if the segment has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.since_power_on.is_empty()
+    }
+
+    /// Time since switch-on of sample `i` in integer milliseconds (`None` past the end).
+    pub fn since_power_on_ms(&self, i: usize) -> Option<u64> {
+        let index = *self.since_power_on.get(i)?;
+        Some(u64::from(index) * 1000 / u64::from(self.sample_rate_hz.max(1)))
+    }
+}
