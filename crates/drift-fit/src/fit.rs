@@ -62,10 +62,14 @@ fn check(settings: &FitSettings) -> Result<(), FitError> {
             "must be at most 7 (8 coefficients in the image)",
         );
     }
-    if !(settings.first_reference_s > 0.0) || !(settings.initial_bias_window_s > 0.0) {
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !positive(settings.first_reference_s) {
+        return bad("first_reference_s", "must be a positive number of seconds");
+    }
+    if !positive(settings.initial_bias_window_s) {
         return bad(
-            "first_reference_s",
-            "first_reference_s and initial_bias_window_s must be > 0",
+            "initial_bias_window_s",
+            "must be a positive number of seconds",
         );
     }
     Ok(())

@@ -16,6 +16,7 @@ pub mod fit;
 pub mod knots;
 pub mod lowpass;
 pub mod settings;
+pub mod summary;
 
 pub use error::FitError;
 pub use fit::{fit_unit, FittedUnit};

@@ -30,7 +30,11 @@ fn segment(set_point: f64, interval_min: f64, activation: u32) -> Segment {
         let rise = rise_end * (1.0 - (-t / 40.0).exp()) / (1.0 - (-3.0_f64).exp());
         for axis in 0..3 {
             let sign = [1.0, -1.0, 0.5][axis];
-            let k = sign * 0.004 * (1.0 + 0.5 * (-t / 15.0).exp()) * (0.7 + 0.3 * dynamics) * (1.0 + 0.02 * (set_point - 30.0));
+            let k = sign
+                * 0.004
+                * (1.0 + 0.5 * (-t / 15.0).exp())
+                * (0.7 + 0.3 * dynamics)
+                * (1.0 + 0.02 * (set_point - 30.0));
             let bias0 = 0.1 * sign + 0.002 * (on_celsius - 30.0);
             rate[axis].push((bias0 + k * rise) as f32);
             raw[axis].push(((on_celsius + rise) * 200.0).round() as i16);
@@ -64,14 +68,18 @@ fn noise_free_fit_removes_nearly_all_drift_at_an_unseen_set_point() {
     for set_point in [30.0, 40.0] {
         for &interval in &intervals {
             for activation in 1..=5 {
-                calibration.push(analyse(&segment(set_point, interval, activation), &settings).unwrap());
+                calibration
+                    .push(analyse(&segment(set_point, interval, activation), &settings).unwrap());
             }
         }
     }
     let fitted = fit_unit(&calibration, &settings).unwrap();
     // 4 short intervals × activations 2–5, plus the merged independent curve.
     assert_eq!(fitted.curve_keys.len(), 17);
-    assert_eq!(fitted.modified.axes[0].reference_ms.len(), settings.reference_count);
+    assert_eq!(
+        fitted.modified.axes[0].reference_ms.len(),
+        settings.reference_count
+    );
     assert_eq!(fitted.modified.axes[0].reference_ms[0], 2000);
 
     let mut before = 0.0;
@@ -87,7 +95,15 @@ fn noise_free_fit_removes_nearly_all_drift_at_an_unseen_set_point() {
     let modified = after[3];
     eprintln!("drift sum over 5 activations × 3 axes: uncorrected {before:.5}, standard {:.5}, 3rd-order {:.5}, modified {modified:.5} °/s", after[1], after[2]);
     assert!(before > 0.05, "synthetic drift too small to test: {before}");
-    assert!(modified < 0.1 * before, "modified left {modified:.5} of {before:.5} °/s");
+    assert!(
+        modified < 0.1 * before,
+        "modified left {modified:.5} of {before:.5} °/s"
+    );
     // The modified model beats both baselines on data with heating dynamics.
-    assert!(modified < after[1] && modified < after[2], "modified {modified} standard {} 3rd {}", after[1], after[2]);
+    assert!(
+        modified < after[1] && modified < after[2],
+        "modified {modified} standard {} 3rd {}",
+        after[1],
+        after[2]
+    );
 }

@@ -1,0 +1,279 @@
+//! The report's tables, in Markdown.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+
+use drift_fit::summary::{Record, Split};
+use drift_fit::FittedUnit;
+
+use super::of_split;
+
+const AXES: [&str; 3] = ["X", "Y", "Z"];
+const MODELS: [&str; 4] = ["standard", "modified", "3rd-order", "uncorrected"];
+
+fn find<'a>(
+    records: &'a [Record],
+    unit: &str,
+    set_point: f64,
+    split: Split,
+    model: &str,
+    axis: &str,
+) -> Option<&'a Record> {
+    records.iter().find(|r| {
+        r.unit == unit
+            && (r.set_point_celsius - set_point).abs() < 1e-6
+            && r.split == split
+            && r.model == model
+            && r.axis == axis
+    })
+}
+
+/// Set points present in a split, ascending.
+fn set_points(records: &[Record], split: Split) -> Vec<f64> {
+    let milli: BTreeSet<i64> = of_split(records, split)
+        .map(|r| (r.set_point_celsius * 1000.0).round() as i64)
+        .collect();
+    milli.into_iter().map(|m| m as f64 / 1000.0).collect()
+}
+
+/// Mean drift of a model over every unit and axis at a set point and split.
+fn mean_drift(
+    records: &[Record],
+    units: &[&FittedUnit],
+    set_point: f64,
+    split: Split,
+    model: &str,
+) -> Option<f64> {
+    let values: Vec<f64> = units
+        .iter()
+        .flat_map(|u| {
+            AXES.iter()
+                .filter_map(move |a| find(records, &u.unit_id, set_point, split, model, a))
+        })
+        .map(|r| r.drift_dps)
+        .collect();
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+}
+
+fn fitted_units(fitted: &[FittedUnit]) -> Vec<&FittedUnit> {
+    fitted.iter().collect()
+}
+
+/// Rows (set point, split) of the paper's table: validation set points and the held-out repeats at
+/// calibration set points.
+fn rows(records: &[Record]) -> Vec<(f64, Split)> {
+    let mut rows: Vec<(f64, Split)> = set_points(records, Split::HeldOutRepeat)
+        .into_iter()
+        .map(|s| (s, Split::HeldOutRepeat))
+        .collect();
+    rows.extend(
+        set_points(records, Split::Validation)
+            .into_iter()
+            .map(|s| (s, Split::Validation)),
+    );
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    rows
+}
+
+/// The result in two sentences, with its ratios and the noise floor beside it.
+pub fn headline(records: &[Record], fitted: &[FittedUnit], noise_units: &[String]) -> String {
+    let units = fitted_units(fitted);
+    let mut md = String::from("## Result\n\n");
+    md.push_str("Mean drift (max − min of the 1-s low-frequency component over each 2-min activation) over ");
+    let _ = writeln!(
+        md,
+        "{} units × 3 axes, on activations the fit did not see:\n",
+        units.len()
+    );
+    md.push_str("| set point | data | uncorrected | standard | 3rd-order | modified | standard / modified | noise floor |\n|---|---|---:|---:|---:|---:|---:|---:|\n");
+    for (set_point, split) in rows(records) {
+        let m = |model| mean_drift(records, &units, set_point, split, model);
+        let noise: Vec<f64> = noise_units
+            .iter()
+            .flat_map(|u| {
+                AXES.iter().filter_map(move |a| {
+                    find(records, u, set_point, Split::NoiseFloor, "uncorrected", a)
+                })
+            })
+            .map(|r| r.drift_dps)
+            .collect();
+        let noise = (!noise.is_empty()).then(|| noise.iter().sum::<f64>() / noise.len() as f64);
+        let fmt = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.4}"));
+        let ratio = match (m("standard"), m("modified")) {
+            (Some(s), Some(d)) if d > 0.0 => format!("**{:.2}×**", s / d),
+            _ => "–".into(),
+        };
+        let _ = writeln!(
+            md,
+            "| {set_point:+} °C | {} | {} | {} | {} | {} | {ratio} | {} |",
+            split.name(),
+            fmt(m("uncorrected")),
+            fmt(m("standard")),
+            fmt(m("3rd-order")),
+            fmt(m("modified")),
+            fmt(noise)
+        );
+    }
+    md.push_str("\nAll drifts in °/s. *Noise floor*: the same metric on a unit with zero systematic drift (uncorrected): no correction can go below it.\n\n");
+    md
+}
+
+/// The paper's Table: rows model × set point, columns unit × axis.
+pub fn paper_table(records: &[Record], fitted: &[FittedUnit]) -> String {
+    let units = fitted_units(fitted);
+    let mut md = String::from(
+        "## Drift per unit and axis (the paper's Table)\n\n| calibration | set point | data |",
+    );
+    for (i, u) in units.iter().enumerate() {
+        for axis in AXES {
+            let _ = write!(md, " GIU {} ({}) {axis} |", i + 1, u.unit_id);
+        }
+    }
+    md.push_str("\n|---|---|---|");
+    md.push_str(&"---:|".repeat(units.len() * 3));
+    md.push('\n');
+    for model in MODELS {
+        for (set_point, split) in rows(records) {
+            let _ = write!(md, "| {model} | {set_point:+} °C | {} |", split.name());
+            for u in &units {
+                for axis in AXES {
+                    match find(records, &u.unit_id, set_point, split, model, axis) {
+                        Some(r) => {
+                            let _ = write!(md, " {:.4} |", r.drift_dps);
+                        }
+                        None => md.push_str(" – |"),
+                    }
+                }
+            }
+            md.push('\n');
+        }
+    }
+    for (set_point, split) in rows(records) {
+        let _ = write!(
+            md,
+            "| standard / modified | {set_point:+} °C | {} |",
+            split.name()
+        );
+        for u in &units {
+            for axis in AXES {
+                let s = find(records, &u.unit_id, set_point, split, "standard", axis);
+                let d = find(records, &u.unit_id, set_point, split, "modified", axis);
+                match (s, d) {
+                    (Some(s), Some(d)) if d.drift_dps > 0.0 => {
+                        let _ = write!(md, " {:.2}× |", s.drift_dps / d.drift_dps);
+                    }
+                    _ => md.push_str(" – |"),
+                }
+            }
+        }
+        md.push('\n');
+    }
+    md.push_str("\n°/s. +33 °C: validation set point, never used in the fit. Calibration set points: each repeat is left out in turn, the tables refitted on the other repeats, and evaluated on the left-out one.\n\n");
+    md
+}
+
+/// Field-like use: off-times and ambients the calibration never had.
+pub fn field_table(records: &[Record], fitted: &[FittedUnit]) -> String {
+    let units = fitted_units(fitted);
+    if of_split(records, Split::Field).next().is_none() {
+        return String::new();
+    }
+    let mut md = String::from("## Field-like use\n\nActivations with random off-times, ambient ramps, supply and orientation changes (never used in the fit), mean over set points:\n\n| model |");
+    for (i, _) in units.iter().enumerate() {
+        for axis in AXES {
+            let _ = write!(md, " GIU {} {axis} |", i + 1);
+        }
+    }
+    md.push_str(" mean |\n|---|");
+    md.push_str(&"---:|".repeat(units.len() * 3 + 1));
+    md.push('\n');
+    for model in MODELS {
+        let _ = write!(md, "| {model} |");
+        let mut all = Vec::new();
+        for u in &units {
+            for axis in AXES {
+                let values: Vec<f64> = of_split(records, Split::Field)
+                    .filter(|r| r.unit == u.unit_id && r.model == model && r.axis == axis)
+                    .map(|r| r.drift_dps)
+                    .collect();
+                if values.is_empty() {
+                    md.push_str(" – |");
+                } else {
+                    let mean = values.iter().sum::<f64>() / values.len() as f64;
+                    all.push(mean);
+                    let _ = write!(md, " {mean:.4} |");
+                }
+            }
+        }
+        let mean = if all.is_empty() {
+            f64::NAN
+        } else {
+            all.iter().sum::<f64>() / all.len() as f64
+        };
+        let _ = writeln!(md, " {mean:.4} |");
+    }
+    md.push('\n');
+    md
+}
+
+/// The noise-floor unit's figures.
+pub fn noise_floor(records: &[Record], noise_units: &[String]) -> String {
+    if noise_units.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from("## Noise floor\n\nA unit whose systematic drift is zero (same heating and noise): the drift metric of its raw output is what white noise and bias instability alone produce over 2 min with a 1-s window. Its own fitted tables should not add to it.\n\n| unit | set point | model | X | Y | Z |\n|---|---|---|---:|---:|---:|\n");
+    for unit in noise_units {
+        for set_point in set_points(records, Split::NoiseFloor) {
+            for model in ["uncorrected", "modified"] {
+                let _ = write!(md, "| {unit} | {set_point:+} °C | {model} |");
+                for axis in AXES {
+                    match find(records, unit, set_point, Split::NoiseFloor, model, axis) {
+                        Some(r) => {
+                            let _ = write!(md, " {:.4} |", r.drift_dps);
+                        }
+                        None => md.push_str(" – |"),
+                    }
+                }
+                md.push('\n');
+            }
+        }
+    }
+    md.push('\n');
+    md
+}
+
+/// Residual bias RMS: includes the initial-bias error that the drift metric ignores.
+pub fn residual_rms(records: &[Record], fitted: &[FittedUnit]) -> String {
+    let units = fitted_units(fitted);
+    let mut md = String::from("## Residual bias RMS\n\nRMS of the corrected low-frequency rate (true rate is zero), mean over axes, °/s. Unlike the drift it includes the error of the initial (switch-on) bias, which turn-on repeatability limits.\n\n| set point | data | model |");
+    for u in &units {
+        let _ = write!(md, " {} |", u.unit_id);
+    }
+    md.push_str("\n|---|---|---|");
+    md.push_str(&"---:|".repeat(units.len()));
+    md.push('\n');
+    for (set_point, split) in rows(records) {
+        for model in ["standard", "3rd-order", "modified"] {
+            let _ = write!(md, "| {set_point:+} °C | {} | {model} |", split.name());
+            for u in &units {
+                let values: Vec<f64> = AXES
+                    .iter()
+                    .filter_map(|a| find(records, &u.unit_id, set_point, split, model, a))
+                    .map(|r| r.residual_rms_dps)
+                    .collect();
+                if values.is_empty() {
+                    md.push_str(" – |");
+                } else {
+                    let _ = write!(
+                        md,
+                        " {:.4} |",
+                        values.iter().sum::<f64>() / values.len() as f64
+                    );
+                }
+            }
+            md.push('\n');
+        }
+    }
+    md.push('\n');
+    md
+}
