@@ -1,0 +1,5 @@
+//! The MCAP recording format: CDR encoding, schemas and topics, and the file writer.
+
+pub mod cdr;
+pub mod schema;
+pub mod writer;
