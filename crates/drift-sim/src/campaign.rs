@@ -37,6 +37,21 @@ pub struct Campaign {
     pub field: Option<Field>,
     /// Hidden effects (all off by default).
     pub effects: HiddenEffects,
+    /// Rate of the ground-truth bias in the sidecar.
+    pub truth_bias: TruthBias,
+}
+
+/// How densely the sidecar stores the true (noise-free) bias.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TruthBias {
+    /// Every gyro sample (exact, ~doubles the bytes written).
+    #[default]
+    EverySample,
+    /// At the 100 Hz auxiliary rate. The systematic bias is smooth (thermal time
+    /// constants ≥ 10 s), so linear interpolation between 10-ms points is exact to
+    /// ~1e-9 °/s; this saves a third of the simulation time.
+    AuxRate,
 }
 
 /// The paper's protocol: series of activations with a fixed off-time between them.
@@ -134,6 +149,7 @@ impl Default for Campaign {
             protocol: Some(Protocol::default()),
             field: None,
             effects: HiddenEffects::default(),
+            truth_bias: TruthBias::EverySample,
         }
     }
 }

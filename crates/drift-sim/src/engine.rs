@@ -3,7 +3,7 @@
 //! recording and its ground-truth sidecar.
 
 use crate::bias::{self, BiasInputs};
-use crate::campaign::Campaign;
+use crate::campaign::{Campaign, TruthBias};
 use crate::error::SimError;
 use crate::record::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use crate::record::writer::McapFile;
@@ -19,6 +19,11 @@ use std::path::Path;
 
 /// Full-scale range of the rate output (°/s); readings saturate here.
 pub const RANGE_DPS: f64 = 500.0;
+/// Rate output resolution (°/s): the unit outputs 24-bit words with LSB 2⁻¹⁴ °/s, which
+/// spans ±512 °/s. The quantisation noise (LSB/√12 ≈ 1.8e-5 °/s) is 350× below the
+/// per-sample white noise.
+pub const RATE_LSB_DPS: f64 = 1.0 / 16384.0;
+const RATE_PER_LSB_INV: f64 = 16384.0;
 /// Rate of the auxiliary and thermal-truth channels (Hz).
 pub const AUX_RATE_HZ: u32 = 100;
 /// Supply-voltage measurement noise, 1σ (V).
@@ -137,7 +142,7 @@ impl FileSim<'_> {
     }
 
     fn open_recording(&self, path: &Path) -> Result<McapFile, SimError> {
-        let mut f = McapFile::create(path, schema::PROFILE_RECORDING)?;
+        let mut f = McapFile::create(path, schema::PROFILE_RECORDING, mcap::Compression::Zstd)?;
         f.add_topic(
             schema::TOPIC_RATE,
             schema::SCHEMA_VECTOR3,
@@ -169,7 +174,9 @@ impl FileSim<'_> {
     }
 
     fn open_truth(&self, path: &Path) -> Result<McapFile, SimError> {
-        let mut f = McapFile::create(path, schema::PROFILE_TRUTH)?;
+        // The sidecar is not a bench recording: lz4 keeps it cheap to write (float truth
+        // hardly compresses anyway), so the recording's zstd gets the CPU.
+        let mut f = McapFile::create(path, schema::PROFILE_TRUTH, mcap::Compression::Lz4)?;
         f.add_topic(
             schema::TOPIC_TRUTH_BIAS,
             schema::SCHEMA_VECTOR3,
@@ -305,7 +312,9 @@ impl FileSim<'_> {
         let white: [f64; 3] = std::array::from_fn(|a| {
             unit.axes[a].white_noise_dps_per_rt_hz * f64::from(fs).sqrt() * noise
         });
-        let gm_phi: [f64; 3] = std::array::from_fn(|a| (-h / unit.axes[a].instability_tau_s).exp());
+        let gm_step_s = f64::from(aux_every) * h;
+        let gm_phi: [f64; 3] =
+            std::array::from_fn(|a| (-gm_step_s / unit.axes[a].instability_tau_s).exp());
         let gm_q: [f64; 3] = std::array::from_fn(|a| {
             unit.axes[a].instability_sigma_dps * noise * (1.0 - gm_phi[a] * gm_phi[a]).sqrt()
         });
@@ -316,6 +325,7 @@ impl FileSim<'_> {
             .iter()
             .any(|a| a.thermal_lag_dps_per_c_per_s != 0.0);
         let nonlinear = unit.asic_power_per_c != 0.0;
+        let every_sample_truth = c.truth_bias == TruthBias::EverySample;
         let ramp = act.ambient_ramp_c_per_s;
         let days_base_s = on_ms as f64 / 1000.0;
 
@@ -329,35 +339,32 @@ impl FileSim<'_> {
         let mut next = [0.0; NODES];
         let accel_true = act.gravity_body;
 
+        let grid_s = f64::from(aux_every) * h;
         for i in 0..act.samples {
             let t = f64::from(i) * h;
             let ambient = act.ambient_on_c + ramp * t;
-            for a in 0..3 {
-                let axis = &unit.axes[a];
-                let element_rate = if lag_on {
-                    self.network.derivative_of(element(a), x, &power, ambient)
-                } else {
-                    0.0
-                };
-                let inputs = BiasInputs {
-                    element_c: x[element(a)],
-                    element_rate_c_per_s: element_rate,
-                    accel_g: accel_true,
-                    supply_v: act.supply_v,
-                    campaign_s: days_base_s + t,
-                };
-                let systematic = bias::systematic_dps(axis, &inputs) + jitter[a];
-                instability[a] = gm_phi[a] * instability[a] + gm_q[a] * normal(r);
-                let rate = (systematic + instability[a] + white[a] * normal(r))
-                    .clamp(-RANGE_DPS, RANGE_DPS);
-                let raw = ((x[asic(a)] + axis.temperature_offset_c) * RAW_PER_CELSIUS
-                    + temp_noise[a] * normal(r))
-                .round();
-                buf.rate[a].push(rate as f32);
-                buf.raw[a].push(raw.clamp(f64::from(i16::MIN), f64::from(i16::MAX)) as i16);
-                buf.truth_bias[a].push(systematic as f32);
-            }
-            if i % aux_every == 0 {
+            let phase = i % aux_every;
+            if phase == 0 {
+                // Advance the thermal state one 10-ms grid step, exactly for inputs held
+                // over the step; samples in between are interpolated linearly. The fastest
+                // thermal mode has a time constant of seconds, so the interpolation error
+                // is ~1e-9 °C, far below the sensor's 0.005 °C step.
+                if nonlinear {
+                    for a in 0..3 {
+                        let growth = 1.0 + unit.asic_power_per_c * (x[asic(a)] - REFERENCE_CELSIUS);
+                        power[asic(a)] = base_power[asic(a)] * growth.max(0.0);
+                    }
+                }
+                if nonlinear || ramp != 0.0 {
+                    self.step
+                        .forcing(&power, ambient + 0.5 * grid_s * ramp, &mut forcing);
+                }
+                self.step.step(x, &forcing, &mut next);
+                // Bias instability is updated on the same grid: its correlation time is
+                // ≥ 100 s, so holding it for 10 ms changes nothing measurable.
+                for a in 0..3 {
+                    instability[a] = gm_phi[a] * instability[a] + gm_q[a] * normal(r);
+                }
                 for a in 0..3 {
                     let g = accel_true[a]
                         + unit.accel.bias_g[a]
@@ -371,19 +378,43 @@ impl FileSim<'_> {
                     .push((act.supply_v + SUPPLY_NOISE_V * noise * normal(r)) as f32);
                 buf.set_point.push(ambient as f32);
             }
-            // Advance the thermal state to the next sample (exact for held inputs).
-            if nonlinear {
-                for a in 0..3 {
-                    let growth = 1.0 + unit.asic_power_per_c * (x[asic(a)] - REFERENCE_CELSIUS);
-                    power[asic(a)] = base_power[asic(a)] * growth.max(0.0);
+            let frac = f64::from(phase) / f64::from(aux_every);
+            for a in 0..3 {
+                let axis = &unit.axes[a];
+                let (e, s) = (element(a), asic(a));
+                let element_c = x[e] + frac * (next[e] - x[e]);
+                let asic_c = x[s] + frac * (next[s] - x[s]);
+                let inputs = BiasInputs {
+                    element_c,
+                    // The exact mean heating rate over the grid step.
+                    element_rate_c_per_s: if lag_on {
+                        (next[e] - x[e]) / grid_s
+                    } else {
+                        0.0
+                    },
+                    accel_g: accel_true,
+                    supply_v: act.supply_v,
+                    campaign_s: days_base_s + t,
+                };
+                let systematic = bias::systematic_dps(axis, &inputs) + jitter[a];
+                let rate = (systematic + instability[a] + white[a] * normal(r))
+                    .clamp(-RANGE_DPS, RANGE_DPS);
+                let raw = (asic_c + axis.temperature_offset_c) * RAW_PER_CELSIUS
+                    + temp_noise[a] * normal(r);
+                // The unit outputs 24-bit words: quantise to the output LSB.
+                let counts = rate * RATE_PER_LSB_INV;
+                let counts = (counts + 0.5f64.copysign(counts)) as i32;
+                buf.rate[a].push((f64::from(counts) * RATE_LSB_DPS) as f32);
+                // Round half away from zero; `as` saturates at the i16 limits (the sensor's
+                // range). Cheaper than f64::round, which is a libm call on baseline x86-64.
+                buf.raw[a].push((raw + 0.5f64.copysign(raw)) as i16);
+                if every_sample_truth || phase == 0 {
+                    buf.truth_bias[a].push(systematic as f32);
                 }
             }
-            if nonlinear || ramp != 0.0 {
-                self.step
-                    .forcing(&power, ambient + 0.5 * h * ramp, &mut forcing);
+            if phase + 1 == aux_every {
+                *x = next;
             }
-            self.step.step(x, &forcing, &mut next);
-            *x = next;
 
             if (i + 1) % batch == 0 || i + 1 == act.samples {
                 let first = i + 1 - buf.rate[0].len() as u32;
@@ -399,7 +430,17 @@ impl FileSim<'_> {
                 rec.write_encoded(schema::TOPIC_SUPPLY, log_ns)?;
                 ScalarBatch::encode(aux_first, AUX_RATE_HZ, &buf.set_point, &mut rec.enc);
                 rec.write_encoded(schema::TOPIC_SET_POINT, log_ns)?;
-                Vector3Batch::encode(first, fs, as_refs(&buf.truth_bias), &mut tru.enc);
+                let (bias_first, bias_rate) = if every_sample_truth {
+                    (first, fs)
+                } else {
+                    (aux_first, AUX_RATE_HZ)
+                };
+                Vector3Batch::encode(
+                    bias_first,
+                    bias_rate,
+                    as_refs(&buf.truth_bias),
+                    &mut tru.enc,
+                );
                 tru.write_encoded(schema::TOPIC_TRUTH_BIAS, log_ns)?;
                 Vector3Batch::encode(
                     aux_first,

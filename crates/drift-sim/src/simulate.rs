@@ -140,10 +140,9 @@ pub fn simulate_campaign(
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let steps: Vec<_> = networks
-        .iter()
-        .map(|n| n.discretise(1.0 / f64::from(c.sample_rate_hz)))
-        .collect();
+    // The thermal state is stepped exactly on the 100 Hz auxiliary grid (see engine).
+    let grid_s = 1.0 / f64::from(crate::engine::AUX_RATE_HZ);
+    let steps: Vec<_> = networks.iter().map(|n| n.discretise(grid_s)).collect();
     for plan in &plans {
         let u = plan.unit_index as usize;
         let sim = FileSim {

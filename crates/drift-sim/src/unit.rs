@@ -97,11 +97,11 @@ pub struct UnitParams {
 /// `(name, low, high, unit)` for every uniformly drawn base parameter; `±` ranges are
 /// drawn as a magnitude in `[low, high]` with a random sign.
 pub const RANGES: &[(&str, f64, f64, &str)] = &[
-    ("housing_j_per_k", 45.0, 65.0, "J/K"),
+    ("housing_j_per_k", 55.0, 75.0, "J/K"),
     ("board_j_per_k", 8.0, 12.0, "J/K"),
     ("asic_j_per_k", 0.3, 0.5, "J/K"),
     ("element_j_per_k", 0.2, 0.3, "J/K"),
-    ("housing_to_ambient_w_per_k", 0.28, 0.36, "W/K"),
+    ("housing_to_ambient_w_per_k", 0.26, 0.34, "W/K"),
     ("board_to_housing_w_per_k", 0.3, 0.4, "W/K"),
     ("asic_to_board_w_per_k", 0.016, 0.024, "W/K"),
     ("asic_to_element_w_per_k", 0.006, 0.010, "W/K"),

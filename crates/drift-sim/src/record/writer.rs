@@ -24,7 +24,11 @@ pub struct McapFile {
 
 impl McapFile {
     /// Creates `path` (via a temporary sibling) with an MCAP `profile`.
-    pub fn create(path: &Path, profile: &str) -> Result<Self, SimError> {
+    pub fn create(
+        path: &Path,
+        profile: &str,
+        compression: mcap::Compression,
+    ) -> Result<Self, SimError> {
         let dir = path.parent().unwrap_or(Path::new("."));
         std::fs::create_dir_all(dir).map_err(|e| SimError::io(dir, e))?;
         let name = path
@@ -36,8 +40,11 @@ impl McapFile {
         let writer = mcap::WriteOptions::new()
             .profile(profile)
             .library(concat!("drift-sim ", env!("CARGO_PKG_VERSION")))
-            .compression(Some(mcap::Compression::Zstd))
+            .compression(Some(compression))
             .compression_level(1)
+            // Single-threaded compression: zstd's multi-threaded mode frames data
+            // differently, and the files must be bit-identical on every machine.
+            .compression_threads(0)
             .chunk_size(Some(CHUNK_BYTES))
             .create(BufWriter::with_capacity(1 << 20, file))
             .map_err(|e| SimError::mcap(&temp, e))?;

@@ -1,0 +1,36 @@
+//! Simulate-and-record throughput: one unit, one set point, the paper's protocol at one
+//! interval (5 activations × 2 min × 1000 Hz = 600 000 samples per iteration), into zstd MCAP.
+//!
+//! `cargo bench --bench simulate` ; figures go to docs/performance.md.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use drift_sim::{simulate_campaign, Campaign};
+
+fn campaign() -> Campaign {
+    let mut c = Campaign {
+        units: 1,
+        set_points_celsius: vec![30.0],
+        ..Campaign::default()
+    };
+    if let Some(p) = c.protocol.as_mut() {
+        p.intervals_min = vec![5.0];
+        p.repeats = 1;
+    }
+    c
+}
+
+fn simulate_and_record(crit: &mut Criterion) {
+    let c = campaign();
+    let samples = drift_sim::simulate::total_samples(&c);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut group = crit.benchmark_group("simulate_and_record");
+    group.throughput(Throughput::Elements(samples));
+    group.sample_size(10);
+    group.bench_function("protocol_1unit_600k_samples_zstd", |b| {
+        b.iter(|| simulate_campaign(&c, dir.path(), |_| {}).expect("simulate"));
+    });
+    group.finish();
+}
+
+criterion_group!(benches, simulate_and_record);
+criterion_main!(benches);
