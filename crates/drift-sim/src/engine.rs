@@ -142,35 +142,7 @@ impl FileSim<'_> {
     }
 
     fn open_recording(&self, path: &Path) -> Result<McapFile, SimError> {
-        let mut f = McapFile::create(path, schema::PROFILE_RECORDING, mcap::Compression::Zstd)?;
-        f.add_topic(
-            schema::TOPIC_RATE,
-            schema::SCHEMA_VECTOR3,
-            &[("unit", "deg/s"), ("frame", "unit body X, Y, Z")],
-        )?;
-        f.add_topic(
-            schema::TOPIC_TEMPERATURE_RAW,
-            schema::SCHEMA_RAW_TEMPERATURE,
-            &[("unit", "raw"), ("raw_per_celsius", "200")],
-        )?;
-        f.add_topic(
-            schema::TOPIC_ACCEL,
-            schema::SCHEMA_VECTOR3,
-            &[("unit", "g"), ("frame", "unit body X, Y, Z")],
-        )?;
-        f.add_topic(
-            schema::TOPIC_SUPPLY,
-            schema::SCHEMA_SCALAR,
-            &[("unit", "V")],
-        )?;
-        f.add_topic(
-            schema::TOPIC_SET_POINT,
-            schema::SCHEMA_SCALAR,
-            &[("unit", "degC")],
-        )?;
-        f.add_topic(schema::TOPIC_POWER, schema::SCHEMA_POWER, &[])?;
-        f.metadata(schema::METADATA_RECORDING, self.recording_metadata())?;
-        Ok(f)
+        crate::record::bench::create_recording(path, self.recording_metadata())
     }
 
     fn open_truth(&self, path: &Path) -> Result<McapFile, SimError> {

@@ -16,6 +16,8 @@ pub struct TruthSegment {
     pub systematic_bias_dps: [Vec<f32>; 3],
     /// Element temperatures at 100 Hz (°C).
     pub element_celsius: [Vec<f32>; 3],
+    /// ASIC (temperature-sensor site) true temperatures at 100 Hz (°C).
+    pub asic_celsius: [Vec<f32>; 3],
 }
 
 /// Reads a `.truth.mcap` sidecar into per-activation series (in recording order).
@@ -50,14 +52,14 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthSegment>, ReadError> {
                     out.push(TruthSegment::default());
                 }
             }
-            schema::TOPIC_TRUTH_BIAS | schema::TOPIC_TRUTH_ELEMENT => {
+            schema::TOPIC_TRUTH_BIAS | schema::TOPIC_TRUTH_ELEMENT | schema::TOPIC_TRUTH_ASIC => {
                 let seg = out
                     .last_mut()
                     .ok_or_else(|| bad("truth before the first switch-on".into()))?;
-                let target = if topic == schema::TOPIC_TRUTH_BIAS {
-                    &mut seg.systematic_bias_dps
-                } else {
-                    &mut seg.element_celsius
+                let target = match topic {
+                    schema::TOPIC_TRUTH_BIAS => &mut seg.systematic_bias_dps,
+                    schema::TOPIC_TRUTH_ELEMENT => &mut seg.element_celsius,
+                    _ => &mut seg.asic_celsius,
                 };
                 Vector3Batch::decode_into(&message.data, target).map_err(bad)?;
             }
