@@ -156,7 +156,7 @@ impl Default for Campaign {
 
 /// Set points from `from` to `to` (inclusive) in `step` (e.g. −40…+60 in 10 °C steps).
 pub fn set_point_range(from: f64, to: f64, step: f64) -> Vec<f64> {
-    if !(step > 0.0) || to < from {
+    if step.is_nan() || step <= 0.0 || to < from {
         return Vec::new();
     }
     let n = ((to - from) / step + 1e-9).floor() as usize;
@@ -260,14 +260,14 @@ impl Campaign {
             }
             check_ordered("field.activation_s", f.activation_s)?;
             check_ordered("field.off_min", f.off_min)?;
-            if !(f.off_min[0] > 0.0) {
+            if f.off_min[0] <= 0.0 {
                 return Err(bad(
                     "field.off_min",
                     "lower bound must be > 0 (log-uniform)",
                 ));
             }
             check_ordered("field.supply_v", f.supply_v)?;
-            if !(f.supply_v[0] > 0.0) {
+            if f.supply_v[0] <= 0.0 {
                 return Err(bad("field.supply_v", "must be > 0 V"));
             }
             check_nonneg("field.ambient_ramp_c_per_min", f.ambient_ramp_c_per_min)?;

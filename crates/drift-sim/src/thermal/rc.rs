@@ -219,17 +219,18 @@ impl RcNetwork {
 }
 
 impl Discrete {
-    /// The forcing term `Γ_P P + Γ_amb T_amb` for held inputs; add it after [`Self::propagate`].
+    /// The forcing term `Γ_P P + Γ_amb T_amb` for inputs held over the step, to pass to
+    /// [`Self::step`].
     pub fn forcing(&self, power_w: &[f64], ambient_c: f64, out: &mut [f64]) {
-        let n = self.n;
-        for i in 0..n {
-            let mut acc = self.gamma_ambient[i] * ambient_c;
-            for (j, p) in power_w.iter().enumerate() {
+        let rows = self.gamma_power.chunks_exact(self.n);
+        for ((o, row), g_amb) in out.iter_mut().zip(rows).zip(&self.gamma_ambient) {
+            let mut acc = g_amb * ambient_c;
+            for (g, p) in row.iter().zip(power_w) {
                 if *p != 0.0 {
-                    acc += self.gamma_power[i * n + j] * p;
+                    acc += g * p;
                 }
             }
-            out[i] = acc;
+            *o = acc;
         }
     }
 
