@@ -319,8 +319,8 @@ impl FileSim<'_> {
             if phase == 0 {
                 // Advance the thermal state one 10-ms grid step, exactly for inputs held
                 // over the step; samples in between are interpolated linearly. The fastest
-                // thermal mode has a time constant of seconds, so the interpolation error
-                // is ~1e-9 °C, far below the sensor's 0.005 °C step.
+                // thermal mode has a time constant of ~8 s, so the interpolation error is
+                // below 1e-6 °C (h²/8 · |T̈|), far below the sensor's 0.005 °C step.
                 if nonlinear {
                     for a in 0..3 {
                         let growth = 1.0 + unit.asic_power_per_c * (x[asic(a)] - REFERENCE_CELSIUS);

@@ -150,11 +150,13 @@ fn steady_state_balances_power() {
 
 #[test]
 fn slowest_mode_is_minutes_so_cool_down_is_done_within_the_hour() {
-    let (_, net) = unit_network();
-    let slowest = net.time_constants_s()[0];
-    // Mostly cooled by 15 min (≥ 3 time constants), complete within 1 h.
-    assert!(
-        (120.0..=300.0).contains(&slowest),
-        "slowest time constant {slowest} s"
-    );
+    // Over many drawn units: mostly cooled by 15 min (≥ 2.5 time constants, ≥ 92 %),
+    // complete within 1 h (≥ 10 time constants), fastest mode seconds (the ASIC).
+    for index in 0..50 {
+        let u = UnitParams::draw(11, index, UnitModel::Physical, &HiddenEffects::default());
+        let tau = u.thermal.network().unwrap().time_constants_s();
+        let (slowest, fastest) = (tau[0], tau[tau.len() - 1]);
+        assert!((120.0..=360.0).contains(&slowest), "unit {index}: slowest {slowest} s");
+        assert!((2.0..=20.0).contains(&fastest), "unit {index}: fastest {fastest} s");
+    }
 }
