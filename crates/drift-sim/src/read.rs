@@ -137,13 +137,17 @@ pub fn read_campaign_dir(dir: &Path) -> Result<Vec<Recording>, ReadError> {
     paths.iter().map(|p| read_recording(p)).collect()
 }
 
-/// True if a path names a ground-truth sidecar (checked before the file is opened).
+/// True if a path names a ground-truth sidecar (checked before the file is opened): a
+/// `*.truth.mcap` name, or any file directly inside a campaign's `truth/` folder.
 pub fn is_truth_path(path: &Path) -> bool {
-    path.file_name()
-        .is_some_and(|n| n.to_string_lossy().ends_with(TRUTH_EXTENSION))
-        || path
-            .components()
-            .any(|c| c.as_os_str() == crate::simulate::TRUTH_DIR)
+    let name_says_truth = path
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().ends_with(TRUTH_EXTENSION));
+    let folder_says_truth = path
+        .parent()
+        .and_then(Path::file_name)
+        .is_some_and(|d| d == crate::simulate::TRUTH_DIR);
+    name_says_truth || folder_says_truth
 }
 
 struct Open {

@@ -156,7 +156,13 @@ fn slowest_mode_is_minutes_so_cool_down_is_done_within_the_hour() {
         let u = UnitParams::draw(11, index, UnitModel::Physical, &HiddenEffects::default());
         let tau = u.thermal.network().unwrap().time_constants_s();
         let (slowest, fastest) = (tau[0], tau[tau.len() - 1]);
-        assert!((120.0..=360.0).contains(&slowest), "unit {index}: slowest {slowest} s");
-        assert!((2.0..=20.0).contains(&fastest), "unit {index}: fastest {fastest} s");
+        assert!(
+            (120.0..=360.0).contains(&slowest),
+            "unit {index}: slowest {slowest} s"
+        );
+        assert!(
+            (2.0..=20.0).contains(&fastest),
+            "unit {index}: fastest {fastest} s"
+        );
     }
 }
