@@ -256,9 +256,7 @@ pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
     let payload = body.get(HEADER_LEN..).unwrap_or_default();
     let (model, rest) = postcard::take_from_bytes::<M>(payload).map_err(BlobError::Malformed)?;
     if !rest.is_empty() {
-        return Err(BlobError::Malformed(
-            postcard::Error::DeserializeBadEncoding,
-        ));
+        return Err(BlobError::Malformed(postcard::Error::DeserializeBadEncoding));
     }
     model.validate().map_err(BlobError::Invalid)?;
     Ok(model)

@@ -91,11 +91,7 @@ impl<S: Copy + Default> CorrectorState<S> {
     ///
     /// Returns the flags that hold for the whole activation (e.g. an ambient outside the calibrated
     /// range). A non-finite reading is rejected, naming the axis, and the state is left unchanged.
-    pub fn power_on<M>(
-        &mut self,
-        model: &M,
-        switch_on_raw: [f32; AXES],
-    ) -> Result<[Flags; AXES], Error>
+    pub fn power_on<M>(&mut self, model: &M, switch_on_raw: [f32; AXES]) -> Result<[Flags; AXES], Error>
     where
         M: Model,
         M::Axis: AxisModel<State = S>,

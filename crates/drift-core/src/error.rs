@@ -107,7 +107,9 @@ impl fmt::Display for Error {
         }
         match self.problem {
             Problem::NonFinite => f.write_str(": value is NaN or infinite"),
-            Problem::NotIncreasing => f.write_str(": not strictly greater than the previous value"),
+            Problem::NotIncreasing => {
+                f.write_str(": not strictly greater than the previous value")
+            }
             Problem::NotPositive => f.write_str(": must be greater than zero"),
             Problem::Empty => f.write_str(": needs at least one entry"),
             Problem::LengthMismatch { expected, found } => {

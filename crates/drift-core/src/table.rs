@@ -80,11 +80,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             return Err(Error::new("reference_ms", at, Problem::Empty));
         }
         if self.reference_ms.first() == Some(&0) {
-            return Err(Error::new(
-                "reference_ms",
-                at.index(0),
-                Problem::NotPositive,
-            ));
+            return Err(Error::new("reference_ms", at.index(0), Problem::NotPositive));
         }
         if let Some(index) = self
             .reference_ms
@@ -200,11 +196,9 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         let time = TimePosition::locate(&self.reference_ms, since_power_on_ms);
         let margin = settings.rise_margin_celsius;
         let k_in = |i: u8| {
-            self.ambients
-                .get(usize::from(i))
-                .map_or((f32::NAN, false), |a| {
-                    heating::k_at(&a.curves, &time, rise_celsius, margin)
-                })
+            self.ambients.get(usize::from(i)).map_or((f32::NAN, false), |a| {
+                heating::k_at(&a.curves, &time, rise_celsius, margin)
+            })
         };
         let ambient = state.ambient;
         let (k_lo, mut out_of_span) = k_in(ambient.lo);

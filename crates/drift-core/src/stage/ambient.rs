@@ -42,11 +42,7 @@ impl AmbientPosition {
                 let lo = lo as u8;
                 Self {
                     lo,
-                    hi: if fraction > 0.0 {
-                        lo.saturating_add(1)
-                    } else {
-                        lo
-                    },
+                    hi: if fraction > 0.0 { lo.saturating_add(1) } else { lo },
                     weight: fraction,
                     out_of_range: false,
                 }

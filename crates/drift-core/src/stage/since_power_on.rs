@@ -57,11 +57,7 @@ impl TimePosition {
             Bracket::Below => held(false),
             Bracket::Inside { lo, fraction } => TimePosition {
                 lo,
-                hi: if fraction > 0.0 {
-                    lo.saturating_add(1)
-                } else {
-                    lo
-                },
+                hi: if fraction > 0.0 { lo.saturating_add(1) } else { lo },
                 fraction,
                 rise_scale: 1.0,
                 past_last: false,
