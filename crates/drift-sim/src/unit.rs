@@ -299,6 +299,53 @@ mod tests {
     }
 
     #[test]
+    fn every_drawn_parameter_is_inside_its_documented_range() {
+        let inside = |name: &str, values: &[f64]| {
+            let (_, lo, hi, _) = RANGES.iter().find(|r| r.0 == name).copied().unwrap();
+            for v in values {
+                let m = if name.contains('±') { v.abs() } else { *v };
+                let lo = if name.contains("uniform ±") { 0.0 } else { lo };
+                assert!(m >= lo && m <= hi, "{name}: {v} outside [{lo}, {hi}]");
+                assert!(*v != 0.0, "{name}: drawn as exactly 0 (unknown name?)");
+            }
+        };
+        for index in 0..20 {
+            let u = UnitParams::draw(99, index, UnitModel::Physical, &HiddenEffects::default());
+            let t = &u.thermal;
+            inside("housing_j_per_k", &[t.housing_j_per_k]);
+            inside("board_j_per_k", &[t.board_j_per_k]);
+            inside("asic_j_per_k", &t.asic_j_per_k);
+            inside("element_j_per_k", &t.element_j_per_k);
+            inside(
+                "housing_to_ambient_w_per_k",
+                &[t.housing_to_ambient_w_per_k],
+            );
+            inside("board_to_housing_w_per_k", &[t.board_to_housing_w_per_k]);
+            inside("asic_to_board_w_per_k", &t.asic_to_board_w_per_k);
+            inside("asic_to_element_w_per_k", &t.asic_to_element_w_per_k);
+            inside("element_to_housing_w_per_k", &t.element_to_housing_w_per_k);
+            inside("supply_power_w", &[t.supply_power_w]);
+            inside("asic_power_w", &t.asic_power_w);
+            inside("accel bias_g (uniform ±)", &u.accel.bias_g);
+            for a in &u.axes {
+                inside("bias_offset_dps (uniform ±)", &[a.bias_offset_dps]);
+                inside("tempco_dps_per_c (±)", &[a.tempco_dps_per_c]);
+                inside("tempco2_dps_per_c2 (±)", &[a.tempco2_dps_per_c2]);
+                inside("pressure_dps (±)", &[a.pressure_dps]);
+                inside("turn_on_sigma_dps", &[a.turn_on_sigma_dps]);
+                inside("white_noise_dps_per_rt_hz", &[a.white_noise_dps_per_rt_hz]);
+                inside("instability_sigma_dps", &[a.instability_sigma_dps]);
+                inside("instability_tau_s", &[a.instability_tau_s]);
+                inside(
+                    "temperature_offset_c (uniform ±)",
+                    &[a.temperature_offset_c],
+                );
+                inside("temperature_noise_raw", &[a.temperature_noise_raw]);
+            }
+        }
+    }
+
+    #[test]
     fn zero_drift_unit_has_no_temperature_coefficients() {
         let u = UnitParams::draw(
             1,
