@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod demo;
+pub mod simulate;
 
 /// Temperature-drift correction for MEMS gyroscopes.
 #[derive(Debug, Parser)]
@@ -18,11 +19,14 @@ pub struct Cli {
 pub enum Command {
     /// Run the built-in demonstration (the README's main job).
     Demo(demo::Args),
+    /// Simulate a calibration campaign and record it as MCAP files.
+    Simulate(simulate::Args),
 }
 
 /// Runs one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Demo(args) => demo::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
     }
 }

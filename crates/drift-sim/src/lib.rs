@@ -1,0 +1,25 @@
+#![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod bias;
+pub mod campaign;
+mod engine;
+pub mod error;
+pub mod hidden;
+pub mod read;
+pub mod record;
+mod rng;
+pub mod schedule;
+pub mod simulate;
+pub mod thermal;
+pub mod truth;
+pub mod unit;
+
+pub use campaign::{Campaign, Field, Protocol};
+pub use error::{ReadError, SimError};
+pub use hidden::HiddenEffects;
+pub use read::{read_campaign_dir, read_recording, AuxChannel, Recording, Segment, SegmentLabels};
+pub use schedule::SeriesKind;
+pub use simulate::{simulate_campaign, Progress, Summary};
+pub use unit::{UnitModel, UnitParams};

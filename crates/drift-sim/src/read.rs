@@ -1,0 +1,502 @@
+//! Reads and validates a recording into per-activation segments: the input of the fitter.
+//!
+//! The reader refuses ground-truth sidecars (by name, by MCAP profile, and by `/truth/`
+//! topics), so code that only uses this module cannot see the truth. It validates while
+//! it reads: missing topics, non-monotonic or duplicate timestamps, gaps or overlaps in the
+//! sample sequence, NaN/∞ values and unbalanced power events are errors naming the file,
+//! topic and the message's index within that topic.
+
+use crate::error::ReadError;
+use crate::record::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
+use crate::schedule::SeriesKind;
+use crate::simulate::{RECORDINGS_DIR, TRUTH_EXTENSION};
+use crate::unit::RAW_PER_CELSIUS;
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+/// Topics every recording must have.
+pub const REQUIRED_TOPICS: [&str; 6] = [
+    schema::TOPIC_RATE,
+    schema::TOPIC_TEMPERATURE_RAW,
+    schema::TOPIC_ACCEL,
+    schema::TOPIC_SUPPLY,
+    schema::TOPIC_SET_POINT,
+    schema::TOPIC_POWER,
+];
+
+/// The labels of one activation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentLabels {
+    /// Unit id (from the recording metadata).
+    pub unit_id: String,
+    /// Chamber set point at switch-on (°C).
+    pub set_point_celsius: f64,
+    /// Protocol or field.
+    pub series_kind: SeriesKind,
+    /// Series number within the file (from 1).
+    pub series: u32,
+    /// Repeat of the interval (from 1).
+    pub repeat: u32,
+    /// Activation number within the series (from 1; 1..5 in the paper's protocol).
+    pub activation: u32,
+    /// Protocol off-time between activations (min); `None` for field sessions.
+    pub interval_min: Option<f64>,
+    /// Off-time before this switch-on as logged by the bench (s); `None` if unknown.
+    pub off_before_s: Option<f64>,
+}
+
+/// An auxiliary channel of one activation, at its own rate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AuxChannel {
+    /// Physical unit (`g`, `V`, `degC`).
+    pub unit: String,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: u32,
+    /// Samples; sample `k` is at `k / sample_rate_hz` seconds after switch-on.
+    pub values: Vec<f32>,
+}
+
+/// One activation (switch-on to switch-off): what the fitter consumes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Segment {
+    /// Labels.
+    pub labels: SegmentLabels,
+    /// Gyro/temperature sample rate (Hz).
+    pub sample_rate_hz: u32,
+    /// Switch-on time on the recording clock (ns).
+    pub power_on_ns: u64,
+    /// Per sample: index since switch-on (0 = switch-on); time = index / `sample_rate_hz`.
+    pub since_power_on: Vec<u32>,
+    /// Per sample: angular rate X, Y, Z (°/s).
+    pub rate_dps: [Vec<f32>; 3],
+    /// Per sample: raw temperature X, Y, Z (200 raw units per °C).
+    pub temperature_raw: [Vec<i16>; 3],
+    /// Auxiliary channels by name: `accel_x`, `accel_y`, `accel_z` (g), `supply_voltage`
+    /// (V), `chamber_set_point` (°C).
+    pub aux: BTreeMap<String, AuxChannel>,
+}
+
+impl Segment {
+    /// Number of gyro samples.
+    pub fn len(&self) -> usize {
+        self.since_power_on.len()
+    }
+    /// True if the segment has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.since_power_on.is_empty()
+    }
+    /// Time since switch-on of sample `i` in integer milliseconds.
+    pub fn since_power_on_ms(&self, i: usize) -> u64 {
+        u64::from(self.since_power_on[i]) * 1000 / u64::from(self.sample_rate_hz)
+    }
+    /// Raw temperature of `axis` at sample `i` in °C.
+    pub fn temperature_celsius(&self, axis: usize, i: usize) -> f64 {
+        f64::from(self.temperature_raw[axis][i]) / RAW_PER_CELSIUS
+    }
+}
+
+/// A validated recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    /// The file.
+    pub path: PathBuf,
+    /// The `gyrodrift.recording` metadata record.
+    pub metadata: BTreeMap<String, String>,
+    /// Unit id.
+    pub unit_id: String,
+    /// Gyro sample rate (Hz).
+    pub sample_rate_hz: u32,
+    /// Activations in recording order.
+    pub segments: Vec<Segment>,
+}
+
+/// Reads every recording of a campaign folder (`<dir>/recordings/*.mcap`, sorted by name).
+/// The `truth/` folder is never listed or opened.
+pub fn read_campaign_dir(dir: &Path) -> Result<Vec<Recording>, ReadError> {
+    let folder = dir.join(RECORDINGS_DIR);
+    let entries = std::fs::read_dir(&folder).map_err(|e| ReadError::Io {
+        path: folder.clone(),
+        source: e,
+    })?;
+    let mut paths = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|e| ReadError::Io {
+            path: folder.clone(),
+            source: e,
+        })?;
+        let path = entry.path();
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if name.ends_with(".mcap") && !name.starts_with('.') && !name.ends_with(TRUTH_EXTENSION) {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    paths.iter().map(|p| read_recording(p)).collect()
+}
+
+/// True if a path names a ground-truth sidecar (checked before the file is opened): a
+/// `*.truth.mcap` name, or any file directly inside a campaign's `truth/` folder.
+pub fn is_truth_path(path: &Path) -> bool {
+    let name_says_truth = path
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().ends_with(TRUTH_EXTENSION));
+    let folder_says_truth = path
+        .parent()
+        .and_then(Path::file_name)
+        .is_some_and(|d| d == crate::simulate::TRUTH_DIR);
+    name_says_truth || folder_says_truth
+}
+
+struct Open {
+    labels: SegmentLabels,
+    on_ns: u64,
+    rate: [Vec<f32>; 3],
+    raw: [Vec<i16>; 3],
+    accel: [Vec<f32>; 3],
+    supply: Vec<f32>,
+    set_point: Vec<f32>,
+}
+
+/// Per-topic bookkeeping for messages: index and last log time.
+#[derive(Default)]
+struct TopicState {
+    count: usize,
+    last_ns: Option<u64>,
+}
+
+/// Reads and validates one recording.
+pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
+    if is_truth_path(path) {
+        return Err(ReadError::GroundTruth {
+            path: path.to_path_buf(),
+            why: "sidecar file name or truth/ folder".into(),
+        });
+    }
+    let buf = std::fs::read(path).map_err(|e| ReadError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    let mcap_err = |e| ReadError::Mcap {
+        path: path.to_path_buf(),
+        source: e,
+    };
+    if let Some(Ok(mcap::records::Record::Header(h))) = mcap::read::LinearReader::new(&buf)
+        .map_err(mcap_err)?
+        .next()
+    {
+        if h.profile == schema::PROFILE_TRUTH {
+            return Err(ReadError::GroundTruth {
+                path: path.to_path_buf(),
+                why: format!("MCAP profile `{}`", h.profile),
+            });
+        }
+    }
+    let summary = mcap::read::Summary::read(&buf)
+        .map_err(mcap_err)?
+        .ok_or_else(|| ReadError::Metadata {
+            path: path.to_path_buf(),
+            name: "summary".into(),
+            reason: "the MCAP has no summary section (was finish() called?)".into(),
+        })?;
+    let topics: Vec<&str> = summary
+        .channels
+        .values()
+        .map(|c| c.topic.as_str())
+        .collect();
+    if let Some(t) = topics.iter().find(|t| t.starts_with(schema::TRUTH_PREFIX)) {
+        return Err(ReadError::GroundTruth {
+            path: path.to_path_buf(),
+            why: format!("topic {t}"),
+        });
+    }
+    for required in REQUIRED_TOPICS {
+        if !topics.contains(&required) {
+            return Err(ReadError::MissingTopic {
+                path: path.to_path_buf(),
+                topic: required.into(),
+            });
+        }
+    }
+    let meta_err = |reason: String| ReadError::Metadata {
+        path: path.to_path_buf(),
+        name: schema::METADATA_RECORDING.into(),
+        reason,
+    };
+    let mut metadata = None;
+    for index in &summary.metadata_indexes {
+        if index.name == schema::METADATA_RECORDING {
+            metadata = Some(
+                mcap::read::metadata(&buf, index)
+                    .map_err(mcap_err)?
+                    .metadata,
+            );
+        }
+    }
+    let metadata = metadata.ok_or_else(|| meta_err("record missing".into()))?;
+    let field = |k: &str| {
+        metadata
+            .get(k)
+            .cloned()
+            .ok_or_else(|| meta_err(format!("key `{k}` missing")))
+    };
+    let unit_id = field("unit_id")?;
+    let sample_rate_hz: u32 = field("sample_rate_hz")?
+        .parse()
+        .map_err(|e| meta_err(format!("sample_rate_hz: {e}")))?;
+    if sample_rate_hz == 0 || 1_000_000_000 % sample_rate_hz != 0 {
+        return Err(meta_err(format!(
+            "sample_rate_hz must divide 10⁹, got {sample_rate_hz}"
+        )));
+    }
+
+    let mut reader = Reader {
+        path,
+        unit_id: &unit_id,
+        rate_hz: sample_rate_hz,
+        open: None,
+        segments: Vec::new(),
+        topics: HashMap::new(),
+    };
+    for message in mcap::MessageStream::new(&buf).map_err(mcap_err)? {
+        let message = message.map_err(mcap_err)?;
+        reader.message(&message.channel.topic, message.log_time, &message.data)?;
+    }
+    if reader.open.is_some() {
+        let index = reader
+            .topics
+            .get(schema::TOPIC_POWER)
+            .map_or(0, |s| s.count.saturating_sub(1));
+        return Err(reader.err(
+            schema::TOPIC_POWER,
+            index,
+            "file ends while the unit is on (no switch-off event)".into(),
+        ));
+    }
+    let segments = reader.segments;
+    Ok(Recording {
+        path: path.to_path_buf(),
+        metadata,
+        unit_id,
+        sample_rate_hz,
+        segments,
+    })
+}
+
+struct Reader<'p> {
+    path: &'p Path,
+    unit_id: &'p str,
+    rate_hz: u32,
+    open: Option<Open>,
+    segments: Vec<Segment>,
+    topics: HashMap<String, TopicState>,
+}
+
+fn nan_free(values: &[f32], from: usize) -> Result<(), String> {
+    match values[from..].iter().position(|v| !v.is_finite()) {
+        Some(k) => Err(format!(
+            "non-finite value {} at sample {} of the segment",
+            values[from + k],
+            from + k
+        )),
+        None => Ok(()),
+    }
+}
+
+impl Reader<'_> {
+    fn err(&self, topic: &str, index: usize, reason: String) -> ReadError {
+        ReadError::Message {
+            path: self.path.to_path_buf(),
+            topic: topic.to_owned(),
+            index,
+            reason,
+        }
+    }
+
+    fn message(&mut self, topic: &str, log_ns: u64, data: &[u8]) -> Result<(), ReadError> {
+        if topic.starts_with(schema::TRUTH_PREFIX) {
+            return Err(ReadError::GroundTruth {
+                path: self.path.to_path_buf(),
+                why: format!("topic {topic}"),
+            });
+        }
+        if !REQUIRED_TOPICS.contains(&topic) {
+            return Ok(()); // Extra topics a bench may add are allowed and ignored.
+        }
+        let state = self.topics.entry(topic.to_owned()).or_default();
+        let index = state.count;
+        state.count += 1;
+        if let Some(last) = state.last_ns {
+            if log_ns == last {
+                return Err(self.err(topic, index, format!("duplicate timestamp {log_ns} ns")));
+            }
+            if log_ns < last {
+                return Err(self.err(
+                    topic,
+                    index,
+                    format!("timestamp {log_ns} ns goes back (previous {last} ns)"),
+                ));
+            }
+        }
+        state.last_ns = Some(log_ns);
+        let result = if topic == schema::TOPIC_POWER {
+            self.power(log_ns, data)
+        } else {
+            self.samples(topic, data)
+        };
+        result.map_err(|reason| self.err(topic, index, reason))
+    }
+
+    fn power(&mut self, log_ns: u64, data: &[u8]) -> Result<(), String> {
+        let e = PowerEvent::decode(data)?;
+        let kind = SeriesKind::parse(&e.series_kind).ok_or_else(|| {
+            format!(
+                "series_kind must be protocol|field, got `{}`",
+                e.series_kind
+            )
+        })?;
+        if e.powered {
+            if self.open.is_some() {
+                return Err("switch-on while already on (missing switch-off)".into());
+            }
+            if !e.set_point_celsius.is_finite() {
+                return Err("set_point_celsius is not finite".into());
+            }
+            let labels = SegmentLabels {
+                unit_id: self.unit_id.to_owned(),
+                set_point_celsius: e.set_point_celsius,
+                series_kind: kind,
+                series: e.series,
+                repeat: e.repeat,
+                activation: e.activation,
+                interval_min: e.interval_min.is_finite().then_some(e.interval_min),
+                off_before_s: e.off_before_s.is_finite().then_some(e.off_before_s),
+            };
+            let v = Vec::new;
+            self.open = Some(Open {
+                labels,
+                on_ns: log_ns,
+                rate: [v(), v(), v()],
+                raw: [Vec::new(), Vec::new(), Vec::new()],
+                accel: [v(), v(), v()],
+                supply: v(),
+                set_point: v(),
+            });
+            return Ok(());
+        }
+        let open = self.open.take().ok_or("switch-off without switch-on")?;
+        if (e.series, e.repeat, e.activation)
+            != (
+                open.labels.series,
+                open.labels.repeat,
+                open.labels.activation,
+            )
+        {
+            return Err(format!(
+                "switch-off labels (series {}, repeat {}, activation {}) differ from switch-on ({}, {}, {})",
+                e.series, e.repeat, e.activation, open.labels.series, open.labels.repeat, open.labels.activation
+            ));
+        }
+        let n = open.rate[0].len();
+        if open.raw[0].len() != n {
+            return Err(format!(
+                "{n} rate samples but {} temperature samples in the activation",
+                open.raw[0].len()
+            ));
+        }
+        if n == 0 {
+            return Err("activation without samples".into());
+        }
+        let period_ns = 1_000_000_000 / u64::from(self.rate_hz);
+        let expected_off = open.on_ns + n as u64 * period_ns;
+        if log_ns < expected_off {
+            return Err(format!(
+                "switch-off at {log_ns} ns precedes the end of the last sample ({expected_off} ns)"
+            ));
+        }
+        let aux = |values: Vec<f32>, unit: &str| AuxChannel {
+            unit: unit.into(),
+            sample_rate_hz: crate::engine::AUX_RATE_HZ,
+            values,
+        };
+        let [ax, ay, az] = open.accel;
+        let aux = BTreeMap::from([
+            ("accel_x".to_owned(), aux(ax, "g")),
+            ("accel_y".to_owned(), aux(ay, "g")),
+            ("accel_z".to_owned(), aux(az, "g")),
+            ("supply_voltage".to_owned(), aux(open.supply, "V")),
+            ("chamber_set_point".to_owned(), aux(open.set_point, "degC")),
+        ]);
+        self.segments.push(Segment {
+            labels: open.labels,
+            sample_rate_hz: self.rate_hz,
+            power_on_ns: open.on_ns,
+            since_power_on: (0..n as u32).collect(),
+            rate_dps: open.rate,
+            temperature_raw: open.raw,
+            aux,
+        });
+        Ok(())
+    }
+
+    fn samples(&mut self, topic: &str, data: &[u8]) -> Result<(), String> {
+        let rate_hz = self.rate_hz;
+        let open = self
+            .open
+            .as_mut()
+            .ok_or("samples while the unit is off (no switch-on before)")?;
+        let (expected, (first, rate, _n)) = match topic {
+            schema::TOPIC_RATE => {
+                let before = open.rate[0].len();
+                let r = Vector3Batch::decode_into(data, &mut open.rate)?;
+                for axis in &open.rate {
+                    nan_free(axis, before)?;
+                }
+                (before, r)
+            }
+            schema::TOPIC_TEMPERATURE_RAW => (
+                open.raw[0].len(),
+                RawTemperatureBatch::decode_into(data, &mut open.raw)?,
+            ),
+            schema::TOPIC_ACCEL => {
+                let before = open.accel[0].len();
+                let r = Vector3Batch::decode_into(data, &mut open.accel)?;
+                for axis in &open.accel {
+                    nan_free(axis, before)?;
+                }
+                (before, r)
+            }
+            _ => {
+                let values = if topic == schema::TOPIC_SUPPLY {
+                    &mut open.supply
+                } else {
+                    &mut open.set_point
+                };
+                let before = values.len();
+                let r = ScalarBatch::decode_into(data, values)?;
+                nan_free(values, before)?;
+                (before, r)
+            }
+        };
+        let expected_rate = if topic == schema::TOPIC_RATE || topic == schema::TOPIC_TEMPERATURE_RAW
+        {
+            rate_hz
+        } else {
+            crate::engine::AUX_RATE_HZ
+        };
+        if rate != expected_rate {
+            return Err(format!("sample_rate_hz {rate}, expected {expected_rate}"));
+        }
+        if first as usize != expected {
+            let what = if (first as usize) > expected {
+                "gap"
+            } else {
+                "overlap or duplicate"
+            };
+            return Err(format!("{what}: first_sample {first}, expected {expected}"));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,130 @@
+//! Writing recordings in the bench format: used by the simulator, and by anything that
+//! converts real test-bench logs (give it [`Recording`] segments, get the same MCAP).
+
+use super::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
+use super::writer::McapFile;
+use crate::engine::AUX_RATE_HZ;
+use crate::error::SimError;
+use crate::read::{Recording, Segment};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Creates a recording file with every topic registered and the metadata record written.
+///
+/// `metadata` must carry at least `unit_id` and `sample_rate_hz` (see
+/// `docs/recording-format.md` for every key).
+pub fn create_recording(
+    path: &Path,
+    metadata: BTreeMap<String, String>,
+) -> Result<McapFile, SimError> {
+    let mut f = McapFile::create(path, schema::PROFILE_RECORDING, mcap::Compression::Zstd)?;
+    f.add_topic(
+        schema::TOPIC_RATE,
+        schema::SCHEMA_VECTOR3,
+        &[("unit", "deg/s"), ("frame", "unit body X, Y, Z")],
+    )?;
+    f.add_topic(
+        schema::TOPIC_TEMPERATURE_RAW,
+        schema::SCHEMA_RAW_TEMPERATURE,
+        &[("unit", "raw"), ("raw_per_celsius", "200")],
+    )?;
+    f.add_topic(
+        schema::TOPIC_ACCEL,
+        schema::SCHEMA_VECTOR3,
+        &[("unit", "g"), ("frame", "unit body X, Y, Z")],
+    )?;
+    f.add_topic(
+        schema::TOPIC_SUPPLY,
+        schema::SCHEMA_SCALAR,
+        &[("unit", "V")],
+    )?;
+    f.add_topic(
+        schema::TOPIC_SET_POINT,
+        schema::SCHEMA_SCALAR,
+        &[("unit", "degC")],
+    )?;
+    f.add_topic(schema::TOPIC_POWER, schema::SCHEMA_POWER, &[])?;
+    f.metadata(schema::METADATA_RECORDING, metadata)?;
+    Ok(f)
+}
+
+fn aux<'a>(segment: &'a Segment, name: &str) -> &'a [f32] {
+    segment.aux.get(name).map_or(&[], |c| c.values.as_slice())
+}
+
+fn event(segment: &Segment, powered: bool) -> PowerEvent {
+    let l = &segment.labels;
+    PowerEvent {
+        powered,
+        series_kind: l.series_kind.as_str().to_owned(),
+        series: l.series,
+        repeat: l.repeat,
+        activation: l.activation,
+        interval_min: l.interval_min.unwrap_or(f64::NAN),
+        off_before_s: l.off_before_s.unwrap_or(f64::NAN),
+        set_point_celsius: l.set_point_celsius,
+    }
+}
+
+/// Writes a whole recording (metadata and segments) to `path` in batches of 100 ms.
+/// Reading the result with [`crate::read_recording`] gives back an identical [`Recording`]
+/// (apart from `path`).
+pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, SimError> {
+    let mut f = create_recording(path, recording.metadata.clone())?;
+    for segment in &recording.segments {
+        let fs = segment.sample_rate_hz;
+        let period_ns = 1_000_000_000 / u64::from(fs);
+        let batch = (fs / 10).max(1) as usize;
+        let aux_every = (fs / AUX_RATE_HZ).max(1) as usize;
+        f.power(&event(segment, true), segment.power_on_ns)?;
+        let n = segment.len();
+        let mut first = 0usize;
+        while first < n {
+            let end = (first + batch).min(n);
+            let log_ns = segment.power_on_ns + first as u64 * period_ns;
+            let r = &segment.rate_dps;
+            Vector3Batch::encode(
+                first as u32,
+                fs,
+                [&r[0][first..end], &r[1][first..end], &r[2][first..end]],
+                &mut f.enc,
+            );
+            f.write_encoded(schema::TOPIC_RATE, log_ns)?;
+            let t = &segment.temperature_raw;
+            RawTemperatureBatch::encode(
+                first as u32,
+                fs,
+                [&t[0][first..end], &t[1][first..end], &t[2][first..end]],
+                &mut f.enc,
+            );
+            f.write_encoded(schema::TOPIC_TEMPERATURE_RAW, log_ns)?;
+            let (a0, a1) = (first.div_ceil(aux_every), end.div_ceil(aux_every));
+            let slice = |name: &str| {
+                let v = aux(segment, name);
+                &v[a0.min(v.len())..a1.min(v.len())]
+            };
+            Vector3Batch::encode(
+                a0 as u32,
+                AUX_RATE_HZ,
+                [slice("accel_x"), slice("accel_y"), slice("accel_z")],
+                &mut f.enc,
+            );
+            f.write_encoded(schema::TOPIC_ACCEL, log_ns)?;
+            ScalarBatch::encode(a0 as u32, AUX_RATE_HZ, slice("supply_voltage"), &mut f.enc);
+            f.write_encoded(schema::TOPIC_SUPPLY, log_ns)?;
+            ScalarBatch::encode(
+                a0 as u32,
+                AUX_RATE_HZ,
+                slice("chamber_set_point"),
+                &mut f.enc,
+            );
+            f.write_encoded(schema::TOPIC_SET_POINT, log_ns)?;
+            first = end;
+        }
+        f.power(
+            &event(segment, false),
+            segment.power_on_ns + n as u64 * period_ns,
+        )?;
+    }
+    f.finish()
+}

@@ -1,0 +1,70 @@
+//! Ground truth, for evaluation code only: never for fitting or diagnosis.
+//!
+//! The truth of a recording `recordings/X.mcap` is `truth/X.truth.mcap` (per-sample noise-free
+//! bias, node temperatures, bias instability) plus `truth/units.json` and
+//! `truth/campaign.json`. [`crate::read::read_recording`] refuses all of them; this module
+//! is the only door, and its name says what it is.
+
+use crate::error::ReadError;
+use crate::record::schema::{self, Vector3Batch};
+use std::path::Path;
+
+/// Per-activation truth series (per-sample systematic bias, °/s, X/Y/Z).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TruthSegment {
+    /// Noise-free bias per sample, including the turn-on jitter (°/s).
+    pub systematic_bias_dps: [Vec<f32>; 3],
+    /// Element temperatures at 100 Hz (°C).
+    pub element_celsius: [Vec<f32>; 3],
+    /// ASIC (temperature-sensor site) true temperatures at 100 Hz (°C).
+    pub asic_celsius: [Vec<f32>; 3],
+}
+
+/// Reads a `.truth.mcap` sidecar into per-activation series (in recording order).
+pub fn read_truth(path: &Path) -> Result<Vec<TruthSegment>, ReadError> {
+    let buf = std::fs::read(path).map_err(|e| ReadError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    let mcap_err = |e| ReadError::Mcap {
+        path: path.to_path_buf(),
+        source: e,
+    };
+    let mut out: Vec<TruthSegment> = Vec::new();
+    let mut counts = std::collections::HashMap::<String, usize>::new();
+    for message in mcap::MessageStream::new(&buf).map_err(mcap_err)? {
+        let message = message.map_err(mcap_err)?;
+        let topic = message.channel.topic.as_str();
+        let index = *counts
+            .entry(topic.to_owned())
+            .and_modify(|c| *c += 1)
+            .or_insert(0);
+        let bad = |reason: String| ReadError::Message {
+            path: path.to_path_buf(),
+            topic: topic.to_owned(),
+            index,
+            reason,
+        };
+        match topic {
+            schema::TOPIC_POWER => {
+                let event = schema::PowerEvent::decode(&message.data).map_err(bad)?;
+                if event.powered {
+                    out.push(TruthSegment::default());
+                }
+            }
+            schema::TOPIC_TRUTH_BIAS | schema::TOPIC_TRUTH_ELEMENT | schema::TOPIC_TRUTH_ASIC => {
+                let seg = out
+                    .last_mut()
+                    .ok_or_else(|| bad("truth before the first switch-on".into()))?;
+                let target = match topic {
+                    schema::TOPIC_TRUTH_BIAS => &mut seg.systematic_bias_dps,
+                    schema::TOPIC_TRUTH_ELEMENT => &mut seg.element_celsius,
+                    _ => &mut seg.asic_celsius,
+                };
+                Vector3Batch::decode_into(&message.data, target).map_err(bad)?;
+            }
+            _ => {}
+        }
+    }
+    Ok(out)
+}
