@@ -2,9 +2,9 @@
 //! row access that borrows the caller's memory (no copy of the array, whatever its layout).
 
 use numpy::ndarray::{ArrayView1, ArrayView2, Axis, Slice};
-use numpy::PyUntypedArrayMethods;
 use numpy::{
-    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArray,
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray2,
+    PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 
@@ -134,6 +134,14 @@ impl RowsView<'_> {
         self.shape().first().copied().unwrap_or(0)
     }
 
+    /// The rows as one flat slice, when they are float32 and C-contiguous (the fast path).
+    pub fn as_f32_slice(&self) -> Option<&[f32]> {
+        match self {
+            Self::F32(view) => view.as_slice(),
+            Self::F64(_) => None,
+        }
+    }
+
     /// Copies rows `start..` as f32 into `out`, as many as `out` yields.
     pub fn copy_rows<'o>(&self, start: usize, out: impl Iterator<Item = &'o mut [f32; 3]>) {
         match self {
@@ -196,5 +204,83 @@ pub fn copy_times<'o>(
         for (d, s) in out.zip(rest.iter()) {
             *d = *s;
         }
+    }
+}
+
+/// `correct_batch`'s outputs: corrected (n, 3) float32, bias (n, 3) float32, flags (n, 3) uint16.
+pub type BatchArrays<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<u16>>,
+);
+
+/// The caller's output arrays for `correct_batch(..., out=(corrected, bias, flags))`: C-contiguous,
+/// writeable, `(n, 3)` float32, float32 and uint16, none of them an input or each other.
+pub struct OutArrays<'py> {
+    /// The arrays, to hand back to the caller.
+    pub arrays: BatchArrays<'py>,
+    /// Exclusive borrows of them (rust-numpy refuses overlap with the inputs' borrows).
+    pub corrected: PyReadwriteArray2<'py, f32>,
+    /// See `corrected`.
+    pub bias: PyReadwriteArray2<'py, f32>,
+    /// See `corrected`.
+    pub flags: PyReadwriteArray2<'py, u16>,
+}
+
+fn out_array<'py, T: numpy::Element>(
+    name: &str,
+    dtype: &str,
+    value: &Bound<'py, PyAny>,
+    n: usize,
+) -> Result<Bound<'py, PyArray2<T>>, Error> {
+    let wrong = || {
+        Error::Input(format!(
+            "`{name}` must be a writeable C-contiguous {dtype} array of shape ({n}, 3), got {}",
+            describe(value)
+        ))
+    };
+    let array = value.cast::<PyArray2<T>>().map_err(|_| wrong())?;
+    if array.shape() != [n, 3] || !array.is_c_contiguous() {
+        return Err(wrong());
+    }
+    Ok(array.clone())
+}
+
+impl<'py> OutArrays<'py> {
+    /// Checks and borrows `out` for `n` samples.
+    pub fn borrow(out: &Bound<'py, PyAny>, n: usize) -> Result<Self, Error> {
+        let (corrected, bias, flags) = out
+            .extract::<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)>()
+            .map_err(|_| {
+                Error::Input(format!(
+                    "`out` must be a tuple of 3 arrays (corrected_dps, bias_dps, flags), got {}",
+                    describe(out)
+                ))
+            })?;
+        let arrays = (
+            out_array::<f32>("out[0]", "float32", &corrected, n)?,
+            out_array::<f32>("out[1]", "float32", &bias, n)?,
+            out_array::<u16>("out[2]", "uint16", &flags, n)?,
+        );
+        let exclusive = |name: &str, error: numpy::BorrowError| {
+            Error::Input(format!(
+                "`{name}` must be writeable and not also an input or another output: {error}"
+            ))
+        };
+        Ok(Self {
+            corrected: arrays
+                .0
+                .try_readwrite()
+                .map_err(|e| exclusive("out[0]", e))?,
+            bias: arrays
+                .1
+                .try_readwrite()
+                .map_err(|e| exclusive("out[1]", e))?,
+            flags: arrays
+                .2
+                .try_readwrite()
+                .map_err(|e| exclusive("out[2]", e))?,
+            arrays,
+        })
     }
 }

@@ -12,7 +12,7 @@ use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 
 use crate::args;
-use crate::arrays::{copy_times, describe, times, Rows, RowsView};
+use crate::arrays::{copy_times, describe, times, BatchArrays, OutArrays, Rows, RowsView};
 use crate::errors::Error;
 use crate::tables::{PyModifiedTables, PyPolynomialTables};
 
@@ -43,31 +43,70 @@ struct Batch<'a> {
     temperatures: RowsView<'a>,
 }
 
-/// The batch's outputs, `n × 3` row-major.
-struct Corrected {
-    corrected_dps: Vec<f32>,
-    bias_dps: Vec<f32>,
-    flags: Vec<u16>,
+/// Where the batch's outputs go: `n × 3` row-major slices (new vectors or the caller's arrays).
+struct Corrected<'a> {
+    corrected_dps: &'a mut [f32],
+    bias_dps: &'a mut [f32],
+    flags: &'a mut [u16],
 }
 
-fn correct_all<M, S>(model: &M, state: &mut CorrectorState<S>, batch: &Batch<'_>) -> Corrected
-where
+fn correct_all<M, S>(
+    model: &M,
+    state: &mut CorrectorState<S>,
+    batch: &Batch<'_>,
+    out: Corrected<'_>,
+) where
     M: Model,
     M::Axis: AxisModel<State = S>,
     S: Copy + Default,
 {
-    let n = batch.times.len();
-    let mut out = Corrected {
-        corrected_dps: vec![0.0; n.saturating_mul(3)],
-        bias_dps: vec![0.0; n.saturating_mul(3)],
-        flags: vec![0; n.saturating_mul(3)],
-    };
-    let mut staged = [Sample::default(); BLOCK];
     let mut outputs = out
         .corrected_dps
         .chunks_exact_mut(3)
         .zip(out.bias_dps.chunks_exact_mut(3))
         .zip(out.flags.chunks_exact_mut(3));
+    let mut store = |output: Output| {
+        if let Some(((corrected, bias), flags)) = outputs.next() {
+            for (dst, src) in corrected.iter_mut().zip(output.corrected_dps) {
+                *dst = src;
+            }
+            for (dst, src) in bias.iter_mut().zip(output.bias_dps) {
+                *dst = src;
+            }
+            for (dst, src) in flags.iter_mut().zip(output.flags) {
+                *dst = src.0;
+            }
+        }
+    };
+    let contiguous = (
+        batch.times.as_slice(),
+        batch.rates.as_f32_slice(),
+        batch.temperatures.as_f32_slice(),
+    );
+    if let (Some(times), Some(rates), Some(temperatures)) = contiguous {
+        // The usual case, float32 C-contiguous inputs: samples straight from the caller's buffers.
+        let rows = times
+            .iter()
+            .zip(rates.chunks_exact(3))
+            .zip(temperatures.chunks_exact(3));
+        for ((&since_power_on_ms, rate), temperature) in rows {
+            let mut sample = Sample {
+                since_power_on_ms,
+                ..Sample::default()
+            };
+            for (dst, src) in sample.rate_dps.iter_mut().zip(rate) {
+                *dst = *src;
+            }
+            for (dst, src) in sample.temperature_raw.iter_mut().zip(temperature) {
+                *dst = *src;
+            }
+            store(state.correct(model, &sample));
+        }
+        return;
+    }
+    // Any other layout or float64: staged through a small buffer, converted per value.
+    let n = batch.times.len();
+    let mut staged = [Sample::default(); BLOCK];
     for start in (0..n).step_by(BLOCK) {
         let count = BLOCK.min(n.saturating_sub(start));
         let block = staged.get_mut(..count).unwrap_or_default();
@@ -82,20 +121,10 @@ where
         batch
             .temperatures
             .copy_rows(start, block.iter_mut().map(|s| &mut s.temperature_raw));
-        for (sample, ((corrected, bias), flags)) in block.iter().zip(&mut outputs) {
-            let output = state.correct(model, sample);
-            for (dst, src) in corrected.iter_mut().zip(output.corrected_dps) {
-                *dst = src;
-            }
-            for (dst, src) in bias.iter_mut().zip(output.bias_dps) {
-                *dst = src;
-            }
-            for (dst, src) in flags.iter_mut().zip(output.flags) {
-                *dst = src.0;
-            }
+        for sample in block.iter() {
+            store(state.correct(model, sample));
         }
     }
-    out
 }
 
 impl Engine {
@@ -120,10 +149,10 @@ impl Engine {
         }
     }
 
-    fn correct_all(&mut self, batch: &Batch<'_>) -> Corrected {
+    fn correct_all(&mut self, batch: &Batch<'_>, out: Corrected<'_>) {
         match self {
-            Self::Modified(model, state) => correct_all(&**model, state, batch),
-            Self::Polynomial(model, state) => correct_all(&**model, state, batch),
+            Self::Modified(model, state) => correct_all(&**model, state, batch, out),
+            Self::Polynomial(model, state) => correct_all(&**model, state, batch, out),
         }
     }
 
@@ -185,13 +214,10 @@ pub struct PyCorrector {
     engine: Engine,
 }
 
-/// The arrays `correct_batch` returns: corrected (n, 3) float32, bias (n, 3) float32, flags (n, 3)
-/// uint16.
-type BatchResult<'py> = (
-    Bound<'py, PyArray2<f32>>,
-    Bound<'py, PyArray2<f32>>,
-    Bound<'py, PyArray2<u16>>,
-);
+/// `OutArrays` checked contiguity already; this names the argument should that ever change.
+fn not_contiguous(error: numpy::AsSliceError) -> Error {
+    Error::Input(format!("`out` arrays must be C-contiguous: {error}"))
+}
 
 fn to_array<'py, T: numpy::Element>(
     py: Python<'py>,
@@ -290,14 +316,16 @@ impl PyCorrector {
     }
 
     /// Corrects n samples in order, continuing the current activation; the GIL is released while
-    /// the samples are corrected.
+    /// the samples are corrected. With `out`, writes into the caller's arrays and returns them.
+    #[pyo3(signature = (since_power_on_ms, rate_dps, temperature_raw, *, out = None))]
     fn correct_batch<'py>(
         &mut self,
         py: Python<'py>,
         since_power_on_ms: &Bound<'py, PyAny>,
         rate_dps: &Bound<'py, PyAny>,
         temperature_raw: &Bound<'py, PyAny>,
-    ) -> Result<BatchResult<'py>, Error> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> Result<BatchArrays<'py>, Error> {
         let times_array = times("since_power_on_ms", since_power_on_ms)?;
         let rates = Rows::borrow("rate_dps", rate_dps)?;
         let temperatures = Rows::borrow("temperature_raw", temperature_raw)?;
@@ -318,11 +346,37 @@ impl PyCorrector {
             }
         }
         let engine = &mut self.engine;
-        let corrected = py.detach(|| engine.correct_all(&batch));
+        if let Some(out) = out {
+            let OutArrays {
+                arrays,
+                mut corrected,
+                mut bias,
+                mut flags,
+            } = OutArrays::borrow(out, n)?;
+            let slices = Corrected {
+                corrected_dps: corrected.as_slice_mut().map_err(not_contiguous)?,
+                bias_dps: bias.as_slice_mut().map_err(not_contiguous)?,
+                flags: flags.as_slice_mut().map_err(not_contiguous)?,
+            };
+            py.detach(|| engine.correct_all(&batch, slices));
+            return Ok(arrays);
+        }
+        let len = n.saturating_mul(3);
+        let (mut corrected, mut bias, mut flags) = (vec![0.0; len], vec![0.0; len], vec![0; len]);
+        py.detach(|| {
+            engine.correct_all(
+                &batch,
+                Corrected {
+                    corrected_dps: &mut corrected,
+                    bias_dps: &mut bias,
+                    flags: &mut flags,
+                },
+            );
+        });
         Ok((
-            to_array(py, corrected.corrected_dps, n)?,
-            to_array(py, corrected.bias_dps, n)?,
-            to_array(py, corrected.flags, n)?,
+            to_array(py, corrected, n)?,
+            to_array(py, bias, n)?,
+            to_array(py, flags, n)?,
         ))
     }
 

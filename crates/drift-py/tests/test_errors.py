@@ -128,6 +128,46 @@ def test_a_rejected_batch_leaves_the_state_alone(modified: ModifiedTables) -> No
         np.testing.assert_array_equal(want, got)
 
 
+def out_arrays(n: int = N) -> list[np.ndarray]:
+    return [np.zeros((n, 3), np.float32), np.zeros((n, 3), np.float32), np.zeros((n, 3), np.uint16)]
+
+
+@pytest.mark.parametrize(
+    ("index", "bad", "message"),
+    [
+        (0, np.zeros((N, 3), np.float64),
+         "`out[0]` must be a writeable C-contiguous float32 array of shape (5, 3), got float64 array of shape (5, 3)"),
+        (1, np.zeros((N + 1, 3), np.float32),
+         "`out[1]` must be a writeable C-contiguous float32 array of shape (5, 3), got float32 array of shape (6, 3)"),
+        (2, np.zeros((N, 3), np.uint32),
+         "`out[2]` must be a writeable C-contiguous uint16 array of shape (5, 3), got uint32 array of shape (5, 3)"),
+        (0, np.zeros((3, N), np.float32).T,
+         "`out[0]` must be a writeable C-contiguous float32 array of shape (5, 3), got float32 array of shape (5, 3)"),
+    ],
+)
+def test_batch_rejects_bad_out_arrays(corrector: gyrodrift.Corrector, index: int, bad: np.ndarray, message: str) -> None:
+    out = out_arrays()
+    out[index] = bad
+    with pytest.raises(InputError, match=re.escape(message)):
+        corrector.correct_batch(*inputs(), out=tuple(out))
+
+
+def test_batch_rejects_read_only_aliased_or_missing_out(corrector: gyrodrift.Corrector) -> None:
+    times, rate, temperature = inputs()
+    read_only = out_arrays()
+    read_only[1].flags.writeable = False
+    with pytest.raises(InputError, match=re.escape("`out[1]` must be writeable and not also an input")):
+        corrector.correct_batch(times, rate, temperature, out=tuple(read_only))
+    aliased = out_arrays()
+    with pytest.raises(InputError, match=re.escape("`out[0]` must be writeable and not also an input")):
+        corrector.correct_batch(times, aliased[0], temperature, out=tuple(aliased))
+    twice = out_arrays()
+    with pytest.raises(InputError, match=re.escape("`out[1]` must be writeable and not also an input")):
+        corrector.correct_batch(times, rate, temperature, out=(twice[0], twice[0], twice[2]))
+    with pytest.raises(InputError, match=re.escape("`out` must be a tuple of 3 arrays (corrected_dps, bias_dps, flags), got list")):
+        corrector.correct_batch(times, rate, temperature, out=out_arrays()[:2])  # type: ignore[arg-type]
+
+
 # --- NaN is data -----------------------------------------------------------------------------
 
 

@@ -104,3 +104,14 @@ def test_outputs_are_fresh_writeable_c_contiguous_arrays(cases: list[Case], mode
     corrected[:] = 0  # the caller owns them: writing does not disturb the corrector
     again = powered_corrector(models[case.model], case).correct_batch(case.times, case.rate, case.temperature)
     assert same_bits(case.corrected, again[0]).all()
+
+
+def test_out_arrays_receive_the_same_results(cases: list[Case], models: dict[str, Model]) -> None:
+    """`out=` writes into the caller's arrays (reusable buffers) and returns those same arrays."""
+    for case in cases:
+        n = len(case.times)
+        out = (np.full((n, 3), 7, np.float32), np.full((n, 3), 7, np.float32), np.full((n, 3), 7, np.uint16))
+        corrector = powered_corrector(models[case.model], case)
+        returned = corrector.correct_batch(case.times, case.rate, case.temperature, out=out)
+        assert all(r is o for r, o in zip(returned, out))
+        check_batch(case, *out)

@@ -227,12 +227,16 @@ class Corrector:
         since_power_on_ms: NDArray[np.uint32],
         rate_dps: NDArray[np.float32] | NDArray[np.float64],
         temperature_raw: NDArray[np.float32] | NDArray[np.float64],
+        *,
+        out: tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.uint16]] | None = None,
     ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.uint16]]:
         """Corrects n samples in order, continuing the current activation.
 
         Arguments: `since_power_on_ms` uint32 (n,); `rate_dps` and `temperature_raw` float32 or
         float64 (n, 3), any strides (read in place, not copied; float64 is rounded to f32 per
-        value). Returns `(corrected_dps, bias_dps, flags)`: new float32, float32 and uint16 arrays
-        of shape (n, 3). The GIL is released while correcting. Raises `InputError` for a wrong
-        dtype or shape, an empty array, or lengths that differ.
+        value). Returns `(corrected_dps, bias_dps, flags)`: float32, float32 and uint16 arrays of
+        shape (n, 3) — new arrays, or the arrays given as `out` (C-contiguous, writeable, none of
+        them an input), filled in place, which saves allocating for every block. The GIL is
+        released while correcting. Raises `InputError` for a wrong dtype or shape, an empty
+        array, or lengths that differ.
         """
