@@ -35,9 +35,12 @@ def stream(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     rate = np.empty((n, 3), dtype=np.float32)
     temperature = np.empty((n, 3), dtype=np.float32)
     for a in range(3):
-        rate[:, a] = (((i * np.uint32(7) + np.uint32(a * 13)) % np.uint32(2001)).astype(np.float32)
-                      - np.float32(1000.0)) * np.float32(0.001)
-        temperature[:, a] = np.float32(6600.0) + ((i // np.uint32(50 + 10 * a)) % np.uint32(800)).astype(np.float32)
+        rate[:, a] = (
+            ((i * np.uint32(7) + np.uint32(a * 13)) % np.uint32(2001)).astype(np.float32) - np.float32(1000.0)
+        ) * np.float32(0.001)
+        temperature[:, a] = np.float32(6600.0) + ((i // np.uint32(50 + 10 * a)) % np.uint32(800)).astype(
+            np.float32
+        )
     return times, rate, temperature
 
 
@@ -48,8 +51,18 @@ def checksum(corrected: np.ndarray, bias: np.ndarray, flags: np.ndarray) -> int:
 
 def rust(samples: int, repeats: int) -> dict[str, tuple[float, float, int]]:
     """samples/s (reused outputs, fresh outputs) and checksum per model from the pure-Rust example."""
-    command = ["cargo", "run", "--quiet", "--release", "--locked", "--example", "correct_throughput",
-               "--", str(samples), str(repeats)]
+    command = [
+        "cargo",
+        "run",
+        "--quiet",
+        "--release",
+        "--locked",
+        "--example",
+        "correct_throughput",
+        "--",
+        str(samples),
+        str(repeats),
+    ]
     out = subprocess.run(command, cwd=ROOT, check=True, capture_output=True, text=True).stdout
     result = {}
     for line in out.splitlines():
@@ -59,7 +72,10 @@ def rust(samples: int, repeats: int) -> dict[str, tuple[float, float, int]]:
 
 
 def binding(
-    model: gyrodrift.ModifiedTables | gyrodrift.PolynomialTables, inputs: tuple, repeats: int, reuse: bool
+    model: gyrodrift.ModifiedTables | gyrodrift.PolynomialTables,
+    inputs: tuple[np.ndarray, np.ndarray, np.ndarray],
+    repeats: int,
+    reuse: bool,
 ) -> tuple[float, int]:
     """Best samples/s of correct_batch over `repeats`, and the outputs' checksum. With `reuse`, the
     outputs go into the same preallocated arrays every time (`out=`), as the Rust reference does."""
@@ -86,21 +102,31 @@ def main() -> int:
 
     vectors = json.loads((ROOT / "testdata" / "vectors.json").read_text())
     models = {
-        m["name"]: (gyrodrift.ModifiedTables if m["kind"] == "modified" else gyrodrift.PolynomialTables)
-        .from_image(bytes.fromhex(m["image_hex"]))
+        m["name"]: (
+            gyrodrift.ModifiedTables if m["kind"] == "modified" else gyrodrift.PolynomialTables
+        ).from_image(bytes.fromhex(m["image_hex"]))
         for m in vectors["models"]
     }
-    print(f"gyrodrift {gyrodrift.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}, "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
+    print(
+        f"gyrodrift {gyrodrift.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}, "
+        f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}"
+    )
     print(f"{args.samples:,} samples, best of {args.repeats}")
     reference = rust(args.samples, args.repeats)
     inputs32 = stream(args.samples)
     inputs64 = (inputs32[0], inputs32[1].astype(np.float64), inputs32[2].astype(np.float64))
 
-    variants = [("f32, new arrays", inputs32, False), ("f32, out=", inputs32, True),
-                ("f64, new arrays", inputs64, False), ("f64, out=", inputs64, True)]
+    variants = [
+        ("f32, new arrays", inputs32, False),
+        ("f32, out=", inputs32, True),
+        ("f64, new arrays", inputs64, False),
+        ("f64, out=", inputs64, True),
+    ]
     print("Msamples/s (ratio to pure Rust into a reused buffer)")
-    print(f"{'model':<12} {'pure Rust':>10} {'Rust, fresh':>12}" + "".join(f" {label:>20}" for label, _, _ in variants))
+    print(
+        f"{'model':<12} {'pure Rust':>10} {'Rust, fresh':>12}"
+        + "".join(f" {label:>20}" for label, _, _ in variants)
+    )
     failed = False
     for name, model in models.items():
         rust_rate, rust_fresh, rust_check = reference[name]
@@ -112,8 +138,11 @@ def main() -> int:
             if reuse and inputs is inputs32 and rate / rust_rate < FLOOR:
                 print(f"{name}: below the floor, the binding must reach {FLOOR:.0%} of pure Rust")
                 failed = True
-        print(f"{name:<12} {rust_rate / 1e6:>10.1f} {rust_fresh / 1e6:>12.1f}" + "".join(f" {c:>20}" for c in cells)
-              + ("  same outputs" if same else "  CHECKSUM DIFFERS"))
+        print(
+            f"{name:<12} {rust_rate / 1e6:>10.1f} {rust_fresh / 1e6:>12.1f}"
+            + "".join(f" {c:>20}" for c in cells)
+            + ("  same outputs" if same else "  CHECKSUM DIFFERS")
+        )
         failed |= not same
     return 1 if failed else 0
 

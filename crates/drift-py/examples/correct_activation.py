@@ -39,13 +39,15 @@ def unit_like(model: gyrodrift.ModifiedTables) -> tuple[np.ndarray, np.ndarray]:
     AMBIENT_CELSIUS (°/s), and k (°/s/°C) at the first and last point of a middle 30 °C curve."""
     axes = json.loads(model.to_json())["axes"]
     initial = [
-        np.interp(AMBIENT_CELSIUS, [a["ambient_celsius"] for a in axis["ambients"]],
-                  [a["initial_bias_dps"] for a in axis["ambients"]])
+        np.interp(
+            AMBIENT_CELSIUS,
+            [a["ambient_celsius"] for a in axis["ambients"]],
+            [a["initial_bias_dps"] for a in axis["ambients"]],
+        )
         for axis in axes
     ]
     k = [
-        [axis["ambients"][1]["curves"][8]["points"][j]["k_dps_per_celsius"] for j in (0, -1)]
-        for axis in axes
+        [axis["ambients"][1]["curves"][8]["points"][j]["k_dps_per_celsius"] for j in (0, -1)] for axis in axes
     ]
     return np.array(initial), np.array(k).T
 
@@ -81,15 +83,18 @@ def main() -> int:
     assert isinstance(modified, gyrodrift.ModifiedTables)
     times, rate, temperature, true_bias = synthetic_activation(*unit_like(modified))
     drift = true_bias - true_bias[0]
-    print(f"gyrodrift {gyrodrift.__version__}: {len(times)} samples, {SECONDS} s at {RATE_HZ} Hz, "
-          f"switch-on at {AMBIENT_CELSIUS} °C, unit at rest")
+    print(
+        f"gyrodrift {gyrodrift.__version__}: {len(times)} samples, {SECONDS} s at {RATE_HZ} Hz, "
+        f"switch-on at {AMBIENT_CELSIUS} °C, unit at rest"
+    )
     print(f"drift since switch-on (true): up to {np.abs(drift).max():.4f} °/s")
     print("zero error = |mean output| of the unit at rest, averaged over the axes, °/s")
     print()
     header = f"{'model':<12} {'first 1 s':>10} {'last 10 s':>10}  flags seen"
     print(header)
     print("-" * len(header))
-    print(f"{'uncorrected':<12} {zero_error(rate, 0, 1):>10.5f} {zero_error(rate, SECONDS - 10, SECONDS):>10.5f}")
+    first, last = zero_error(rate, 0, 1), zero_error(rate, SECONDS - 10, SECONDS)
+    print(f"{'uncorrected':<12} {first:>10.5f} {last:>10.5f}")
     for name, model in models.items():
         corrector = gyrodrift.Corrector(model)
         corrector.power_on(temperature[0])

@@ -57,8 +57,7 @@ def vectors() -> dict[str, Any]:
 def models(vectors: dict[str, Any]) -> dict[str, Model]:
     """The vector models, loaded from their firmware images (the canonical form)."""
     return {
-        m["name"]: model_class(m["kind"]).from_image(bytes.fromhex(m["image_hex"]))
-        for m in vectors["models"]
+        m["name"]: model_class(m["kind"]).from_image(bytes.fromhex(m["image_hex"])) for m in vectors["models"]
     }
 
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import threading
 
 import numpy as np
-from conftest import Model
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import gyrodrift
+from conftest import Model
 
 finite_or_not = st.floats(width=32, allow_nan=True, allow_infinity=True)
 
@@ -63,7 +63,9 @@ def test_batch_equals_per_sample(models: dict[str, Model], stream: tuple, model_
 
 @settings(max_examples=40, deadline=None)
 @given(stream=streams(), cuts=st.lists(st.integers(0, 1500), max_size=5))
-def test_any_split_gives_the_same_result(modified: gyrodrift.ModifiedTables, stream: tuple, cuts: list[int]) -> None:
+def test_any_split_gives_the_same_result(
+    modified: gyrodrift.ModifiedTables, stream: tuple, cuts: list[int]
+) -> None:
     times, rate, temperature = stream
     n = len(times)
     bounds = sorted({0, n, *(c for c in cuts if c < n)})
@@ -71,7 +73,9 @@ def test_any_split_gives_the_same_result(modified: gyrodrift.ModifiedTables, str
     whole.power_on([6000.0] * 3)
     parts.power_on([6000.0] * 3)
     expected = whole.correct_batch(times, rate, temperature)
-    pieces = [parts.correct_batch(times[a:b], rate[a:b], temperature[a:b]) for a, b in zip(bounds, bounds[1:])]
+    pieces = [
+        parts.correct_batch(times[a:b], rate[a:b], temperature[a:b]) for a, b in zip(bounds, bounds[1:])
+    ]
     assert_same(expected, tuple(np.concatenate(p) for p in zip(*pieces)))
 
 

@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import Model
 
 import gyrodrift
+from conftest import Model
 from gyrodrift import (
     FileError,
     Flags,
@@ -63,30 +63,62 @@ def test_hierarchy() -> None:
 @pytest.mark.parametrize(
     ("argument", "bad", "message"),
     [
-        ("rate_dps", np.zeros((N, 3), dtype=np.int64),
-         "`rate_dps` must be a float32 or float64 array of shape (n, 3), got int64 array of shape (5, 3)"),
-        ("rate_dps", np.zeros((N, 2), dtype=np.float32),
-         "`rate_dps` must be a float32 or float64 array of shape (n, 3), got float32 array of shape (5, 2)"),
-        ("rate_dps", np.zeros(N * 3, dtype=np.float32),
-         "`rate_dps` must be a float32 or float64 array of shape (n, 3), got float32 array of shape (15,)"),
-        ("rate_dps", np.zeros((N, 3), dtype=np.float16),
-         "`rate_dps` must be a float32 or float64 array of shape (n, 3), got float16 array of shape (5, 3)"),
-        ("rate_dps", np.zeros((N, 3), dtype=">f4"),
-         "`rate_dps` must be a float32 or float64 array of shape (n, 3), got >f4 array of shape (5, 3)"),
-        ("rate_dps", [[0.0, 0.0, 0.0]] * N,
-         "`rate_dps` must be a float32 or float64 array of shape (n, 3), got list"),
-        ("temperature_raw", np.zeros((N, 3, 1), dtype=np.float32),
-         "`temperature_raw` must be a float32 or float64 array of shape (n, 3), got float32 array of shape (5, 3, 1)"),
-        ("temperature_raw", np.zeros((N, 3), dtype=np.complex64),
-         "`temperature_raw` must be a float32 or float64 array of shape (n, 3), got complex64 array of shape (5, 3)"),
-        ("since_power_on_ms", np.arange(N, dtype=np.int64),
-         "`since_power_on_ms` must be a uint32 array of shape (n,), got int64 array of shape (5,) (convert with .astype(np.uint32))"),
-        ("since_power_on_ms", np.arange(N, dtype=np.float64),
-         "`since_power_on_ms` must be a uint32 array of shape (n,), got float64 array of shape (5,)"),
-        ("since_power_on_ms", np.zeros((N, 1), dtype=np.uint32),
-         "`since_power_on_ms` must be a uint32 array of shape (n,), got uint32 array of shape (5, 1)"),
-        ("since_power_on_ms", None,
-         "`since_power_on_ms` must be a uint32 array of shape (n,), got NoneType"),
+        (
+            "rate_dps",
+            np.zeros((N, 3), dtype=np.int64),
+            "`rate_dps` must be a float32 or float64 array of shape (n, 3), got int64 array of shape (5, 3)",
+        ),
+        (
+            "rate_dps",
+            np.zeros((N, 2), dtype=np.float32),
+            "`rate_dps` must be a float32 or float64 array of shape (n, 3), got float32 array of shape (5, 2)",
+        ),
+        (
+            "rate_dps",
+            np.zeros(N * 3, dtype=np.float32),
+            "`rate_dps` must be a float32 or float64 array of shape (n, 3), got float32 array of shape (15,)",
+        ),
+        (
+            "rate_dps",
+            np.zeros((N, 3), dtype=np.float16),
+            "`rate_dps` must be a float32 or float64 array of shape (n, 3), got float16 array of shape (5, 3)",
+        ),
+        (
+            "rate_dps",
+            np.zeros((N, 3), dtype=">f4"),
+            "`rate_dps` must be a float32 or float64 array of shape (n, 3), got >f4 array of shape (5, 3)",
+        ),
+        (
+            "rate_dps",
+            [[0.0, 0.0, 0.0]] * N,
+            "`rate_dps` must be a float32 or float64 array of shape (n, 3), got list",
+        ),
+        (
+            "temperature_raw",
+            np.zeros((N, 3, 1), dtype=np.float32),
+            "`temperature_raw` must be a float32 or float64 array of shape (n, 3), got float32 array of shape (5, 3, 1)",
+        ),
+        (
+            "temperature_raw",
+            np.zeros((N, 3), dtype=np.complex64),
+            "`temperature_raw` must be a float32 or float64 array of shape (n, 3), got complex64 array of shape (5, 3)",
+        ),
+        (
+            "since_power_on_ms",
+            np.arange(N, dtype=np.int64),
+            "`since_power_on_ms` must be a uint32 array of shape (n,), got int64 array of shape (5,) (convert with .astype(np.uint32))",
+        ),
+        (
+            "since_power_on_ms",
+            np.arange(N, dtype=np.float64),
+            "`since_power_on_ms` must be a uint32 array of shape (n,), got float64 array of shape (5,)",
+        ),
+        (
+            "since_power_on_ms",
+            np.zeros((N, 1), dtype=np.uint32),
+            "`since_power_on_ms` must be a uint32 array of shape (n,), got uint32 array of shape (5, 1)",
+        ),
+        ("since_power_on_ms", None, "`since_power_on_ms` must be a uint32 array of shape (n,), got NoneType"),
     ],
 )
 def test_batch_rejects_wrong_dtype_and_shape(
@@ -135,17 +167,31 @@ def out_arrays(n: int = N) -> list[np.ndarray]:
 @pytest.mark.parametrize(
     ("index", "bad", "message"),
     [
-        (0, np.zeros((N, 3), np.float64),
-         "`out[0]` must be a writeable C-contiguous float32 array of shape (5, 3), got float64 array of shape (5, 3)"),
-        (1, np.zeros((N + 1, 3), np.float32),
-         "`out[1]` must be a writeable C-contiguous float32 array of shape (5, 3), got float32 array of shape (6, 3)"),
-        (2, np.zeros((N, 3), np.uint32),
-         "`out[2]` must be a writeable C-contiguous uint16 array of shape (5, 3), got uint32 array of shape (5, 3)"),
-        (0, np.zeros((3, N), np.float32).T,
-         "`out[0]` must be a writeable C-contiguous float32 array of shape (5, 3), got float32 array of shape (5, 3)"),
+        (
+            0,
+            np.zeros((N, 3), np.float64),
+            "`out[0]` must be a writeable C-contiguous float32 array of shape (5, 3), got float64 array of shape (5, 3)",
+        ),
+        (
+            1,
+            np.zeros((N + 1, 3), np.float32),
+            "`out[1]` must be a writeable C-contiguous float32 array of shape (5, 3), got float32 array of shape (6, 3)",
+        ),
+        (
+            2,
+            np.zeros((N, 3), np.uint32),
+            "`out[2]` must be a writeable C-contiguous uint16 array of shape (5, 3), got uint32 array of shape (5, 3)",
+        ),
+        (
+            0,
+            np.zeros((3, N), np.float32).T,
+            "`out[0]` must be a writeable C-contiguous float32 array of shape (5, 3), got float32 array of shape (5, 3)",
+        ),
     ],
 )
-def test_batch_rejects_bad_out_arrays(corrector: gyrodrift.Corrector, index: int, bad: np.ndarray, message: str) -> None:
+def test_batch_rejects_bad_out_arrays(
+    corrector: gyrodrift.Corrector, index: int, bad: np.ndarray, message: str
+) -> None:
     out = out_arrays()
     out[index] = bad
     with pytest.raises(InputError, match=re.escape(message)):
@@ -164,7 +210,10 @@ def test_batch_rejects_read_only_aliased_or_missing_out(corrector: gyrodrift.Cor
     twice = out_arrays()
     with pytest.raises(InputError, match=re.escape("`out[1]` must be writeable and not also an input")):
         corrector.correct_batch(times, rate, temperature, out=(twice[0], twice[0], twice[2]))
-    with pytest.raises(InputError, match=re.escape("`out` must be a tuple of 3 arrays (corrected_dps, bias_dps, flags), got list")):
+    with pytest.raises(
+        InputError,
+        match=re.escape("`out` must be a tuple of 3 arrays (corrected_dps, bias_dps, flags), got list"),
+    ):
         corrector.correct_batch(times, rate, temperature, out=out_arrays()[:2])  # type: ignore[arg-type]
 
 
@@ -191,12 +240,24 @@ def test_nan_inputs_are_flagged_not_raised(corrector: gyrodrift.Corrector) -> No
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        ((-1, [0.0] * 3, [6000.0] * 3), "`since_power_on_ms` must be an integer in 0..=4294967295 (ms), got -1"),
-        ((2**32, [0.0] * 3, [6000.0] * 3), "`since_power_on_ms` must be an integer in 0..=4294967295 (ms), got 4294967296"),
-        ((1.5, [0.0] * 3, [6000.0] * 3), "`since_power_on_ms` must be an integer in 0..=4294967295 (ms), got 1.5"),
+        (
+            (-1, [0.0] * 3, [6000.0] * 3),
+            "`since_power_on_ms` must be an integer in 0..=4294967295 (ms), got -1",
+        ),
+        (
+            (2**32, [0.0] * 3, [6000.0] * 3),
+            "`since_power_on_ms` must be an integer in 0..=4294967295 (ms), got 4294967296",
+        ),
+        (
+            (1.5, [0.0] * 3, [6000.0] * 3),
+            "`since_power_on_ms` must be an integer in 0..=4294967295 (ms), got 1.5",
+        ),
         ((1, [0.0] * 2, [6000.0] * 3), "`rate_dps` must be a sequence of 3 floats (X, Y, Z), got list"),
         ((1, [0.0] * 3, "abc"), "`temperature_raw` must be a sequence of 3 floats (X, Y, Z), got str"),
-        ((1, [0.0] * 3, np.zeros(4)), "`temperature_raw` must be a sequence of 3 floats (X, Y, Z), got float64 array of shape (4,)"),
+        (
+            (1, [0.0] * 3, np.zeros(4)),
+            "`temperature_raw` must be a sequence of 3 floats (X, Y, Z), got float64 array of shape (4,)",
+        ),
     ],
 )
 def test_correct_rejects_bad_arguments(corrector: gyrodrift.Corrector, args: tuple, message: str) -> None:
@@ -206,7 +267,9 @@ def test_correct_rejects_bad_arguments(corrector: gyrodrift.Corrector, args: tup
 
 def test_power_on_rejects_non_finite_and_keeps_the_state(modified: ModifiedTables) -> None:
     corrector = gyrodrift.Corrector(modified)
-    with pytest.raises(InputError, match=r"`switch_on_raw` must be finite on every axis.*axes\[1\]\.switch_on_raw"):
+    with pytest.raises(
+        InputError, match=r"`switch_on_raw` must be finite on every axis.*axes\[1\]\.switch_on_raw"
+    ):
         corrector.power_on([6000.0, float("nan"), 6000.0])
     assert not corrector.is_powered_on
     corrector.power_on([6000.0, 6100.0, 6200.0])
@@ -216,7 +279,9 @@ def test_power_on_rejects_non_finite_and_keeps_the_state(modified: ModifiedTable
 
 
 def test_power_on_rejects_wrong_length(modified: ModifiedTables) -> None:
-    with pytest.raises(InputError, match=re.escape("`switch_on_raw` must be a sequence of 3 floats (X, Y, Z), got tuple")):
+    with pytest.raises(
+        InputError, match=re.escape("`switch_on_raw` must be a sequence of 3 floats (X, Y, Z), got tuple")
+    ):
         gyrodrift.Corrector(modified).power_on((6000.0, 6000.0))
 
 
@@ -235,7 +300,9 @@ def test_bad_json_syntax(modified: ModifiedTables) -> None:
 
 
 def test_json_of_another_model_type(models: dict[str, Model]) -> None:
-    with pytest.raises(TableError, match=r"not a valid ModifiedTables JSON: missing field `reference_ms` at line"):
+    with pytest.raises(
+        TableError, match=r"not a valid ModifiedTables JSON: missing field `reference_ms` at line"
+    ):
         ModifiedTables.from_json(models["standard"].to_json())
 
 
@@ -286,16 +353,34 @@ def image(modified: ModifiedTables) -> bytes:
         (lambda b: b[:-1], "table image truncated: needs {n} bytes, got {m}"),
         (lambda b: b"JUNK" + b[4:], "not a gyrodrift table image: magic is [4a, 55, 4e, 4b]"),
         (lambda b: b'{"axes": []}', "not a gyrodrift table image: magic is [7b, 22, 61, 78]"),
-        (lambda b: b[:4] + b"\x02\x00" + b[6:], "table image format version 2 is not supported (this build reads 1)"),
+        (
+            lambda b: b[:4] + b"\x02\x00" + b[6:],
+            "table image format version 2 is not supported (this build reads 1)",
+        ),
         (lambda b: b[:6] + b"\x02" + b[7:], "table image holds model kind 2, expected 1"),
         (lambda b: b + b"\x00\x00", "2 unexpected bytes after the table image's CRC"),
         (lambda b: b[:20] + bytes([b[20] ^ 1]) + b[21:], "table image CRC mismatch"),
-        (lambda b: with_crc(b[:8] + struct.pack("<I", 3) + b"\xff\xff\xff"), "table image payload is malformed"),
-        (lambda b: with_crc(b[:12] + struct.pack("<f", -1.0) + b[16:-4]),
-         "table image contents are invalid: raw_per_celsius: must be greater than zero"),
+        (
+            lambda b: with_crc(b[:8] + struct.pack("<I", 3) + b"\xff\xff\xff"),
+            "table image payload is malformed",
+        ),
+        (
+            lambda b: with_crc(b[:12] + struct.pack("<f", -1.0) + b[16:-4]),
+            "table image contents are invalid: raw_per_celsius: must be greater than zero",
+        ),
     ],
-    ids=["truncated-header", "truncated-body", "bad-magic", "not-an-image", "version", "wrong-kind",
-         "trailing-bytes", "crc-mismatch", "malformed-payload", "invalid-contents"],
+    ids=[
+        "truncated-header",
+        "truncated-body",
+        "bad-magic",
+        "not-an-image",
+        "version",
+        "wrong-kind",
+        "trailing-bytes",
+        "crc-mismatch",
+        "malformed-payload",
+        "invalid-contents",
+    ],
 )
 def test_each_image_error(image: bytes, corrupt: Any, message: str) -> None:
     bad = corrupt(image)
@@ -360,8 +445,16 @@ def test_path_must_be_a_path(modified: ModifiedTables) -> None:
         ({"raw_per_celsius": float("nan")}, TableError, "raw_per_celsius: value is NaN or infinite"),
         ({"rise_margin_celsius": -0.1}, TableError, "rise_margin_celsius: must be greater than zero"),
         ({"raw_at_zero_celsius": "zero"}, InputError, "`raw_at_zero_celsius` must be a float, got str"),
-        ({"stuck_after_samples": 70000}, InputError, "`stuck_after_samples` must be an integer in 0..=65535, got 70000"),
-        ({"stuck_after_samples": -1}, InputError, "`stuck_after_samples` must be an integer in 0..=65535, got -1"),
+        (
+            {"stuck_after_samples": 70000},
+            InputError,
+            "`stuck_after_samples` must be an integer in 0..=65535, got 70000",
+        ),
+        (
+            {"stuck_after_samples": -1},
+            InputError,
+            "`stuck_after_samples` must be an integer in 0..=65535, got -1",
+        ),
     ],
 )
 def test_settings_validation(kwargs: dict[str, Any], error: type[Exception], message: str) -> None:

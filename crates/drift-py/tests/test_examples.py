@@ -29,7 +29,9 @@ def test_example_runs(script: Path) -> None:
 def test_correct_activation_reports_each_model() -> None:
     script = next(p for p in EXAMPLES if p.name == "correct_activation.py")
     out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, check=True).stdout
-    rows = {line.split()[0]: line.split()[1:3] for line in out.splitlines() if line[:1].isalpha() and "  " in line}
+    rows = {
+        line.split()[0]: line.split()[1:3] for line in out.splitlines() if line[:1].isalpha() and "  " in line
+    }
     for name in ("uncorrected", "modified", "standard", "third_order"):
         assert name in rows, out
     # The drift-aware model leaves less error than no correction at the end of the warm-up.

@@ -8,8 +8,15 @@ from gyrodrift import Flags, _gyrodrift
 
 def test_every_native_constant_is_a_flag_member() -> None:
     names = [
-        "AMBIENT_OUT_OF_RANGE", "RISE_OUT_OF_SPAN", "PAST_LAST_REFERENCE", "TEMPERATURE_OUT_OF_RANGE",
-        "TEMPERATURE_INVALID", "TEMPERATURE_STUCK", "RATE_INVALID", "NOT_POWERED_ON", "MODEL_INVALID",
+        "AMBIENT_OUT_OF_RANGE",
+        "RISE_OUT_OF_SPAN",
+        "PAST_LAST_REFERENCE",
+        "TEMPERATURE_OUT_OF_RANGE",
+        "TEMPERATURE_INVALID",
+        "TEMPERATURE_STUCK",
+        "RATE_INVALID",
+        "NOT_POWERED_ON",
+        "MODEL_INVALID",
     ]
     assert [m.name for m in Flags] == names
     for name in names:
@@ -20,8 +27,11 @@ def test_every_native_constant_is_a_flag_member() -> None:
 
 def test_faults_mask() -> None:
     assert Flags.faults() == (
-        Flags.TEMPERATURE_INVALID | Flags.TEMPERATURE_STUCK | Flags.RATE_INVALID
-        | Flags.NOT_POWERED_ON | Flags.MODEL_INVALID
+        Flags.TEMPERATURE_INVALID
+        | Flags.TEMPERATURE_STUCK
+        | Flags.RATE_INVALID
+        | Flags.NOT_POWERED_ON
+        | Flags.MODEL_INVALID
     )
     assert Flags.faults().value == _gyrodrift.FAULTS
 

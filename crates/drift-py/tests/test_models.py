@@ -6,9 +6,9 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import Model
 
 import gyrodrift
+from conftest import Model
 from gyrodrift import ModifiedTables, PolynomialTables, Settings
 
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import json
 
 import numpy as np
-from conftest import Model
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import gyrodrift
+from conftest import Model
 from gyrodrift import Flags
 
 f32 = np.float32
@@ -32,7 +32,11 @@ def evaluate(axis: dict, celsius: np.ndarray, margin: np.float32) -> tuple[np.nd
 
 def restated(tables: dict, switch_on_raw: np.ndarray, rate: np.ndarray, temperature: np.ndarray):
     s = tables["settings"]
-    rpc, raw0, margin = f32(s["raw_per_celsius"]), f32(s["raw_at_zero_celsius"]), f32(s["ambient_margin_celsius"])
+    rpc, raw0, margin = (
+        f32(s["raw_per_celsius"]),
+        f32(s["raw_at_zero_celsius"]),
+        f32(s["ambient_margin_celsius"]),
+    )
     corrected, bias, flags = np.empty_like(rate), np.empty_like(rate), np.zeros(rate.shape, np.uint16)
     for a, axis in enumerate(tables["axes"]):
         on, on_outside = evaluate(axis, (switch_on_raw[a : a + 1] - raw0) / rpc, margin)
@@ -49,8 +53,9 @@ def restated(tables: dict, switch_on_raw: np.ndarray, rate: np.ndarray, temperat
 @given(
     name=st.sampled_from(["standard", "third_order"]),
     switch_on=hnp.arrays(np.float32, 3, elements=st.floats(2000, 11000, width=32)),
-    temperature=hnp.arrays(np.float32, st.tuples(st.integers(1, 300), st.just(3)),
-                           elements=st.floats(2000, 11000, width=32)),
+    temperature=hnp.arrays(
+        np.float32, st.tuples(st.integers(1, 300), st.just(3)), elements=st.floats(2000, 11000, width=32)
+    ),
 )
 def test_polynomial_baselines_match_numpy(
     models: dict[str, Model], name: str, switch_on: np.ndarray, temperature: np.ndarray
@@ -58,11 +63,15 @@ def test_polynomial_baselines_match_numpy(
     model = models[name]
     s = model.settings
     # No stuck-sensor detection: the restatement does not keep the repeat counter.
-    model = model.with_settings(gyrodrift.Settings(
-        raw_per_celsius=s.raw_per_celsius, raw_at_zero_celsius=s.raw_at_zero_celsius,
-        ambient_margin_celsius=s.ambient_margin_celsius, rise_margin_celsius=s.rise_margin_celsius,
-        stuck_after_samples=0,
-    ))
+    model = model.with_settings(
+        gyrodrift.Settings(
+            raw_per_celsius=s.raw_per_celsius,
+            raw_at_zero_celsius=s.raw_at_zero_celsius,
+            ambient_margin_celsius=s.ambient_margin_celsius,
+            rise_margin_celsius=s.rise_margin_celsius,
+            stuck_after_samples=0,
+        )
+    )
     n = len(temperature)
     rate = np.linspace(-0.5, 0.5, n * 3, dtype=np.float32).reshape(n, 3)
     corrector = gyrodrift.Corrector(model)
@@ -70,5 +79,7 @@ def test_polynomial_baselines_match_numpy(
     got = corrector.correct_batch(np.arange(n, dtype=np.uint32), rate, temperature)
     want = restated(json.loads(model.to_json()), switch_on, rate, temperature)
     for g, w in zip(got, want):
-        np.testing.assert_array_equal(g.view(np.uint32) if g.dtype == np.float32 else g,
-                                      w.view(np.uint32) if w.dtype == np.float32 else w)
+        np.testing.assert_array_equal(
+            g.view(np.uint32) if g.dtype == np.float32 else g,
+            w.view(np.uint32) if w.dtype == np.float32 else w,
+        )

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import Case, Model, powered_corrector, same_bits
 
+from conftest import Case, Model, powered_corrector, same_bits
 
 
 def check_batch(case: Case, corrected: np.ndarray, bias: np.ndarray, flags: np.ndarray) -> None:

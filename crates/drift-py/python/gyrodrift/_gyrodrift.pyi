@@ -7,39 +7,40 @@ temperature-sensor units (see `Settings`), `_celsius` °C. All arithmetic is f32
 from __future__ import annotations
 
 import os
-from typing import Final, Sequence, Union, final
+from collections.abc import Sequence
+from typing import Final, TypeAlias, final
 
 import numpy as np
 from numpy.typing import NDArray
 
 __version__: Final[str]
 __all__ = [
-    "__version__",
-    "GyrodriftError",
-    "InputError",
-    "TableError",
-    "ImageError",
-    "FileError",
     "AMBIENT_OUT_OF_RANGE",
-    "RISE_OUT_OF_SPAN",
-    "PAST_LAST_REFERENCE",
-    "TEMPERATURE_OUT_OF_RANGE",
-    "TEMPERATURE_INVALID",
-    "TEMPERATURE_STUCK",
-    "RATE_INVALID",
-    "NOT_POWERED_ON",
-    "MODEL_INVALID",
     "FAULTS",
-    "Settings",
-    "ModifiedTables",
-    "PolynomialTables",
+    "MODEL_INVALID",
+    "NOT_POWERED_ON",
+    "PAST_LAST_REFERENCE",
+    "RATE_INVALID",
+    "RISE_OUT_OF_SPAN",
+    "TEMPERATURE_INVALID",
+    "TEMPERATURE_OUT_OF_RANGE",
+    "TEMPERATURE_STUCK",
     "Corrector",
+    "FileError",
+    "GyrodriftError",
+    "ImageError",
+    "InputError",
+    "ModifiedTables",
     "Output",
+    "PolynomialTables",
+    "Settings",
+    "TableError",
+    "__version__",
 ]
 
-_Path = Union[str, os.PathLike[str]]
-_Floats3 = Union[Sequence[float], NDArray[np.floating]]
-_Model = Union[ModifiedTables, PolynomialTables]
+_Path: TypeAlias = str | os.PathLike[str]
+_Floats3: TypeAlias = Sequence[float] | NDArray[np.floating]
+_Model: TypeAlias = ModifiedTables | PolynomialTables
 
 # Status flags (bits of each `flags` output value); `gyrodrift.Flags` is the IntFlag of these.
 AMBIENT_OUT_OF_RANGE: Final[int]
