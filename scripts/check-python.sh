@@ -2,7 +2,8 @@
 # The Python module's checks, from a really clean state: a fresh venv in .venv-check/ (deleted and
 # recreated on every run), `pip install ./crates/drift-py[test]` (a real PEP 517 build through
 # maturin), then pytest, mypy's stubtest, a strict type check of the examples, ruff, and the
-# examples themselves. Prints how long each step took. Called by scripts/check.sh; safe to re-run.
+# examples themselves. Prints how long each step took. Safe to re-run; meant to be called from
+# scripts/check.sh (the single test command).
 #
 # Needs: python3 >= 3.9 (with venv; installed via apt-get if missing), Rust (cargo), and PyPI.
 set -euo pipefail
