@@ -19,8 +19,10 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 import gyrodrift
 
@@ -28,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[3]
 FLOOR = 0.5
 
 
-def stream(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def stream(n: int) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any]]:
     """Mirror of `sample(i)` in examples/correct_throughput.rs (integer formulas, exact in f32)."""
     i = np.arange(n, dtype=np.uint32)
     times = i % np.uint32(150_000)
@@ -44,7 +46,7 @@ def stream(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return times, rate, temperature
 
 
-def checksum(corrected: np.ndarray, bias: np.ndarray, flags: np.ndarray) -> int:
+def checksum(corrected: NDArray[Any], bias: NDArray[Any], flags: NDArray[Any]) -> int:
     parts = [corrected.view(np.uint32), bias.view(np.uint32), flags.astype(np.uint32)]
     return int(np.bitwise_xor.reduce(np.concatenate([p.ravel() for p in parts])))
 
@@ -73,7 +75,7 @@ def rust(samples: int, repeats: int) -> dict[str, tuple[float, float, int]]:
 
 def binding(
     model: gyrodrift.ModifiedTables | gyrodrift.PolynomialTables,
-    inputs: tuple[np.ndarray, np.ndarray, np.ndarray],
+    inputs: tuple[NDArray[Any], NDArray[Any], NDArray[Any]],
     repeats: int,
     reuse: bool,
 ) -> tuple[float, int]:

@@ -13,8 +13,10 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 import gyrodrift
 from gyrodrift import Flags
@@ -34,7 +36,7 @@ def load_models(path: Path) -> dict[str, gyrodrift.ModifiedTables | gyrodrift.Po
     return models
 
 
-def unit_like(model: gyrodrift.ModifiedTables) -> tuple[np.ndarray, np.ndarray]:
+def unit_like(model: gyrodrift.ModifiedTables) -> tuple[NDArray[Any], NDArray[Any]]:
     """A synthetic unit's bias law, per axis, roughly like the tables': the initial bias at
     AMBIENT_CELSIUS (°/s), and k (°/s/°C) at the first and last point of a middle 30 °C curve."""
     axes = json.loads(model.to_json())["axes"]
@@ -53,8 +55,8 @@ def unit_like(model: gyrodrift.ModifiedTables) -> tuple[np.ndarray, np.ndarray]:
 
 
 def synthetic_activation(
-    initial_bias: np.ndarray, k_first_last: np.ndarray, seed: int = 7
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    initial_bias: NDArray[Any], k_first_last: NDArray[Any], seed: int = 7
+) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any], NDArray[Any]]:
     """times (ms), measured rate (°/s), raw temperature, true bias (°/s) of a unit at rest."""
     rng = np.random.default_rng(seed)
     n = RATE_HZ * SECONDS
@@ -70,7 +72,7 @@ def synthetic_activation(
     return times, rate, temperature.astype(np.float32), true_bias
 
 
-def zero_error(output: np.ndarray, from_s: int, to_s: int) -> float:
+def zero_error(output: NDArray[Any], from_s: int, to_s: int) -> float:
     """|mean| over a time window, averaged over the axes: the rate error left at rest."""
     window = output[from_s * RATE_HZ : to_s * RATE_HZ]
     return float(np.abs(window.mean(axis=0)).mean())
