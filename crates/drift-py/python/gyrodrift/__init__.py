@@ -1,0 +1,72 @@
+"""gyrodrift: remove the temperature-driven zero drift of MEMS gyroscopes.
+
+The corrector is drift-core's, the code the firmware runs, bound with pyo3: a `Corrector` holds a
+model (`ModifiedTables`, the paper's method, or `PolynomialTables`, a baseline) and one unit's
+run-time state, and corrects one sample (`correct`) or numpy arrays (`correct_batch`) with the same
+f32 results as the firmware.
+"""
+
+from __future__ import annotations
+
+import enum
+
+from . import _gyrodrift
+from ._gyrodrift import (
+    Corrector,
+    FileError,
+    GyrodriftError,
+    ImageError,
+    InputError,
+    ModifiedTables,
+    Output,
+    PolynomialTables,
+    Settings,
+    TableError,
+    __version__,
+)
+
+__all__ = [
+    "Corrector",
+    "FileError",
+    "Flags",
+    "GyrodriftError",
+    "ImageError",
+    "InputError",
+    "ModifiedTables",
+    "Output",
+    "PolynomialTables",
+    "Settings",
+    "TableError",
+    "__version__",
+]
+
+
+class Flags(enum.IntFlag):
+    """Status flags, per axis and sample (the `flags` outputs are bitwise ORs of these).
+
+    `Flags(value)` names the bits of one output value, e.g. `Flags(flags[i, 0])`.
+    """
+
+    AMBIENT_OUT_OF_RANGE = _gyrodrift.AMBIENT_OUT_OF_RANGE
+    """Switch-on temperature outside the calibrated ambients: nearest ambient used (clamp)."""
+    RISE_OUT_OF_SPAN = _gyrodrift.RISE_OUT_OF_SPAN
+    """Temperature rise outside the stored curves' span: nearest curve's k used (clamp)."""
+    PAST_LAST_REFERENCE = _gyrodrift.PAST_LAST_REFERENCE
+    """Time past the last reference time: k held at its last value."""
+    TEMPERATURE_OUT_OF_RANGE = _gyrodrift.TEMPERATURE_OUT_OF_RANGE
+    """Polynomial baselines: temperature outside the fitted range (clamp)."""
+    TEMPERATURE_INVALID = _gyrodrift.TEMPERATURE_INVALID
+    """NaN/inf temperature: last good drift held."""
+    TEMPERATURE_STUCK = _gyrodrift.TEMPERATURE_STUCK
+    """Temperature unchanged for `stuck_after_samples`: last good drift held."""
+    RATE_INVALID = _gyrodrift.RATE_INVALID
+    """NaN/inf rate: passed through (output non-finite)."""
+    NOT_POWERED_ON = _gyrodrift.NOT_POWERED_ON
+    """No successful power_on: rate passed through uncorrected."""
+    MODEL_INVALID = _gyrodrift.MODEL_INVALID
+    """The tables produced a non-finite drift (corrupt tables only): last good drift held."""
+
+    @classmethod
+    def faults(cls) -> Flags:
+        """The flags that mean a degraded correction (a hold or pass-through), not a clamp."""
+        return cls(_gyrodrift.FAULTS)

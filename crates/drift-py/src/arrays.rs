@@ -1,0 +1,286 @@
+//! numpy arguments: dtype, shape and emptiness checks with messages that name the argument, and
+//! row access that borrows the caller's memory (no copy of the array, whatever its layout).
+
+use numpy::ndarray::{ArrayView1, ArrayView2, Axis, Slice};
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray2,
+    PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::prelude::*;
+
+use crate::errors::Error;
+
+/// What an argument is, for error messages: `int64 array of shape (5, 2)` or `list`.
+pub fn describe(value: &Bound<'_, PyAny>) -> String {
+    match value.cast::<PyUntypedArray>() {
+        Ok(array) => {
+            let dtype = array
+                .dtype()
+                .str()
+                .map_or_else(|_| "unknown dtype".to_owned(), |s| s.to_string());
+            format!("{dtype} array of shape {}", shape_text(array.shape()))
+        }
+        Err(_) => value
+            .get_type()
+            .name()
+            .map_or_else(|_| "an object".to_owned(), |name| name.to_string()),
+    }
+}
+
+/// A shape as Python prints it: `(5,)`, `(5, 2)`.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [single] => format!("({single},)"),
+        _ => {
+            let parts: Vec<String> = shape.iter().map(ToString::to_string).collect();
+            format!("({})", parts.join(", "))
+        }
+    }
+}
+
+fn not_empty(name: &str, value: &Bound<'_, PyAny>, rows: usize) -> Result<(), Error> {
+    if rows == 0 {
+        return Err(Error::Input(format!(
+            "`{name}` must not be empty, got {}",
+            describe(value)
+        )));
+    }
+    Ok(())
+}
+
+/// A borrowed `(n,)` uint32 array (times since switch-on, ms).
+pub fn times<'py>(
+    name: &str,
+    value: &Bound<'py, PyAny>,
+) -> Result<PyReadonlyArray1<'py, u32>, Error> {
+    let array = value.cast::<PyArray1<u32>>().map_err(|_| {
+        Error::Input(format!(
+            "`{name}` must be a uint32 array of shape (n,), got {} (convert with .astype(np.uint32))",
+            describe(value)
+        ))
+    })?;
+    not_empty(name, value, array.len())?;
+    array
+        .try_readonly()
+        .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))
+}
+
+/// A borrowed `(n, 3)` float array (rates or raw temperatures), float32 or float64.
+pub enum Rows<'py> {
+    /// float32: read in place.
+    F32(PyReadonlyArray2<'py, f32>),
+    /// float64: read in place, rounded to f32 per value (as `astype(np.float32)` does).
+    F64(PyReadonlyArray2<'py, f64>),
+}
+
+impl<'py> Rows<'py> {
+    /// Checks and borrows `value`, naming it `name` in errors.
+    pub fn borrow(name: &str, value: &Bound<'py, PyAny>) -> Result<Self, Error> {
+        let wrong = || {
+            Error::Input(format!(
+                "`{name}` must be a float32 or float64 array of shape (n, 3), got {}",
+                describe(value)
+            ))
+        };
+        let borrow_error = |error: numpy::BorrowError| {
+            Error::Input(format!("`{name}` cannot be borrowed: {error}"))
+        };
+        let rows = if let Ok(array) = value.cast::<PyArray2<f32>>() {
+            Self::F32(array.try_readonly().map_err(borrow_error)?)
+        } else if let Ok(array) = value.cast::<PyArray2<f64>>() {
+            Self::F64(array.try_readonly().map_err(borrow_error)?)
+        } else {
+            return Err(wrong());
+        };
+        let (n, columns) = {
+            let view = rows.view();
+            (view.len(), view.shape().get(1).copied())
+        };
+        if columns != Some(3) {
+            return Err(wrong());
+        }
+        not_empty(name, value, n)?;
+        Ok(rows)
+    }
+
+    /// A view that can cross into `Python::detach` (no Python object inside).
+    pub fn view(&self) -> RowsView<'_> {
+        match self {
+            Self::F32(array) => RowsView::F32(array.as_array()),
+            Self::F64(array) => RowsView::F64(array.as_array()),
+        }
+    }
+}
+
+/// Rows of an `(n, 3)` array of either float dtype, any strides.
+pub enum RowsView<'a> {
+    /// float32 rows.
+    F32(ArrayView2<'a, f32>),
+    /// float64 rows.
+    F64(ArrayView2<'a, f64>),
+}
+
+impl RowsView<'_> {
+    /// The array's shape, `[n, 3]`.
+    pub fn shape(&self) -> &[usize] {
+        match self {
+            Self::F32(view) => view.shape(),
+            Self::F64(view) => view.shape(),
+        }
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.shape().first().copied().unwrap_or(0)
+    }
+
+    /// The rows as one flat slice, when they are float32 and C-contiguous (the fast path).
+    pub fn as_f32_slice(&self) -> Option<&[f32]> {
+        match self {
+            Self::F32(view) => view.as_slice(),
+            Self::F64(_) => None,
+        }
+    }
+
+    /// Copies rows `start..` as f32 into `out`, as many as `out` yields.
+    pub fn copy_rows<'o>(&self, start: usize, out: impl Iterator<Item = &'o mut [f32; 3]>) {
+        match self {
+            Self::F32(view) => copy_rows(view, start, out),
+            Self::F64(view) => copy_rows(view, start, out),
+        }
+    }
+}
+
+/// An element type read as f32.
+trait AsF32: Copy {
+    fn as_f32(self) -> f32;
+}
+
+impl AsF32 for f32 {
+    fn as_f32(self) -> f32 {
+        self
+    }
+}
+
+impl AsF32 for f64 {
+    /// Round to nearest, ties to even: the same f32 as numpy's `astype(np.float32)`.
+    fn as_f32(self) -> f32 {
+        self as f32
+    }
+}
+
+fn copy_rows<'o, T: AsF32>(
+    view: &ArrayView2<'_, T>,
+    start: usize,
+    out: impl Iterator<Item = &'o mut [f32; 3]>,
+) {
+    if let Some(flat) = view.as_slice() {
+        // C-contiguous: straight from the caller's buffer.
+        let rows = flat.get(start.saturating_mul(3)..).unwrap_or_default();
+        for (dst, src) in out.zip(rows.chunks_exact(3)) {
+            for (d, s) in dst.iter_mut().zip(src) {
+                *d = s.as_f32();
+            }
+        }
+    } else if start < view.nrows() {
+        // Any other layout (a column slice, a transposed or reversed array): through the strides.
+        let rows = view.slice_axis(Axis(0), Slice::from(start..));
+        for (dst, src) in out.zip(rows.rows()) {
+            for (d, s) in dst.iter_mut().zip(src) {
+                *d = s.as_f32();
+            }
+        }
+    }
+}
+
+/// Times from a uint32 view, any stride, starting at `start`.
+pub fn copy_times<'o>(
+    view: &ArrayView1<'_, u32>,
+    start: usize,
+    out: impl Iterator<Item = &'o mut u32>,
+) {
+    if start < view.len() {
+        let rest = view.slice_axis(Axis(0), Slice::from(start..));
+        for (d, s) in out.zip(rest.iter()) {
+            *d = *s;
+        }
+    }
+}
+
+/// `correct_batch`'s outputs: corrected (n, 3) float32, bias (n, 3) float32, flags (n, 3) uint16.
+pub type BatchArrays<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<u16>>,
+);
+
+/// The caller's output arrays for `correct_batch(..., out=(corrected, bias, flags))`: C-contiguous,
+/// writeable, `(n, 3)` float32, float32 and uint16, none of them an input or each other.
+pub struct OutArrays<'py> {
+    /// The arrays, to hand back to the caller.
+    pub arrays: BatchArrays<'py>,
+    /// Exclusive borrows of them (rust-numpy refuses overlap with the inputs' borrows).
+    pub corrected: PyReadwriteArray2<'py, f32>,
+    /// See `corrected`.
+    pub bias: PyReadwriteArray2<'py, f32>,
+    /// See `corrected`.
+    pub flags: PyReadwriteArray2<'py, u16>,
+}
+
+fn out_array<'py, T: numpy::Element>(
+    name: &str,
+    dtype: &str,
+    value: &Bound<'py, PyAny>,
+    n: usize,
+) -> Result<Bound<'py, PyArray2<T>>, Error> {
+    let wrong = || {
+        Error::Input(format!(
+            "`{name}` must be a writeable C-contiguous {dtype} array of shape ({n}, 3), got {}",
+            describe(value)
+        ))
+    };
+    let array = value.cast::<PyArray2<T>>().map_err(|_| wrong())?;
+    if array.shape() != [n, 3] || !array.is_c_contiguous() {
+        return Err(wrong());
+    }
+    Ok(array.clone())
+}
+
+impl<'py> OutArrays<'py> {
+    /// Checks and borrows `out` for `n` samples.
+    pub fn borrow(out: &Bound<'py, PyAny>, n: usize) -> Result<Self, Error> {
+        let (corrected, bias, flags) = out
+            .extract::<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)>()
+            .map_err(|_| {
+                Error::Input(format!(
+                    "`out` must be a tuple of 3 arrays (corrected_dps, bias_dps, flags), got {}",
+                    describe(out)
+                ))
+            })?;
+        let arrays = (
+            out_array::<f32>("out[0]", "float32", &corrected, n)?,
+            out_array::<f32>("out[1]", "float32", &bias, n)?,
+            out_array::<u16>("out[2]", "uint16", &flags, n)?,
+        );
+        let exclusive = |name: &str, error: numpy::BorrowError| {
+            Error::Input(format!(
+                "`{name}` must be writeable and not also an input or another output: {error}"
+            ))
+        };
+        Ok(Self {
+            corrected: arrays
+                .0
+                .try_readwrite()
+                .map_err(|e| exclusive("out[0]", e))?,
+            bias: arrays
+                .1
+                .try_readwrite()
+                .map_err(|e| exclusive("out[1]", e))?,
+            flags: arrays
+                .2
+                .try_readwrite()
+                .map_err(|e| exclusive("out[2]", e))?,
+            arrays,
+        })
+    }
+}

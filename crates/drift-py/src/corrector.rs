@@ -1,0 +1,395 @@
+//! `gyrodrift.Corrector`: a model plus one unit's run-time state, correcting one sample at a time
+//! or whole numpy arrays. Every sample goes through drift-core's `CorrectorState::correct`, the
+//! code the firmware runs.
+
+use std::sync::Arc;
+
+use drift_core::{
+    AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialTables, Sample,
+};
+use numpy::ndarray::{Array2, ArrayView1};
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::prelude::*;
+
+use crate::args;
+use crate::arrays::{copy_times, describe, times, BatchArrays, OutArrays, Rows, RowsView};
+use crate::errors::Error;
+use crate::tables::{PyModifiedTables, PyPolynomialTables};
+
+/// Samples staged at a time between the caller's arrays and the corrector (on the stack).
+const BLOCK: usize = 512;
+
+/// A model and its state; the model kind decides the state type.
+#[derive(Debug)]
+enum Engine {
+    Modified(
+        Arc<ModifiedTables>,
+        CorrectorState<<ModifiedAxis as AxisModel>::State>,
+    ),
+    Polynomial(
+        Arc<PolynomialTables>,
+        CorrectorState<<PolynomialAxis as AxisModel>::State>,
+    ),
+}
+
+type ModifiedAxis = <ModifiedTables as Model>::Axis;
+type PolynomialAxis = <PolynomialTables as Model>::Axis;
+
+/// The batch's inputs, borrowed from the caller's arrays (no Python object inside, so they can be
+/// used without the GIL).
+struct Batch<'a> {
+    times: ArrayView1<'a, u32>,
+    rates: RowsView<'a>,
+    temperatures: RowsView<'a>,
+}
+
+/// Where the batch's outputs go: `n × 3` row-major slices (new vectors or the caller's arrays).
+struct Corrected<'a> {
+    corrected_dps: &'a mut [f32],
+    bias_dps: &'a mut [f32],
+    flags: &'a mut [u16],
+}
+
+fn correct_all<M, S>(
+    model: &M,
+    state: &mut CorrectorState<S>,
+    batch: &Batch<'_>,
+    out: Corrected<'_>,
+) where
+    M: Model,
+    M::Axis: AxisModel<State = S>,
+    S: Copy + Default,
+{
+    let mut outputs = out
+        .corrected_dps
+        .chunks_exact_mut(3)
+        .zip(out.bias_dps.chunks_exact_mut(3))
+        .zip(out.flags.chunks_exact_mut(3));
+    let mut store = |output: Output| {
+        if let Some(((corrected, bias), flags)) = outputs.next() {
+            for (dst, src) in corrected.iter_mut().zip(output.corrected_dps) {
+                *dst = src;
+            }
+            for (dst, src) in bias.iter_mut().zip(output.bias_dps) {
+                *dst = src;
+            }
+            for (dst, src) in flags.iter_mut().zip(output.flags) {
+                *dst = src.0;
+            }
+        }
+    };
+    let contiguous = (
+        batch.times.as_slice(),
+        batch.rates.as_f32_slice(),
+        batch.temperatures.as_f32_slice(),
+    );
+    if let (Some(times), Some(rates), Some(temperatures)) = contiguous {
+        // The usual case, float32 C-contiguous inputs: samples straight from the caller's buffers.
+        let rows = times
+            .iter()
+            .zip(rates.chunks_exact(3))
+            .zip(temperatures.chunks_exact(3));
+        for ((&since_power_on_ms, rate), temperature) in rows {
+            let mut sample = Sample {
+                since_power_on_ms,
+                ..Sample::default()
+            };
+            for (dst, src) in sample.rate_dps.iter_mut().zip(rate) {
+                *dst = *src;
+            }
+            for (dst, src) in sample.temperature_raw.iter_mut().zip(temperature) {
+                *dst = *src;
+            }
+            store(state.correct(model, &sample));
+        }
+        return;
+    }
+    // Any other layout or float64: staged through a small buffer, converted per value.
+    let n = batch.times.len();
+    let mut staged = [Sample::default(); BLOCK];
+    for start in (0..n).step_by(BLOCK) {
+        let count = BLOCK.min(n.saturating_sub(start));
+        let block = staged.get_mut(..count).unwrap_or_default();
+        copy_times(
+            &batch.times,
+            start,
+            block.iter_mut().map(|s| &mut s.since_power_on_ms),
+        );
+        batch
+            .rates
+            .copy_rows(start, block.iter_mut().map(|s| &mut s.rate_dps));
+        batch
+            .temperatures
+            .copy_rows(start, block.iter_mut().map(|s| &mut s.temperature_raw));
+        for sample in block.iter() {
+            store(state.correct(model, sample));
+        }
+    }
+}
+
+impl Engine {
+    fn power_on(&mut self, raw: [f32; 3]) -> Result<[Flags; 3], drift_core::Error> {
+        match self {
+            Self::Modified(model, state) => state.power_on(&**model, raw),
+            Self::Polynomial(model, state) => state.power_on(&**model, raw),
+        }
+    }
+
+    fn power_off(&mut self) {
+        match self {
+            Self::Modified(_, state) => state.power_off(),
+            Self::Polynomial(_, state) => state.power_off(),
+        }
+    }
+
+    fn correct(&mut self, sample: &Sample) -> Output {
+        match self {
+            Self::Modified(model, state) => state.correct(&**model, sample),
+            Self::Polynomial(model, state) => state.correct(&**model, sample),
+        }
+    }
+
+    fn correct_all(&mut self, batch: &Batch<'_>, out: Corrected<'_>) {
+        match self {
+            Self::Modified(model, state) => correct_all(&**model, state, batch, out),
+            Self::Polynomial(model, state) => correct_all(&**model, state, batch, out),
+        }
+    }
+
+    fn is_powered_on(&self) -> bool {
+        match self {
+            Self::Modified(_, state) => state.is_powered_on(),
+            Self::Polynomial(_, state) => state.is_powered_on(),
+        }
+    }
+
+    /// Per axis: (raw reading at switch-on, initial bias °/s).
+    fn switch_on(&self) -> [(f32, f32); 3] {
+        match self {
+            Self::Modified(_, state) => state
+                .axes()
+                .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
+            Self::Polynomial(_, state) => state
+                .axes()
+                .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
+        }
+    }
+}
+
+/// One corrected sample: per axis X, Y, Z.
+#[pyclass(module = "gyrodrift", name = "Output", frozen, eq)]
+#[derive(Clone, Debug, PartialEq)]
+pub struct PyOutput {
+    /// Rate with the estimated drift removed, °/s.
+    #[pyo3(get)]
+    corrected_dps: (f32, f32, f32),
+    /// Estimated bias that was removed (initial bias + drift since switch-on), °/s.
+    #[pyo3(get)]
+    bias_dps: (f32, f32, f32),
+    /// Status flags (see `gyrodrift.Flags`).
+    #[pyo3(get)]
+    flags: (u16, u16, u16),
+}
+
+#[pymethods]
+impl PyOutput {
+    fn __repr__(&self) -> String {
+        format!(
+            "Output(corrected_dps={:?}, bias_dps={:?}, flags={:?})",
+            self.corrected_dps, self.bias_dps, self.flags
+        )
+    }
+}
+
+fn triple<T: Copy>(values: [T; 3]) -> (T, T, T) {
+    let [x, y, z] = values;
+    (x, y, z)
+}
+
+/// Corrects a gyro's temperature drift: a model (the paper's tables or a polynomial baseline) and
+/// one unit's run-time state.
+#[pyclass(module = "gyrodrift", name = "Corrector")]
+#[derive(Debug)]
+pub struct PyCorrector {
+    engine: Engine,
+}
+
+/// `OutArrays` checked contiguity already; this names the argument should that ever change.
+fn not_contiguous(error: numpy::AsSliceError) -> Error {
+    Error::Input(format!("`out` arrays must be C-contiguous: {error}"))
+}
+
+fn to_array<'py, T: numpy::Element>(
+    py: Python<'py>,
+    values: Vec<T>,
+    rows: usize,
+) -> Result<Bound<'py, PyArray2<T>>, Error> {
+    Array2::from_shape_vec((rows, 3), values)
+        .map(|array| array.into_pyarray(py))
+        .map_err(|error| Error::Input(format!("internal: output shape ({rows}, 3): {error}")))
+}
+
+#[pymethods]
+impl PyCorrector {
+    /// A corrector for `model` (`ModifiedTables` or `PolynomialTables`), not yet powered on.
+    #[new]
+    fn new(model: &Bound<'_, PyAny>) -> Result<Self, Error> {
+        let engine = if let Ok(tables) = model.cast::<PyModifiedTables>() {
+            Engine::Modified(Arc::clone(&tables.get().0), CorrectorState::new())
+        } else if let Ok(tables) = model.cast::<PyPolynomialTables>() {
+            Engine::Polynomial(Arc::clone(&tables.get().0), CorrectorState::new())
+        } else {
+            return Err(Error::Input(format!(
+                "`model` must be a gyrodrift.ModifiedTables or gyrodrift.PolynomialTables, got {}",
+                describe(model)
+            )));
+        };
+        Ok(Self { engine })
+    }
+
+    /// The model in use.
+    #[getter]
+    fn model(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        Ok(match &self.engine {
+            Engine::Modified(model, _) => {
+                Py::new(py, PyModifiedTables(Arc::clone(model)))?.into_any()
+            }
+            Engine::Polynomial(model, _) => {
+                Py::new(py, PyPolynomialTables(Arc::clone(model)))?.into_any()
+            }
+        })
+    }
+
+    /// Whether `power_on` has succeeded since the last `power_off`.
+    #[getter]
+    fn is_powered_on(&self) -> bool {
+        self.engine.is_powered_on()
+    }
+
+    /// Raw temperature readings at the last switch-on, per axis.
+    #[getter]
+    fn switch_on_raw(&self) -> (f32, f32, f32) {
+        triple(self.engine.switch_on().map(|(raw, _)| raw))
+    }
+
+    /// Initial (switch-on) bias located at the last switch-on, per axis, °/s.
+    #[getter]
+    fn initial_bias_dps(&self) -> (f32, f32, f32) {
+        triple(self.engine.switch_on().map(|(_, bias)| bias))
+    }
+
+    /// Starts an activation from the raw temperature readings at switch-on (X, Y, Z); returns the
+    /// flags that hold for the whole activation, per axis.
+    fn power_on(&mut self, switch_on_raw: &Bound<'_, PyAny>) -> Result<(u16, u16, u16), Error> {
+        let raw = args::per_axis("switch_on_raw", switch_on_raw)?;
+        let flags = self.engine.power_on(raw).map_err(|error| {
+            Error::Input(format!(
+                "`switch_on_raw` must be finite on every axis, got {raw:?} ({error}); the state is unchanged"
+            ))
+        })?;
+        Ok(triple(flags.map(|f| f.0)))
+    }
+
+    /// Ends the activation: samples pass through, flagged NOT_POWERED_ON, until the next power_on.
+    fn power_off(&mut self) {
+        self.engine.power_off();
+    }
+
+    /// Corrects one sample.
+    fn correct(
+        &mut self,
+        since_power_on_ms: &Bound<'_, PyAny>,
+        rate_dps: &Bound<'_, PyAny>,
+        temperature_raw: &Bound<'_, PyAny>,
+    ) -> Result<PyOutput, Error> {
+        let sample = Sample {
+            since_power_on_ms: args::milliseconds("since_power_on_ms", since_power_on_ms)?,
+            rate_dps: args::per_axis("rate_dps", rate_dps)?,
+            temperature_raw: args::per_axis("temperature_raw", temperature_raw)?,
+        };
+        let output = self.engine.correct(&sample);
+        Ok(PyOutput {
+            corrected_dps: triple(output.corrected_dps),
+            bias_dps: triple(output.bias_dps),
+            flags: triple(output.flags.map(|f| f.0)),
+        })
+    }
+
+    /// Corrects n samples in order, continuing the current activation; the GIL is released while
+    /// the samples are corrected. With `out`, writes into the caller's arrays and returns them.
+    #[pyo3(signature = (since_power_on_ms, rate_dps, temperature_raw, *, out = None))]
+    fn correct_batch<'py>(
+        &mut self,
+        py: Python<'py>,
+        since_power_on_ms: &Bound<'py, PyAny>,
+        rate_dps: &Bound<'py, PyAny>,
+        temperature_raw: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> Result<BatchArrays<'py>, Error> {
+        let times_array = times("since_power_on_ms", since_power_on_ms)?;
+        let rates = Rows::borrow("rate_dps", rate_dps)?;
+        let temperatures = Rows::borrow("temperature_raw", temperature_raw)?;
+        let batch = Batch {
+            times: times_array.as_array(),
+            rates: rates.view(),
+            temperatures: temperatures.view(),
+        };
+        let n = batch.times.len();
+        for (name, rows) in [
+            ("rate_dps", batch.rates.len()),
+            ("temperature_raw", batch.temperatures.len()),
+        ] {
+            if rows != n {
+                return Err(Error::Input(format!(
+                    "`{name}` must have one row per time in `since_power_on_ms` ({n}), got {rows} rows"
+                )));
+            }
+        }
+        let engine = &mut self.engine;
+        if let Some(out) = out {
+            let OutArrays {
+                arrays,
+                mut corrected,
+                mut bias,
+                mut flags,
+            } = OutArrays::borrow(out, n)?;
+            let slices = Corrected {
+                corrected_dps: corrected.as_slice_mut().map_err(not_contiguous)?,
+                bias_dps: bias.as_slice_mut().map_err(not_contiguous)?,
+                flags: flags.as_slice_mut().map_err(not_contiguous)?,
+            };
+            py.detach(|| engine.correct_all(&batch, slices));
+            return Ok(arrays);
+        }
+        let len = n.saturating_mul(3);
+        let (mut corrected, mut bias, mut flags) = (vec![0.0; len], vec![0.0; len], vec![0; len]);
+        py.detach(|| {
+            engine.correct_all(
+                &batch,
+                Corrected {
+                    corrected_dps: &mut corrected,
+                    bias_dps: &mut bias,
+                    flags: &mut flags,
+                },
+            );
+        });
+        Ok((
+            to_array(py, corrected, n)?,
+            to_array(py, bias, n)?,
+            to_array(py, flags, n)?,
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        let model = match &self.engine {
+            Engine::Modified(..) => "ModifiedTables",
+            Engine::Polynomial(..) => "PolynomialTables",
+        };
+        let state = if self.engine.is_powered_on() {
+            "powered on"
+        } else {
+            "not powered on"
+        };
+        format!("<Corrector {model}, {state}>")
+    }
+}

@@ -1,0 +1,172 @@
+//! The model classes: `gyrodrift.ModifiedTables` (the paper's method) and
+//! `gyrodrift.PolynomialTables` (the standard and 3rd-order baselines).
+//!
+//! Both are immutable, validated on construction, and share one API (generated below so it cannot
+//! drift apart): JSON and firmware-image conversion, files, settings.
+
+use std::sync::Arc;
+
+use drift_core::{Model, ModifiedTables, PolynomialTables};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+
+use crate::args;
+use crate::errors::Error;
+use crate::model_io;
+use crate::settings::PySettings;
+
+/// One line describing a model's size, for `repr`.
+trait Summary {
+    fn summary(&self) -> String;
+}
+
+impl Summary for ModifiedTables {
+    fn summary(&self) -> String {
+        let axes: Vec<String> = self
+            .axes
+            .iter()
+            .map(|axis| {
+                let curves = axis.ambients.first().map_or(0, |a| a.curves.len());
+                format!(
+                    "{}x{}x{}",
+                    axis.reference_ms.len(),
+                    axis.ambients.len(),
+                    curves
+                )
+            })
+            .collect();
+        format!(
+            "reference times x ambients x curves per axis: {}",
+            axes.join(", ")
+        )
+    }
+}
+
+impl Summary for PolynomialTables {
+    fn summary(&self) -> String {
+        let axes: Vec<String> = self
+            .axes
+            .iter()
+            .map(|axis| {
+                let [low, high] = axis.range_celsius;
+                format!(
+                    "{} coefficients over [{low:?}, {high:?}] °C",
+                    axis.coefficients.len()
+                )
+            })
+            .collect();
+        format!("per axis: {}", axes.join("; "))
+    }
+}
+
+/// Defines a frozen model class wrapping `Arc<$model>` with the shared API.
+macro_rules! model_class {
+    ($class:ident, $model:ty, $name:literal, $doc:literal) => {
+        #[doc = $doc]
+        #[pyclass(module = "gyrodrift", name = $name, frozen, eq)]
+        #[derive(Clone, Debug, PartialEq)]
+        pub struct $class(pub Arc<$model>);
+
+        impl $class {
+            fn checked(tables: $model) -> Result<Self, Error> {
+                tables.validate().map_err(Error::Table)?;
+                Ok(Self(Arc::new(tables)))
+            }
+        }
+
+        #[pymethods]
+        impl $class {
+            /// Parses drift-core's JSON form and validates it.
+            #[staticmethod]
+            fn from_json(text: &Bound<'_, PyAny>) -> Result<Self, Error> {
+                let text = args::text("text", text)?;
+                model_io::from_json::<$model>($name, &text).map(|t| Self(Arc::new(t)))
+            }
+
+            /// Decodes a firmware table image and validates it.
+            #[staticmethod]
+            fn from_image(data: &Bound<'_, PyAny>) -> Result<Self, Error> {
+                let data = args::bytes("data", data)?;
+                model_io::from_image::<$model>(&data).map(|t| Self(Arc::new(t)))
+            }
+
+            /// Reads a JSON file written by `save_json` (or the command line).
+            #[staticmethod]
+            fn load_json(path: &Bound<'_, PyAny>) -> Result<Self, Error> {
+                let path = args::path("path", path)?;
+                let text = model_io::read_text(&path)?;
+                model_io::from_json::<$model>($name, &text).map(|t| Self(Arc::new(t)))
+            }
+
+            /// Reads a firmware table image file written by `save_image`.
+            #[staticmethod]
+            fn load_image(path: &Bound<'_, PyAny>) -> Result<Self, Error> {
+                let path = args::path("path", path)?;
+                let bytes = model_io::read(&path)?;
+                model_io::from_image::<$model>(&bytes).map(|t| Self(Arc::new(t)))
+            }
+
+            /// drift-core's JSON form, pretty-printed.
+            fn to_json(&self) -> Result<String, Error> {
+                model_io::to_json($name, &*self.0)
+            }
+
+            /// The firmware table image.
+            fn to_image<'py>(&self, py: Python<'py>) -> Result<Bound<'py, PyBytes>, Error> {
+                let bytes = model_io::to_image(&*self.0)?;
+                Ok(PyBytes::new(py, &bytes))
+            }
+
+            /// Writes the JSON form to `path` (atomically: temporary file, then rename).
+            fn save_json(&self, path: &Bound<'_, PyAny>) -> Result<(), Error> {
+                let path = args::path("path", path)?;
+                let text = model_io::to_json($name, &*self.0)?;
+                model_io::write(&path, text.as_bytes())
+            }
+
+            /// Writes the firmware table image to `path` (atomically).
+            fn save_image(&self, path: &Bound<'_, PyAny>) -> Result<(), Error> {
+                let path = args::path("path", path)?;
+                let bytes = model_io::to_image(&*self.0)?;
+                model_io::write(&path, &bytes)
+            }
+
+            /// The settings stored with the tables.
+            #[getter]
+            fn settings(&self) -> PySettings {
+                PySettings(self.0.settings)
+            }
+
+            /// The same tables with other settings (validated).
+            fn with_settings(&self, settings: &Bound<'_, PyAny>) -> Result<Self, Error> {
+                let settings = settings.cast::<PySettings>().map_err(|_| {
+                    Error::Input(format!(
+                        "`settings` must be a gyrodrift.Settings, got {}",
+                        crate::arrays::describe(settings)
+                    ))
+                })?;
+                let mut tables = (*self.0).clone();
+                tables.settings = settings.get().0;
+                Self::checked(tables)
+            }
+
+            fn __repr__(&self) -> String {
+                format!("<{} {}>", $name, self.0.summary())
+            }
+        }
+    };
+}
+
+model_class!(
+    PyModifiedTables,
+    ModifiedTables,
+    "ModifiedTables",
+    "The paper's correlation tables (`drift_core::ModifiedTables`, host capacities 16 x 12 x 32)."
+);
+
+model_class!(
+    PyPolynomialTables,
+    PolynomialTables,
+    "PolynomialTables",
+    "A polynomial baseline, standard or 3rd order (`drift_core::PolynomialTables`)."
+);

@@ -1,0 +1,110 @@
+"""Fixtures shared by the gyrodrift tests: the shared test vectors and their models."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+import pytest
+
+import gyrodrift
+
+VECTORS = Path(__file__).resolve().parents[3] / "testdata" / "vectors.json"
+
+Model = Union[gyrodrift.ModifiedTables, gyrodrift.PolynomialTables]
+
+
+@dataclass
+class Case:
+    """One vector case, with its floats turned from bit patterns into numpy arrays."""
+
+    name: str
+    model: str
+    switch_on_raw: np.ndarray | None  # (3,) float32
+    power_on_fails: bool
+    times: np.ndarray  # (n,) uint32
+    rate: np.ndarray  # (n, 3) float32
+    temperature: np.ndarray  # (n, 3) float32
+    corrected: np.ndarray  # (n, 3) float32
+    bias: np.ndarray  # (n, 3) float32
+    flags: np.ndarray  # (n, 3) uint16
+
+
+def f32(bits: Any) -> np.ndarray:
+    """IEEE-754 binary32 bit patterns to float32 values (NaN payloads preserved)."""
+    return np.asarray(bits, dtype=np.uint32).view(np.float32)
+
+
+def load_vectors() -> dict[str, Any]:
+    with VECTORS.open() as file:
+        data: dict[str, Any] = json.load(file)
+    return data
+
+
+def model_class(kind: str) -> type[Model]:
+    return {"modified": gyrodrift.ModifiedTables, "polynomial": gyrodrift.PolynomialTables}[kind]
+
+
+@pytest.fixture(scope="session")
+def vectors() -> dict[str, Any]:
+    return load_vectors()
+
+
+@pytest.fixture(scope="session")
+def models(vectors: dict[str, Any]) -> dict[str, Model]:
+    """The vector models, loaded from their firmware images (the canonical form)."""
+    return {
+        m["name"]: model_class(m["kind"]).from_image(bytes.fromhex(m["image_hex"])) for m in vectors["models"]
+    }
+
+
+@pytest.fixture(scope="session")
+def modified(models: dict[str, Model]) -> gyrodrift.ModifiedTables:
+    model = models["modified"]
+    assert isinstance(model, gyrodrift.ModifiedTables)
+    return model
+
+
+def parse_case(case: dict[str, Any]) -> Case:
+    samples = np.asarray(case["samples"], dtype=np.uint32)
+    expected = np.asarray(case["expected"], dtype=np.uint32)
+    switch_on = case["switch_on_raw"]
+    return Case(
+        name=case["name"],
+        model=case["model"],
+        switch_on_raw=None if switch_on is None else f32(switch_on),
+        power_on_fails=case["power_on_fails"],
+        times=np.ascontiguousarray(samples[:, 0]),
+        rate=f32(np.ascontiguousarray(samples[:, 1:4])),
+        temperature=f32(np.ascontiguousarray(samples[:, 4:7])),
+        corrected=f32(np.ascontiguousarray(expected[:, 0:3])),
+        bias=f32(np.ascontiguousarray(expected[:, 3:6])),
+        flags=expected[:, 6:9].astype(np.uint16),
+    )
+
+
+@pytest.fixture(scope="session")
+def cases(vectors: dict[str, Any]) -> list[Case]:
+    return [parse_case(c) for c in vectors["cases"]]
+
+
+def same_bits(expected: np.ndarray, got: np.ndarray) -> np.ndarray:
+    """Element-wise: equal bit patterns, or both NaN (the vectors' rule)."""
+    assert got.dtype == np.float32, got.dtype
+    equal = expected.view(np.uint32) == got.view(np.uint32)
+    return equal | (np.isnan(expected) & np.isnan(got))
+
+
+def powered_corrector(model: Model, case: Case) -> gyrodrift.Corrector:
+    """A fresh corrector, powered on as the case says (a rejected power_on leaves it off)."""
+    corrector = gyrodrift.Corrector(model)
+    if case.switch_on_raw is not None:
+        if case.power_on_fails:
+            with pytest.raises(gyrodrift.InputError):
+                corrector.power_on(case.switch_on_raw)
+        else:
+            corrector.power_on(case.switch_on_raw)
+    return corrector

@@ -1,0 +1,117 @@
+"""The shared test vectors (testdata/vectors.json), reproduced bit for bit from Python."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import Case, Model, powered_corrector, same_bits
+
+
+def check_batch(case: Case, corrected: np.ndarray, bias: np.ndarray, flags: np.ndarray) -> None:
+    n = len(case.times)
+    assert corrected.shape == bias.shape == flags.shape == (n, 3)
+    assert flags.dtype == np.uint16
+    bad = ~same_bits(case.corrected, corrected) | ~same_bits(case.bias, bias) | (flags != case.flags)
+    rows = np.flatnonzero(bad.any(axis=1))
+    assert rows.size == 0, f"{case.name}: {rows.size} of {n} samples differ, first at {rows[:5]}"
+
+
+def test_vectors_cover_every_model_and_enough_samples(cases: list[Case], models: dict[str, Model]) -> None:
+    assert {c.model for c in cases} == set(models) == {"modified", "standard", "third_order"}
+    assert sum(len(c.times) for c in cases) > 1000
+
+
+def test_batch_reproduces_every_case(cases: list[Case], models: dict[str, Model]) -> None:
+    for case in cases:
+        corrector = powered_corrector(models[case.model], case)
+        check_batch(case, *corrector.correct_batch(case.times, case.rate, case.temperature))
+
+
+def test_per_sample_reproduces_every_case(cases: list[Case], models: dict[str, Model]) -> None:
+    for case in cases:
+        corrector = powered_corrector(models[case.model], case)
+        outputs = [
+            corrector.correct(int(t), rate, temperature)
+            for t, rate, temperature in zip(case.times, case.rate, case.temperature)
+        ]
+        corrected = np.array([o.corrected_dps for o in outputs], dtype=np.float32)
+        bias = np.array([o.bias_dps for o in outputs], dtype=np.float32)
+        flags = np.array([o.flags for o in outputs], dtype=np.uint16)
+        check_batch(case, corrected, bias, flags)
+
+
+@pytest.mark.parametrize("layout", ["float64", "fortran", "strided", "reversed-copy"])
+def test_batch_is_layout_and_dtype_independent(
+    layout: str, cases: list[Case], models: dict[str, Model]
+) -> None:
+    """float64 inputs (exact widenings of the vectors' f32) and non-contiguous views give the same bits."""
+    for case in cases:
+        if layout == "float64":
+            rate, temperature = case.rate.astype(np.float64), case.temperature.astype(np.float64)
+            times = case.times
+        elif layout == "fortran":
+            rate, temperature = np.asfortranarray(case.rate), np.asfortranarray(case.temperature)
+            times = case.times
+        elif layout == "strided":
+            # Every other row of a doubled array, and every other column of a widened one.
+            rate = np.repeat(case.rate, 2, axis=0)[::2]
+            temperature = np.repeat(case.temperature, 2, axis=1)[:, ::2]
+            times = np.repeat(case.times, 2)[::2]
+            assert not rate.flags.c_contiguous and not temperature.flags.c_contiguous
+            assert not times.flags.c_contiguous
+        else:
+            rate = case.rate[::-1].copy()[::-1]
+            temperature = case.temperature[::-1].copy()[::-1]
+            times = case.times[::-1].copy()[::-1]
+        corrector = powered_corrector(models[case.model], case)
+        check_batch(case, *corrector.correct_batch(times, rate, temperature))
+
+
+def test_a_case_split_into_batches_continues_the_activation(
+    cases: list[Case], models: dict[str, Model]
+) -> None:
+    for case in cases:
+        corrector = powered_corrector(models[case.model], case)
+        parts = [
+            corrector.correct_batch(case.times[s], case.rate[s], case.temperature[s])
+            for s in (slice(0, 1), slice(1, 7), slice(7, None))
+            if len(case.times[s])
+        ]
+        check_batch(case, *(np.concatenate(outputs) for outputs in zip(*parts)))
+
+
+def test_models_from_json_equal_models_from_images(vectors: dict, models: dict[str, Model]) -> None:
+    import json
+
+    for named in vectors["models"]:
+        cls = type(models[named["name"]])
+        assert cls.from_json(json.dumps(named["tables"])) == models[named["name"]]
+
+
+def test_images_are_reproduced_byte_for_byte(vectors: dict, models: dict[str, Model]) -> None:
+    for named in vectors["models"]:
+        assert models[named["name"]].to_image() == bytes.fromhex(named["image_hex"])
+
+
+def test_outputs_are_fresh_writeable_c_contiguous_arrays(cases: list[Case], models: dict[str, Model]) -> None:
+    case = cases[0]
+    corrector = powered_corrector(models[case.model], case)
+    corrected, bias, flags = corrector.correct_batch(case.times, case.rate, case.temperature)
+    assert (corrected.dtype, bias.dtype, flags.dtype) == (np.float32, np.float32, np.uint16)
+    for array in (corrected, bias, flags):
+        assert array.flags.c_contiguous and array.flags.writeable
+    corrected[:] = 0  # the caller owns them: writing does not disturb the corrector
+    again = powered_corrector(models[case.model], case).correct_batch(case.times, case.rate, case.temperature)
+    assert same_bits(case.corrected, again[0]).all()
+
+
+def test_out_arrays_receive_the_same_results(cases: list[Case], models: dict[str, Model]) -> None:
+    """`out=` writes into the caller's arrays (reusable buffers) and returns those same arrays."""
+    for case in cases:
+        n = len(case.times)
+        out = (np.full((n, 3), 7, np.float32), np.full((n, 3), 7, np.float32), np.full((n, 3), 7, np.uint16))
+        corrector = powered_corrector(models[case.model], case)
+        returned = corrector.correct_batch(case.times, case.rate, case.temperature, out=out)
+        assert all(r is o for r, o in zip(returned, out))
+        check_batch(case, *out)

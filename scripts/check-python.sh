@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# The Python module's checks, from a really clean state: a fresh venv in .venv-check/ (deleted and
+# recreated on every run), `pip install ./crates/drift-py[test]` (a real PEP 517 build through
+# maturin), then pytest, mypy's stubtest, a strict type check of the examples, ruff, and the
+# examples themselves. Prints how long each step took. Safe to re-run; meant to be called from
+# scripts/check.sh (the single test command).
+#
+# Needs: python3 >= 3.9 (with venv; installed via apt-get if missing), Rust (cargo), and PyPI.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+VENV=.venv-check
+PYTHON=${PYTHON:-python3}
+declare -a TIMES=()
+
+now() { echo "$EPOCHREALTIME"; }
+step() {
+    local name=$1
+    shift
+    printf '\n=== %s\n' "$name"
+    local start
+    start=$(now)
+    "$@"
+    TIMES+=("$(awk -v a="$start" -v b="$(now)" -v n="$name" 'BEGIN { printf "%7.1f s  %s", b - a, n }')")
+}
+
+make_venv() {
+    rm -rf "$VENV"
+    if ! "$PYTHON" -m venv "$VENV" 2>/dev/null; then
+        # Debian/Ubuntu ship venv (ensurepip) separately.
+        rm -rf "$VENV"
+        local sudo=""
+        [ "$(id -u)" -eq 0 ] || sudo="sudo"
+        version=$("$PYTHON" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')
+        $sudo apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "python${version}-venv" >/dev/null
+        "$PYTHON" -m venv "$VENV"
+    fi
+    "$VENV/bin/python" --version
+    "$VENV/bin/python" -m pip install --quiet --upgrade pip
+}
+
+install_package() {
+    # Builds the abi3 wheel with maturin (fetched by pip into an isolated build environment) and
+    # installs it with its test tools (pytest, hypothesis, mypy; numpy is a runtime dependency).
+    "$VENV/bin/python" -m pip install --quiet "./crates/drift-py[test]"
+    "$VENV/bin/python" -c 'import gyrodrift, numpy; print("gyrodrift", gyrodrift.__version__, "from", gyrodrift.__file__, "| numpy", numpy.__version__)'
+}
+
+run_pytest() {
+    # From the repository root, so `import gyrodrift` is the installed wheel, not the source tree.
+    "$VENV/bin/python" -m pytest crates/drift-py/tests -q -p no:cacheprovider
+}
+
+run_stubtest() {
+    "$VENV/bin/python" -m mypy.stubtest gyrodrift._gyrodrift \
+        --allowlist crates/drift-py/stubtest-allowlist.txt
+}
+
+run_mypy_examples() {
+    "$VENV/bin/python" -m mypy --strict --no-incremental crates/drift-py/examples crates/drift-py/bench
+}
+
+run_ruff() {
+    "$VENV/bin/ruff" check crates/drift-py
+    "$VENV/bin/ruff" format --check crates/drift-py
+}
+
+run_examples() {
+    for script in crates/drift-py/examples/*.py; do
+        echo "--- $script"
+        MPLBACKEND=Agg "$VENV/bin/python" "$script"
+    done
+}
+
+"$PYTHON" --version
+command -v cargo >/dev/null || { echo "cargo not found: install Rust (rustup) first" >&2; exit 1; }
+step "fresh venv in $VENV" make_venv
+step "pip install ./crates/drift-py[test] (maturin build)" install_package
+step "pytest crates/drift-py/tests" run_pytest
+step "stubtest gyrodrift._gyrodrift" run_stubtest
+step "mypy --strict examples and bench" run_mypy_examples
+step "ruff check and format --check" run_ruff
+step "examples" run_examples
+
+printf '\n=== timings\n'
+printf '%s\n' "${TIMES[@]}"
+printf '\nPython checks passed.\n'
