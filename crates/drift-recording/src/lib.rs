@@ -1,10 +1,23 @@
 //! The recording side of gyrodrift's data flow: recording → **segments** → fitted tables →
 //! corrector → residual → report.
 //!
-//! A [`Segment`] is one activation (switch-on to switch-off) with its protocol labels. The
-//! simulator writes recordings; the fitter and the evaluation read segments; neither needs the
-//! other.
+//! The format (specified in `docs/recording-format.md`): MCAP files with CDR-encoded (`ros2msg`)
+//! batches of samples, one topic per signal, zstd chunks. [`read_recording`] validates while it
+//! reads and yields [`Segment`]s, one per activation, with their protocol labels; it refuses
+//! simulator ground truth, so code that reads through it cannot see the truth.
+//! [`write_recording`] writes the same format from a real test bench's data.
 
+pub mod cdr;
+mod error;
+mod layout;
+mod read;
+pub mod schema;
 mod segment;
+mod write;
+pub mod writer;
 
+pub use error::{ReadError, WriteError};
+pub use layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+pub use read::{is_truth_path, read_campaign_dir, read_recording, Recording, REQUIRED_TOPICS};
 pub use segment::{AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS};
+pub use write::{create_recording, write_recording};

@@ -104,4 +104,10 @@ impl Segment {
         let index = *self.since_power_on.get(i)?;
         Some(u64::from(index) * 1000 / u64::from(self.sample_rate_hz.max(1)))
     }
+
+    /// Raw temperature of `axis` at sample `i` in °C (`None` past the end).
+    pub fn temperature_celsius(&self, axis: usize, i: usize) -> Option<f64> {
+        let raw = *self.temperature_raw.get(axis)?.get(i)?;
+        Some(f64::from(raw) / RAW_PER_CELSIUS)
+    }
 }

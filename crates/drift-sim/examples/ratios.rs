@@ -39,7 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for axis in 0..3 {
             let rate: Vec<f64> = seg.rate_dps[axis].iter().map(|&x| f64::from(x)).collect();
             let temp: Vec<f64> = (0..seg.len())
-                .map(|i| seg.temperature_celsius(axis, i))
+                .filter_map(|i| seg.temperature_celsius(axis, i))
                 .collect();
             let (g0, t0) = (mean(&rate[..500]), mean(&temp[..500]));
             line += " |";

@@ -5,13 +5,14 @@
 use crate::bias::{self, BiasInputs};
 use crate::campaign::{Campaign, TruthBias};
 use crate::error::SimError;
-use crate::record::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
-use crate::record::writer::McapFile;
 use crate::rng;
 use crate::schedule::{ActivationPlan, FilePlan};
 use crate::thermal::network::{asic, element, NODES};
 use crate::thermal::rc::{Discrete, RcNetwork};
-use crate::unit::{UnitParams, NOMINAL_SUPPLY_V, RAW_PER_CELSIUS, REFERENCE_CELSIUS};
+use crate::unit::{UnitParams, NOMINAL_SUPPLY_V, REFERENCE_CELSIUS};
+use drift_recording::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
+use drift_recording::writer::McapFile;
+use drift_recording::{AUX_RATE_HZ, RAW_PER_CELSIUS};
 use rand::rngs::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use std::collections::BTreeMap;
@@ -24,8 +25,6 @@ pub const RANGE_DPS: f64 = 500.0;
 /// per-sample white noise.
 pub const RATE_LSB_DPS: f64 = 1.0 / 16384.0;
 const RATE_PER_LSB_INV: f64 = 16384.0;
-/// Rate of the auxiliary and thermal-truth channels (Hz).
-pub const AUX_RATE_HZ: u32 = 100;
 /// Supply-voltage measurement noise, 1σ (V).
 const SUPPLY_NOISE_V: f64 = 0.002;
 
@@ -142,7 +141,10 @@ impl FileSim<'_> {
     }
 
     fn open_recording(&self, path: &Path) -> Result<McapFile, SimError> {
-        crate::record::bench::create_recording(path, self.recording_metadata())
+        Ok(drift_recording::create_recording(
+            path,
+            self.recording_metadata(),
+        )?)
     }
 
     fn open_truth(&self, path: &Path) -> Result<McapFile, SimError> {

@@ -7,8 +7,6 @@ pub mod campaign;
 mod engine;
 pub mod error;
 pub mod hidden;
-pub mod read;
-pub mod record;
 mod rng;
 pub mod schedule;
 pub mod simulate;
@@ -17,9 +15,12 @@ pub mod truth;
 pub mod unit;
 
 pub use campaign::{Campaign, Field, Protocol};
-pub use error::{ReadError, SimError};
+pub use error::SimError;
 pub use hidden::HiddenEffects;
-pub use read::{read_campaign_dir, read_recording, AuxChannel, Recording, Segment, SegmentLabels};
+// The recording format lives in drift-recording; re-exported for the simulator's users.
+pub use drift_recording::{
+    read_campaign_dir, read_recording, AuxChannel, ReadError, Recording, Segment, SegmentLabels,
+};
 pub use schedule::SeriesKind;
 pub use simulate::{simulate_campaign, Progress, Summary};
 pub use unit::{UnitModel, UnitParams};

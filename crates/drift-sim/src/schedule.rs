@@ -8,35 +8,8 @@ use crate::unit::NOMINAL_SUPPLY_V;
 use rand::rngs::ChaCha8Rng;
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
-use serde::{Deserialize, Serialize};
 
-/// Which kind of series an activation belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SeriesKind {
-    /// The paper's calibration protocol.
-    Protocol,
-    /// A field-like session.
-    Field,
-}
-
-impl SeriesKind {
-    /// The label written into recordings.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Protocol => "protocol",
-            Self::Field => "field",
-        }
-    }
-    /// Parses a label.
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "protocol" => Some(Self::Protocol),
-            "field" => Some(Self::Field),
-            _ => None,
-        }
-    }
-}
+pub use drift_recording::SeriesKind;
 
 /// One switch-on to switch-off, as planned.
 #[derive(Debug, Clone, PartialEq)]

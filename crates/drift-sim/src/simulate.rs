@@ -11,18 +11,12 @@
 use crate::campaign::Campaign;
 use crate::engine::FileSim;
 use crate::error::SimError;
-use crate::schedule::{self, SeriesKind};
+use crate::schedule;
 use crate::unit::UnitParams;
+use drift_recording::{SeriesKind, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Sub-folder of recordings.
-pub const RECORDINGS_DIR: &str = "recordings";
-/// Sub-folder of ground truth (never read by fitting or diagnosis code).
-pub const TRUTH_DIR: &str = "truth";
-/// Extension of ground-truth sidecars.
-pub const TRUTH_EXTENSION: &str = "truth.mcap";
 
 /// Progress of a running campaign.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,7 +135,7 @@ pub fn simulate_campaign(
         })
         .collect::<Result<Vec<_>, _>>()?;
     // The thermal state is stepped exactly on the 100 Hz auxiliary grid (see engine).
-    let grid_s = 1.0 / f64::from(crate::engine::AUX_RATE_HZ);
+    let grid_s = 1.0 / f64::from(drift_recording::AUX_RATE_HZ);
     let steps: Vec<_> = networks.iter().map(|n| n.discretise(grid_s)).collect();
     for plan in &plans {
         let u = plan.unit_index as usize;

@@ -2,11 +2,11 @@
 //!
 //! The truth of a recording `recordings/X.mcap` is `truth/X.truth.mcap` (per-sample noise-free
 //! bias, node temperatures, bias instability) plus `truth/units.json` and
-//! `truth/campaign.json`. [`crate::read::read_recording`] refuses all of them; this module
+//! `truth/campaign.json`. [`drift_recording::read_recording`] refuses all of them; this module
 //! is the only door, and its name says what it is.
 
-use crate::error::ReadError;
-use crate::record::schema::{self, Vector3Batch};
+use drift_recording::schema::{self, Vector3Batch};
+use drift_recording::ReadError;
 use std::path::Path;
 
 /// Per-activation truth series (per-sample systematic bias, °/s, X/Y/Z).

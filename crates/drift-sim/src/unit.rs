@@ -14,8 +14,7 @@ use serde::{Deserialize, Serialize};
 
 /// Reference temperature for the bias polynomial and the capsule pressure (°C).
 pub const REFERENCE_CELSIUS: f64 = 25.0;
-/// Temperature-sensor scale: raw units per °C (paper: 1° = 200 units).
-pub const RAW_PER_CELSIUS: f64 = 200.0;
+pub use drift_recording::RAW_PER_CELSIUS;
 /// Nominal supply voltage (V).
 pub const NOMINAL_SUPPLY_V: f64 = 5.0;
 

@@ -3,8 +3,8 @@
 
 mod common;
 
-use drift_sim::record::bench::create_recording;
-use drift_sim::record::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
+use drift_recording::create_recording;
+use drift_recording::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use drift_sim::{read_campaign_dir, read_recording, simulate_campaign, Campaign, ReadError};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -45,7 +45,7 @@ enum Fault {
 fn write(path: &Path, fault: Fault) {
     let mut f = if fault == Fault::NoSupplyTopic {
         // Register everything except the supply topic by hand.
-        let mut f = drift_sim::record::writer::McapFile::create(
+        let mut f = drift_recording::writer::McapFile::create(
             path,
             schema::PROFILE_RECORDING,
             mcap::Compression::Zstd,

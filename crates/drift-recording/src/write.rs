@@ -1,11 +1,12 @@
 //! Writing recordings in the bench format: used by the simulator, and by anything that
 //! converts real test-bench logs (give it [`Recording`] segments, get the same MCAP).
 
-use super::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
-use super::writer::McapFile;
-use crate::engine::AUX_RATE_HZ;
-use crate::error::SimError;
-use crate::read::{Recording, Segment};
+use crate::error::WriteError;
+use crate::layout::AUX_RATE_HZ;
+use crate::read::Recording;
+use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
+use crate::segment::Segment;
+use crate::writer::McapFile;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -16,7 +17,7 @@ use std::path::Path;
 pub fn create_recording(
     path: &Path,
     metadata: BTreeMap<String, String>,
-) -> Result<McapFile, SimError> {
+) -> Result<McapFile, WriteError> {
     let mut f = McapFile::create(path, schema::PROFILE_RECORDING, mcap::Compression::Zstd)?;
     f.add_topic(
         schema::TOPIC_RATE,
@@ -69,7 +70,7 @@ fn event(segment: &Segment, powered: bool) -> PowerEvent {
 /// Writes a whole recording (metadata and segments) to `path` in batches of 100 ms.
 /// Reading the result with [`crate::read_recording`] gives back an identical [`Recording`]
 /// (apart from `path`).
-pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, SimError> {
+pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteError> {
     let mut f = create_recording(path, recording.metadata.clone())?;
     for segment in &recording.segments {
         let fs = segment.sample_rate_hz;

@@ -7,10 +7,9 @@
 //! topic and the message's index within that topic.
 
 use crate::error::ReadError;
-use crate::record::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
-use crate::schedule::SeriesKind;
-use crate::simulate::{RECORDINGS_DIR, TRUTH_EXTENSION};
-use crate::unit::RAW_PER_CELSIUS;
+use crate::layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
+use crate::segment::{AuxChannel, Segment, SegmentLabels, SeriesKind};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
@@ -23,77 +22,6 @@ pub const REQUIRED_TOPICS: [&str; 6] = [
     schema::TOPIC_SET_POINT,
     schema::TOPIC_POWER,
 ];
-
-/// The labels of one activation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SegmentLabels {
-    /// Unit id (from the recording metadata).
-    pub unit_id: String,
-    /// Chamber set point at switch-on (°C).
-    pub set_point_celsius: f64,
-    /// Protocol or field.
-    pub series_kind: SeriesKind,
-    /// Series number within the file (from 1).
-    pub series: u32,
-    /// Repeat of the interval (from 1).
-    pub repeat: u32,
-    /// Activation number within the series (from 1; 1..5 in the paper's protocol).
-    pub activation: u32,
-    /// Protocol off-time between activations (min); `None` for field sessions.
-    pub interval_min: Option<f64>,
-    /// Off-time before this switch-on as logged by the bench (s); `None` if unknown.
-    pub off_before_s: Option<f64>,
-}
-
-/// An auxiliary channel of one activation, at its own rate.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AuxChannel {
-    /// Physical unit (`g`, `V`, `degC`).
-    pub unit: String,
-    /// Sample rate (Hz).
-    pub sample_rate_hz: u32,
-    /// Samples; sample `k` is at `k / sample_rate_hz` seconds after switch-on.
-    pub values: Vec<f32>,
-}
-
-/// One activation (switch-on to switch-off): what the fitter consumes.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Segment {
-    /// Labels.
-    pub labels: SegmentLabels,
-    /// Gyro/temperature sample rate (Hz).
-    pub sample_rate_hz: u32,
-    /// Switch-on time on the recording clock (ns).
-    pub power_on_ns: u64,
-    /// Per sample: index since switch-on (0 = switch-on); time = index / `sample_rate_hz`.
-    pub since_power_on: Vec<u32>,
-    /// Per sample: angular rate X, Y, Z (°/s).
-    pub rate_dps: [Vec<f32>; 3],
-    /// Per sample: raw temperature X, Y, Z (200 raw units per °C).
-    pub temperature_raw: [Vec<i16>; 3],
-    /// Auxiliary channels by name: `accel_x`, `accel_y`, `accel_z` (g), `supply_voltage`
-    /// (V), `chamber_set_point` (°C).
-    pub aux: BTreeMap<String, AuxChannel>,
-}
-
-impl Segment {
-    /// Number of gyro samples.
-    pub fn len(&self) -> usize {
-        self.since_power_on.len()
-    }
-    /// True if the segment has no samples.
-    pub fn is_empty(&self) -> bool {
-        self.since_power_on.is_empty()
-    }
-    /// Time since switch-on of sample `i` in integer milliseconds.
-    pub fn since_power_on_ms(&self, i: usize) -> u64 {
-        u64::from(self.since_power_on[i]) * 1000 / u64::from(self.sample_rate_hz)
-    }
-    /// Raw temperature of `axis` at sample `i` in °C.
-    pub fn temperature_celsius(&self, axis: usize, i: usize) -> f64 {
-        f64::from(self.temperature_raw[axis][i]) / RAW_PER_CELSIUS
-    }
-}
 
 /// A validated recording.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,7 +74,7 @@ pub fn is_truth_path(path: &Path) -> bool {
     let folder_says_truth = path
         .parent()
         .and_then(Path::file_name)
-        .is_some_and(|d| d == crate::simulate::TRUTH_DIR);
+        .is_some_and(|d| d == TRUTH_DIR);
     name_says_truth || folder_says_truth
 }
 
@@ -418,7 +346,7 @@ impl Reader<'_> {
         }
         let aux = |values: Vec<f32>, unit: &str| AuxChannel {
             unit: unit.into(),
-            sample_rate_hz: crate::engine::AUX_RATE_HZ,
+            sample_rate_hz: AUX_RATE_HZ,
             values,
         };
         let [ax, ay, az] = open.accel;
@@ -484,7 +412,7 @@ impl Reader<'_> {
         {
             rate_hz
         } else {
-            crate::engine::AUX_RATE_HZ
+            AUX_RATE_HZ
         };
         if rate != expected_rate {
             return Err(format!("sample_rate_hz {rate}, expected {expected_rate}"));

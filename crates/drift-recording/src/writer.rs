@@ -1,8 +1,8 @@
 //! An MCAP file being written: temp file in the target folder, renamed on success.
 
-use super::cdr::Encoder;
-use super::schema;
-use crate::error::SimError;
+use crate::cdr::Encoder;
+use crate::error::WriteError;
+use crate::schema;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
@@ -30,15 +30,15 @@ impl McapFile {
         path: &Path,
         profile: &str,
         compression: mcap::Compression,
-    ) -> Result<Self, SimError> {
+    ) -> Result<Self, WriteError> {
         let dir = path.parent().unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir).map_err(|e| SimError::io(dir, e))?;
+        std::fs::create_dir_all(dir).map_err(|e| WriteError::io(dir, e))?;
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         let temp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-        let file = File::create(&temp).map_err(|e| SimError::io(&temp, e))?;
+        let file = File::create(&temp).map_err(|e| WriteError::io(&temp, e))?;
         let writer = mcap::WriteOptions::new()
             .profile(profile)
             .library(concat!("drift-sim ", env!("CARGO_PKG_VERSION")))
@@ -49,7 +49,7 @@ impl McapFile {
             .compression_threads(0)
             .chunk_size(Some(CHUNK_BYTES))
             .create(BufWriter::with_capacity(1 << 20, file))
-            .map_err(|e| SimError::mcap(&temp, e))?;
+            .map_err(|e| WriteError::mcap(&temp, e))?;
         Ok(Self {
             writer: Some(writer),
             temp,
@@ -60,11 +60,11 @@ impl McapFile {
         })
     }
 
-    fn w(&mut self) -> Result<&mut mcap::Writer<BufWriter<File>>, SimError> {
+    fn w(&mut self) -> Result<&mut mcap::Writer<BufWriter<File>>, WriteError> {
         let temp = self.temp.clone();
         self.writer
             .as_mut()
-            .ok_or_else(|| SimError::Finished { path: temp })
+            .ok_or_else(|| WriteError::Finished { path: temp })
     }
 
     /// Registers a topic with a schema and channel metadata (e.g. `unit`).
@@ -73,7 +73,7 @@ impl McapFile {
         topic: &'static str,
         schema: (&str, &str),
         metadata: &[(&str, &str)],
-    ) -> Result<(), SimError> {
+    ) -> Result<(), WriteError> {
         let temp = self.temp.clone();
         let meta: BTreeMap<String, String> = metadata
             .iter()
@@ -82,10 +82,10 @@ impl McapFile {
         let w = self.w()?;
         let schema_id = w
             .add_schema(schema.0, "ros2msg", schema.1.as_bytes())
-            .map_err(|e| SimError::mcap(&temp, e))?;
+            .map_err(|e| WriteError::mcap(&temp, e))?;
         let id = w
             .add_channel(schema_id, topic, "cdr", &meta)
-            .map_err(|e| SimError::mcap(&temp, e))?;
+            .map_err(|e| WriteError::mcap(&temp, e))?;
         self.channels.insert(topic, id);
         Ok(())
     }
@@ -95,22 +95,26 @@ impl McapFile {
         &mut self,
         name: &str,
         entries: BTreeMap<String, String>,
-    ) -> Result<(), SimError> {
+    ) -> Result<(), WriteError> {
         let temp = self.temp.clone();
         self.w()?
             .write_metadata(&mcap::records::Metadata {
                 name: name.to_owned(),
                 metadata: entries,
             })
-            .map_err(|e| SimError::mcap(&temp, e))
+            .map_err(|e| WriteError::mcap(&temp, e))
     }
 
     /// Writes the message currently in `self.enc` on `topic` at `log_time_ns`.
-    pub fn write_encoded(&mut self, topic: &'static str, log_time_ns: u64) -> Result<(), SimError> {
+    pub fn write_encoded(
+        &mut self,
+        topic: &'static str,
+        log_time_ns: u64,
+    ) -> Result<(), WriteError> {
         let channel_id = *self
             .channels
             .get(topic)
-            .ok_or_else(|| SimError::UnknownTopic {
+            .ok_or_else(|| WriteError::UnknownTopic {
                 topic: topic.to_owned(),
             })?;
         self.sequence = self.sequence.wrapping_add(1);
@@ -124,35 +128,39 @@ impl McapFile {
         let writer = self
             .writer
             .as_mut()
-            .ok_or_else(|| SimError::Finished { path: temp.clone() })?;
+            .ok_or_else(|| WriteError::Finished { path: temp.clone() })?;
         writer
             .write_to_known_channel(&header, self.enc.bytes())
-            .map_err(|e| SimError::mcap(&temp, e))
+            .map_err(|e| WriteError::mcap(&temp, e))
     }
 
     /// Writes a power event.
-    pub fn power(&mut self, event: &schema::PowerEvent, log_time_ns: u64) -> Result<(), SimError> {
+    pub fn power(
+        &mut self,
+        event: &schema::PowerEvent,
+        log_time_ns: u64,
+    ) -> Result<(), WriteError> {
         event.encode(&mut self.enc);
         self.write_encoded(schema::TOPIC_POWER, log_time_ns)
     }
 
     /// Finishes the MCAP (summary, footer), flushes, and renames into place. Returns bytes.
-    pub fn finish(mut self) -> Result<u64, SimError> {
+    pub fn finish(mut self) -> Result<u64, WriteError> {
         let temp = self.temp.clone();
         let mut writer = self
             .writer
             .take()
-            .ok_or_else(|| SimError::Finished { path: temp.clone() })?;
+            .ok_or_else(|| WriteError::Finished { path: temp.clone() })?;
         // finish() writes the summary and footer; its error must not be lost in Drop.
-        writer.finish().map_err(|e| SimError::mcap(&temp, e))?;
+        writer.finish().map_err(|e| WriteError::mcap(&temp, e))?;
         let buffered = writer.into_inner();
         let file = buffered
             .into_inner()
-            .map_err(|e| SimError::io(&temp, e.into_error()))?;
-        file.sync_all().map_err(|e| SimError::io(&temp, e))?;
-        let bytes = file.metadata().map_err(|e| SimError::io(&temp, e))?.len();
+            .map_err(|e| WriteError::io(&temp, e.into_error()))?;
+        file.sync_all().map_err(|e| WriteError::io(&temp, e))?;
+        let bytes = file.metadata().map_err(|e| WriteError::io(&temp, e))?.len();
         drop(file);
-        std::fs::rename(&temp, &self.path).map_err(|e| SimError::io(&self.path, e))?;
+        std::fs::rename(&temp, &self.path).map_err(|e| WriteError::io(&self.path, e))?;
         Ok(bytes)
     }
 }

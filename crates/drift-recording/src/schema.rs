@@ -6,7 +6,7 @@
 //! compact binary layout, which JSON is not: see `docs/recording-format.md` for the sizes
 //! and throughputs that decided it.
 
-use super::cdr::{DecodeError, Decoder, Encoder};
+use crate::cdr::{DecodeError, Decoder, Encoder};
 
 /// Gyro angular rates, °/s, per sample (batch of consecutive samples).
 pub const TOPIC_RATE: &str = "/gyro/rate";
