@@ -3,6 +3,9 @@
 use clap::{Parser, Subcommand};
 
 pub mod demo;
+pub mod fit;
+mod progress;
+pub mod report;
 pub mod simulate;
 
 /// Temperature-drift correction for MEMS gyroscopes.
@@ -21,6 +24,10 @@ pub enum Command {
     Demo(demo::Args),
     /// Simulate a calibration campaign and record it as MCAP files.
     Simulate(simulate::Args),
+    /// Fit the paper's tables and the baselines from recordings.
+    Fit(fit::Args),
+    /// Fit, evaluate on data the fit did not see, and write the report.
+    Report(report::Args),
 }
 
 /// Runs one parsed command line.
@@ -28,5 +35,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Demo(args) => demo::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Fit(args) => fit::run(&args),
+        Command::Report(args) => report::run(&args),
     }
 }

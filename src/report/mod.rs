@@ -105,3 +105,12 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
 pub(crate) fn of_split(records: &[Record], split: Split) -> impl Iterator<Item = &Record> {
     records.iter().filter(move |r| r.split == split)
 }
+
+/// The headline table (Markdown), for printing.
+pub fn headline_text(
+    records: &[Record],
+    fitted: &[FittedUnit],
+    noise_floor_units: &[String],
+) -> String {
+    tables::headline(records, fitted, noise_floor_units)
+}

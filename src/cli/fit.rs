@@ -1,0 +1,110 @@
+//! `gyrodrift fit`: recordings → the paper's tables and the baselines, as JSON and firmware images.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use drift_core::blob::{encode, Image};
+use drift_fit::{FitSettings, FittedUnit};
+
+use super::progress::Steps;
+use crate::output::write_atomic;
+use crate::pipeline::{self, Options};
+
+/// Options of `gyrodrift fit`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Campaign folder (with `recordings/`) or a folder of `.mcap` recordings.
+    pub campaign: PathBuf,
+    /// Chamber set points to fit, °C (protocol activations only).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "30,40",
+        allow_hyphen_values = true
+    )]
+    pub calibration: Vec<f64>,
+    /// Output folder: one subfolder per unit.
+    #[arg(long, short = 'o', default_value = "out/tables")]
+    pub out: PathBuf,
+    /// Fit settings as JSON (fields of `drift_fit::FitSettings`; missing fields keep defaults).
+    #[arg(long)]
+    pub settings: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// Reads fit settings from a JSON file, or the defaults.
+pub fn load_settings(path: Option<&Path>) -> anyhow::Result<FitSettings> {
+    match path {
+        None => Ok(FitSettings::default()),
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading {}", path.display()))?;
+            serde_json::from_str(&text)
+                .with_context(|| format!("{}: not valid fit settings", path.display()))
+        }
+    }
+}
+
+fn image<M: Image>(model: &M) -> anyhow::Result<Vec<u8>> {
+    let mut buffer = vec![0; 1 << 20];
+    let len = encode(model, &mut buffer).map_err(|e| anyhow::anyhow!("{e}"))?;
+    buffer.truncate(len);
+    Ok(buffer)
+}
+
+/// Writes each unit's models as `<out>/<unit>/{modified,standard,third_order}.{json,bin}`.
+pub fn write_tables(out: &Path, fitted: &[FittedUnit]) -> anyhow::Result<()> {
+    for unit in fitted {
+        let dir = out.join(&unit.unit_id);
+        write_atomic(
+            &dir.join("modified.json"),
+            serde_json::to_string_pretty(&unit.modified)?.as_bytes(),
+        )?;
+        write_atomic(&dir.join("modified.bin"), &image(&unit.modified)?)?;
+        for (name, model) in [
+            ("standard", &unit.standard),
+            ("third_order", &unit.third_order),
+        ] {
+            write_atomic(
+                &dir.join(format!("{name}.json")),
+                serde_json::to_string_pretty(model)?.as_bytes(),
+            )?;
+            write_atomic(&dir.join(format!("{name}.bin")), &image(model)?)?;
+        }
+    }
+    Ok(())
+}
+
+/// Runs `gyrodrift fit`.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let settings = load_settings(args.settings.as_deref())?;
+    let files = pipeline::recording_files(&args.campaign)?;
+    let options = Options {
+        calibration_set_points: args.calibration.clone(),
+        validation_set_points: Vec::new(),
+        fit: settings,
+        held_out_repeats: false,
+    };
+    let steps = Steps::new(args.quiet);
+    let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;
+    steps.finish();
+    write_tables(&args.out, &outcome.fitted)?;
+    for unit in &outcome.fitted {
+        let refs: Vec<String> = unit.modified.axes[0]
+            .reference_ms
+            .iter()
+            .map(|ms| format!("{}", f64::from(*ms) / 1000.0))
+            .collect();
+        println!(
+            "{}: {} curves × {} ambients, reference times (X) {} s → {}",
+            unit.unit_id,
+            unit.curve_keys.len(),
+            unit.modified.axes[0].ambients.len(),
+            refs.join(", "),
+            args.out.join(&unit.unit_id).display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,229 @@
+//! The main job, one way through: recordings → segments → fitted tables → corrector → residual →
+//! report data.
+//!
+//! Recordings are read twice, file by file, so memory holds one file's samples at a time: the first
+//! pass analyses the calibration activations (small curves) for the fits, the second corrects every
+//! activation the fits did not see. Validation set points, field sessions and the noise-floor unit
+//! never reach a fit; at calibration set points each repeat is evaluated with tables refitted
+//! without it.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use drift_fit::analyse::{analyse, Analysed};
+use drift_fit::evaluate::{evaluate, ActivationResult};
+use drift_fit::summary::Split;
+use drift_fit::{fit_unit, FitSettings, FittedUnit};
+use drift_recording::{read_recording, Segment, SeriesKind, RECORDINGS_DIR};
+use rayon::prelude::*;
+
+/// What to fit on and what to evaluate on.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Chamber set points whose protocol activations are fitted, °C.
+    pub calibration_set_points: Vec<f64>,
+    /// Chamber set points evaluated only, °C (never fitted).
+    pub validation_set_points: Vec<f64>,
+    /// Fitting settings.
+    pub fit: FitSettings,
+    /// Evaluate each repeat at the calibration set points with tables refitted without it.
+    pub held_out_repeats: bool,
+}
+
+/// Everything the report needs.
+#[derive(Debug, Default)]
+pub struct Outcome {
+    /// Tables fitted on all calibration activations, per unit.
+    pub fitted: Vec<FittedUnit>,
+    /// The calibration activations, analysed.
+    pub calibration: Vec<Analysed>,
+    /// Evaluation results with their split.
+    pub results: Vec<(Split, ActivationResult)>,
+    /// Step durations, seconds.
+    pub timings: Vec<(String, f64)>,
+    /// Samples read in the first pass.
+    pub samples_read: u64,
+}
+
+/// Reports progress: (step, done, total).
+pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
+
+fn is_one_of(set_point: f64, list: &[f64]) -> bool {
+    list.iter().any(|s| (s - set_point).abs() < 1e-6)
+}
+
+/// The recordings of a campaign folder (or of a folder of `.mcap` files), sorted by name.
+pub fn recording_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let folder = if dir.join(RECORDINGS_DIR).is_dir() {
+        dir.join(RECORDINGS_DIR)
+    } else {
+        dir.to_path_buf()
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
+        .with_context(|| format!("listing recordings in {}", folder.display()))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "mcap") && !drift_recording::is_truth_path(p)
+        })
+        .collect();
+    files.sort();
+    anyhow::ensure!(
+        !files.is_empty(),
+        "no .mcap recordings in {}",
+        folder.display()
+    );
+    Ok(files)
+}
+
+fn calibration_segment(segment: &Segment, options: &Options) -> bool {
+    segment.labels.series_kind == SeriesKind::Protocol
+        && is_one_of(
+            segment.labels.set_point_celsius,
+            &options.calibration_set_points,
+        )
+}
+
+/// Fits every unit found in `files` and evaluates on everything the fits did not see.
+/// With `noise_floor`, the units have no systematic drift: their validation results are labelled
+/// [`Split::NoiseFloor`] and nothing else of theirs is evaluated.
+pub fn run(
+    files: &[PathBuf],
+    options: &Options,
+    noise_floor: bool,
+    progress: Progress<'_>,
+) -> anyhow::Result<Outcome> {
+    let mut outcome = Outcome::default();
+    let settings = &options.fit;
+
+    // Pass 1: read, analyse calibration activations.
+    let mut read_seconds = 0.0;
+    let mut analyse_seconds = 0.0;
+    let mut by_unit: BTreeMap<String, Vec<Analysed>> = BTreeMap::new();
+    for (i, path) in files.iter().enumerate() {
+        progress(
+            "reading and analysing calibration recordings",
+            i as u64,
+            files.len() as u64,
+        );
+        let started = Instant::now();
+        let recording = read_recording(path)?;
+        read_seconds += started.elapsed().as_secs_f64();
+        outcome.samples_read += recording
+            .segments
+            .iter()
+            .map(|s| s.len() as u64)
+            .sum::<u64>();
+        let started = Instant::now();
+        let analysed: Vec<Analysed> = recording
+            .segments
+            .par_iter()
+            .filter(|s| calibration_segment(s, options))
+            .map(|s| analyse(s, settings))
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("analysing {}", path.display()))?;
+        analyse_seconds += started.elapsed().as_secs_f64();
+        by_unit
+            .entry(recording.unit_id.clone())
+            .or_default()
+            .extend(analysed);
+    }
+    progress(
+        "reading and analysing calibration recordings",
+        files.len() as u64,
+        files.len() as u64,
+    );
+
+    // Fits: all calibration data, and one per left-out repeat.
+    let started = Instant::now();
+    let mut held_out: BTreeMap<(String, u32), FittedUnit> = BTreeMap::new();
+    for (unit, analysed) in &by_unit {
+        anyhow::ensure!(
+            !analysed.is_empty(),
+            "unit {unit}: no protocol activations at the calibration set points {:?}",
+            options.calibration_set_points
+        );
+        outcome.fitted.push(fit_unit(analysed, settings)?);
+        if options.held_out_repeats {
+            let repeats: BTreeSet<u32> = analysed.iter().map(|a| a.labels.repeat).collect();
+            if repeats.len() > 1 {
+                for &repeat in &repeats {
+                    let rest: Vec<Analysed> = analysed
+                        .iter()
+                        .filter(|a| a.labels.repeat != repeat)
+                        .cloned()
+                        .collect();
+                    held_out.insert((unit.clone(), repeat), fit_unit(&rest, settings)?);
+                }
+            }
+        }
+    }
+    let fit_seconds = started.elapsed().as_secs_f64();
+
+    // Pass 2: evaluate everything no fit saw.
+    let started = Instant::now();
+    for (i, path) in files.iter().enumerate() {
+        progress("correcting and evaluating", i as u64, files.len() as u64);
+        let recording = read_recording(path)?;
+        let Some(fitted) = outcome
+            .fitted
+            .iter()
+            .find(|f| f.unit_id == recording.unit_id)
+        else {
+            continue;
+        };
+        let results: Vec<(Split, ActivationResult)> = recording
+            .segments
+            .par_iter()
+            .filter_map(|segment| {
+                let labels = &segment.labels;
+                let validation =
+                    is_one_of(labels.set_point_celsius, &options.validation_set_points);
+                let (split, model) = if noise_floor {
+                    // The noise floor is measured where the other units are validated.
+                    if !validation {
+                        return None;
+                    }
+                    (Split::NoiseFloor, fitted)
+                } else if labels.series_kind == SeriesKind::Field {
+                    (Split::Field, fitted)
+                } else if validation {
+                    (Split::Validation, fitted)
+                } else if calibration_segment(segment, options) {
+                    (
+                        Split::HeldOutRepeat,
+                        held_out.get(&(recording.unit_id.clone(), labels.repeat))?,
+                    )
+                } else {
+                    return None;
+                };
+                Some((split, evaluate(model, segment, settings)))
+            })
+            .collect();
+        outcome.results.extend(results);
+    }
+    progress(
+        "correcting and evaluating",
+        files.len() as u64,
+        files.len() as u64,
+    );
+    let evaluate_seconds = started.elapsed().as_secs_f64();
+    outcome.calibration = by_unit.into_values().flatten().collect();
+    outcome.timings = vec![
+        ("read recordings (pass 1)".into(), read_seconds),
+        ("analyse calibration activations".into(), analyse_seconds),
+        (
+            format!(
+                "fit tables ({} units, with refits per left-out repeat)",
+                outcome.fitted.len()
+            ),
+            fit_seconds,
+        ),
+        (
+            "read again, correct and evaluate (pass 2)".into(),
+            evaluate_seconds,
+        ),
+    ];
+    Ok(outcome)
+}
