@@ -66,6 +66,13 @@ run_ruff() {
     "$VENV/bin/ruff" format --check crates/drift-py
 }
 
+run_recording_read_test() {
+    # The Python `mcap` package must read what `gyrodrift simulate` writes (issue 3).
+    "$VENV/bin/python" -m pip install --quiet mcap mcap-ros2-support
+    cargo build --quiet --release --locked -p gyrodrift
+    GYRODRIFT_BIN=target/release/gyrodrift "$VENV/bin/python" -m pytest crates/drift-sim/tests/python -q -p no:cacheprovider
+}
+
 run_examples() {
     for script in crates/drift-py/examples/*.py; do
         echo "--- $script"
@@ -82,6 +89,7 @@ step "stubtest gyrodrift._gyrodrift" run_stubtest
 step "mypy --strict examples and bench" run_mypy_examples
 step "ruff check and format --check" run_ruff
 step "examples" run_examples
+step "Python mcap reads gyrodrift recordings" run_recording_read_test
 
 printf '\n=== timings\n'
 printf '%s\n' "${TIMES[@]}"

@@ -38,6 +38,9 @@ step "tests: workspace (all features) and drift-core without default features"
 cargo test --workspace --all-features --locked
 cargo test -p drift-core --no-default-features --locked --lib
 
+step "benches: every criterion bench once, quickly (they must not rot)"
+cargo bench --workspace --locked -- --test
+
 step "docs: rustdoc without warnings"
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
 
@@ -48,7 +51,10 @@ step "firmware: clippy, build, and the shared test vectors on QEMU mps2-an386 (C
 step "firmware: executed instructions per 3-axis sample (deterministic; floor 1500)"
 python3 scripts/count-instructions.py --max-modified 1500
 
+step "Python: drift-py in a fresh venv (pip install, pytest, stubtest, mypy, ruff, examples) and the mcap read test"
+./scripts/check-python.sh
+
 step "main job: README's demo command"
-cargo run --release --locked -- demo
+cargo run --release --locked -- demo --quiet
 
 printf '\nAll checks passed.\n'

@@ -16,7 +16,7 @@ use drift_fit::analyse::{analyse, Analysed};
 use drift_fit::evaluate::{evaluate, ActivationResult};
 use drift_fit::summary::Split;
 use drift_fit::{fit_unit, FitSettings, FittedUnit};
-use drift_recording::{read_recording, Segment, SeriesKind, RECORDINGS_DIR};
+use drift_recording::{read_metadata, read_recording, Segment, SeriesKind, RECORDINGS_DIR};
 use rayon::prelude::*;
 
 /// What to fit on and what to evaluate on.
@@ -30,6 +30,8 @@ pub struct Options {
     pub fit: FitSettings,
     /// Evaluate each repeat at the calibration set points with tables refitted without it.
     pub held_out_repeats: bool,
+    /// Run the evaluation pass at all (`false`: fit only; nothing else is read).
+    pub evaluate: bool,
 }
 
 /// Everything the report needs.
@@ -77,6 +79,24 @@ pub fn recording_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     Ok(files)
 }
 
+/// Whether a recording's metadata says it may hold calibration activations. Files whose metadata
+/// lacks the set point or series kind are read in full (the segments' own labels then decide).
+fn may_hold_calibration(path: &Path, options: &Options) -> anyhow::Result<bool> {
+    let metadata = read_metadata(path)?;
+    let set_point = metadata
+        .get("set_point_celsius")
+        .and_then(|s| s.parse::<f64>().ok());
+    let kind = metadata
+        .get("series_kind")
+        .and_then(|s| SeriesKind::parse(s));
+    Ok(match (set_point, kind) {
+        (Some(set_point), Some(kind)) => {
+            kind == SeriesKind::Protocol && is_one_of(set_point, &options.calibration_set_points)
+        }
+        _ => true,
+    })
+}
+
 fn calibration_segment(segment: &Segment, options: &Options) -> bool {
     segment.labels.series_kind == SeriesKind::Protocol
         && is_one_of(
@@ -108,6 +128,10 @@ pub fn run(
             files.len() as u64,
         );
         let started = Instant::now();
+        if !may_hold_calibration(path, options)? {
+            // Validation and field recordings are never decoded for the fit.
+            continue;
+        }
         let recording = read_recording(path)?;
         read_seconds += started.elapsed().as_secs_f64();
         outcome.samples_read += recording
@@ -133,6 +157,13 @@ pub fn run(
         "reading and analysing calibration recordings",
         files.len() as u64,
         files.len() as u64,
+    );
+
+    anyhow::ensure!(
+        !by_unit.is_empty(),
+        "no protocol activations at the calibration set points {:?} °C in {} recordings",
+        options.calibration_set_points,
+        files.len()
     );
 
     // Fits: all calibration data, and one per left-out repeat.
@@ -163,7 +194,8 @@ pub fn run(
 
     // Pass 2: evaluate everything no fit saw.
     let started = Instant::now();
-    for (i, path) in files.iter().enumerate() {
+    let evaluated = if options.evaluate { files } else { &[] };
+    for (i, path) in evaluated.iter().enumerate() {
         progress("correcting and evaluating", i as u64, files.len() as u64);
         let recording = read_recording(path)?;
         let Some(fitted) = outcome

@@ -10,45 +10,71 @@ fn gyrodrift() -> Command {
 }
 
 #[test]
-fn demo_checks_the_vectors_and_writes_decodable_images() {
+fn simulate_fit_and_report_from_the_command_line() {
     let dir = tempfile::tempdir().unwrap();
-    let out = gyrodrift()
-        .args(["demo", "--out"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        stdout.contains("outputs differing from the shared vectors: 0"),
-        "{stdout}"
-    );
-    let modified = std::fs::read(dir.path().join("modified.bin")).unwrap();
-    let tables: ModifiedTables = decode(&modified).unwrap();
-    assert_eq!(tables.axes[0].ambients.len(), 3);
+    let campaign = dir.path().join("campaign");
+    let run = |args: &[&str]| {
+        let out = gyrodrift().args(args).output().unwrap();
+        let text = format!(
+            "{}\n{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(out.status.success(), "{args:?}: {text}");
+        text
+    };
+    let c = campaign.to_str().unwrap();
+    run(&[
+        "simulate",
+        "-q",
+        "-o",
+        c,
+        "--units",
+        "1",
+        "--set-points",
+        "30,40,33",
+        "--intervals",
+        "1,30",
+        "--repeats",
+        "2",
+        "--seed",
+        "3",
+    ]);
+    let tables = dir.path().join("tables");
+    let text = run(&["fit", c, "-q", "-o", tables.to_str().unwrap()]);
+    assert!(text.contains("GIU-01: 5 curves"), "{text}");
+    let modified = std::fs::read(tables.join("GIU-01/modified.bin")).unwrap();
+    let decoded: ModifiedTables = decode(&modified).unwrap();
+    let json: ModifiedTables = serde_json::from_str(
+        &std::fs::read_to_string(tables.join("GIU-01/modified.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(decoded, json);
     for name in ["standard", "third_order"] {
-        let bytes = std::fs::read(dir.path().join(format!("{name}.bin"))).unwrap();
+        let bytes = std::fs::read(tables.join(format!("GIU-01/{name}.bin"))).unwrap();
         assert!(decode::<PolynomialTables>(&bytes).is_ok(), "{name}");
     }
+    let report = dir.path().join("report");
+    let text = run(&["report", c, "-q", "-o", report.to_str().unwrap()]);
+    assert!(text.contains("| +33 °C | validation |"), "{text}");
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(
+        md.contains("## Drift per unit and axis (the paper's Table)")
+            && md.contains("fig-correlation.svg"),
+        "{md}"
+    );
+    assert!(report.join("fig-correlation.svg").exists() && report.join("report.json").exists());
 }
 
 #[test]
-fn demo_reports_an_unwritable_output_folder() {
-    let dir = tempfile::tempdir().unwrap();
-    let blocker = dir.path().join("file");
-    std::fs::write(&blocker, b"not a folder").unwrap();
+fn fit_names_a_missing_campaign_folder() {
     let out = gyrodrift()
-        .args(["demo", "--out"])
-        .arg(blocker.join("sub"))
+        .args(["fit", "/nonexistent/campaign", "-q"])
         .output()
         .unwrap();
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("creating directory"), "{stderr}");
+    assert!(stderr.contains("/nonexistent/campaign"), "{stderr}");
 }
 
 #[test]

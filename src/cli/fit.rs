@@ -86,6 +86,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         validation_set_points: Vec::new(),
         fit: settings,
         held_out_repeats: false,
+        evaluate: false,
     };
     let steps = Steps::new(args.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;

@@ -122,6 +122,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         validation_set_points: args.validation.clone(),
         fit: load_settings(args.settings.as_deref())?,
         held_out_repeats: true,
+        evaluate: true,
     };
     let provenance = vec![format!(
         "Recordings: `{}`; calibration {:?} °C, validation {:?} °C.",

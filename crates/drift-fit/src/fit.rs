@@ -17,6 +17,8 @@ use crate::settings::FitSettings;
 const MAX_REFERENCES: usize = 16;
 const MAX_AMBIENTS: usize = 12;
 const MAX_CURVES: usize = 32;
+/// Smallest temperature rise (°C) that counts as heating: ten raw sensor steps.
+const MIN_RISE_CELSIUS: f64 = 0.05;
 
 /// Everything fitted for one unit.
 #[derive(Debug, Clone, PartialEq)]
@@ -160,6 +162,20 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
         )));
     }
     let window = settings.reference_window_points;
+    // Without heating there is nothing to correlate the drift with: say so instead of fitting k = 0.
+    for axis in 0..3 {
+        let heated = set_points.iter().flat_map(|sp| sp.curves.iter()).any(|c| {
+            c.rise_celsius[axis]
+                .iter()
+                .any(|r| r.abs() >= MIN_RISE_CELSIUS)
+        });
+        if !heated {
+            return Err(insufficient(format!(
+                "axis {}: the temperature never rises by {MIN_RISE_CELSIUS} °C in any activation (stuck or missing temperature sensor?): no heating to correlate the drift with",
+                ["X", "Y", "Z"][axis]
+            )));
+        }
+    }
     let mut axes: [AxisTable<MAX_REFERENCES, MAX_AMBIENTS, MAX_CURVES>; 3] = Default::default();
     for (axis, table) in axes.iter_mut().enumerate() {
         let knots = choose(&set_points, axis, first, settings.reference_count, window);

@@ -107,3 +107,42 @@ fn noise_free_fit_removes_nearly_all_drift_at_an_unseen_set_point() {
         after[2]
     );
 }
+
+#[test]
+fn no_temperature_rise_is_a_clear_error() {
+    let settings = FitSettings::default();
+    let mut calibration = Vec::new();
+    for set_point in [30.0, 40.0] {
+        let mut s = segment(set_point, 30.0, 1);
+        // A stuck sensor on Y: the same reading throughout.
+        let stuck = s.temperature_raw[1][0];
+        s.temperature_raw[1].iter_mut().for_each(|r| *r = stuck);
+        calibration.push(analyse(&s, &settings).unwrap());
+    }
+    let error = fit_unit(&calibration, &settings).unwrap_err().to_string();
+    assert!(
+        error.contains("axis Y") && error.contains("never rises"),
+        "{error}"
+    );
+}
+
+#[test]
+fn mismatched_axis_lengths_and_short_activations_are_named() {
+    let settings = FitSettings::default();
+    let mut s = segment(30.0, 1.0, 2);
+    s.rate_dps[2].truncate(1000);
+    let error = analyse(&s, &settings).unwrap_err().to_string();
+    assert!(
+        error.contains("series 1 activation 2") && error.contains("differ in length"),
+        "{error}"
+    );
+
+    let mut s = segment(30.0, 1.0, 3);
+    for axis in 0..3 {
+        s.rate_dps[axis].truncate(1500);
+        s.temperature_raw[axis].truncate(1500);
+    }
+    s.since_power_on.truncate(1500);
+    let error = analyse(&s, &settings).unwrap_err().to_string();
+    assert!(error.contains("1500 samples is too short"), "{error}");
+}

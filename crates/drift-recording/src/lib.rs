@@ -18,6 +18,8 @@ pub mod writer;
 
 pub use error::{ReadError, WriteError};
 pub use layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
-pub use read::{is_truth_path, read_campaign_dir, read_recording, Recording, REQUIRED_TOPICS};
+pub use read::{
+    is_truth_path, read_campaign_dir, read_metadata, read_recording, Recording, REQUIRED_TOPICS,
+};
 pub use segment::{AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS};
 pub use write::{create_recording, write_recording};

@@ -95,8 +95,16 @@ struct TopicState {
     last_ns: Option<u64>,
 }
 
-/// Reads and validates one recording.
-pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
+/// A recording's bytes, opened and checked up to its metadata: not ground truth, has a summary,
+/// every required topic and the `gyrodrift.recording` metadata.
+struct Opened {
+    buf: Vec<u8>,
+    metadata: BTreeMap<String, String>,
+    unit_id: String,
+    sample_rate_hz: u32,
+}
+
+fn open(path: &Path) -> Result<Opened, ReadError> {
     if is_truth_path(path) {
         return Err(ReadError::GroundTruth {
             path: path.to_path_buf(),
@@ -179,7 +187,33 @@ pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
             "sample_rate_hz must divide 10⁹, got {sample_rate_hz}"
         )));
     }
+    Ok(Opened {
+        buf,
+        metadata,
+        unit_id,
+        sample_rate_hz,
+    })
+}
 
+/// Reads a recording's metadata (unit id, chamber set point, series kind, ...) without decoding its
+/// messages: how the fitter picks calibration files without decoding anything else. The same
+/// checks as [`read_recording`] up to the metadata (ground truth is refused).
+pub fn read_metadata(path: &Path) -> Result<BTreeMap<String, String>, ReadError> {
+    Ok(open(path)?.metadata)
+}
+
+/// Reads and validates one recording.
+pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
+    let Opened {
+        buf,
+        metadata,
+        unit_id,
+        sample_rate_hz,
+    } = open(path)?;
+    let mcap_err = |e| ReadError::Mcap {
+        path: path.to_path_buf(),
+        source: e,
+    };
     let mut reader = Reader {
         path,
         unit_id: &unit_id,

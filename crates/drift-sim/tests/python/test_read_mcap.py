@@ -1,11 +1,8 @@
 """The Python `mcap` package reads what `gyrodrift simulate` writes.
 
-Setup (from the repository root), as in scripts/check.sh:
+Run by scripts/check-python.sh (its fresh venv gets `mcap mcap-ros2-support pytest`):
 
-    python3 -m venv .venv
-    .venv/bin/pip install mcap mcap-ros2-support pytest
-    cargo build -p gyrodrift
-    GYRODRIFT_BIN=target/debug/gyrodrift .venv/bin/pytest crates/drift-sim/tests/python
+    GYRODRIFT_BIN=target/release/gyrodrift .venv-check/bin/python -m pytest crates/drift-sim/tests/python
 
 Without GYRODRIFT_BIN the test runs `cargo run -q -p gyrodrift --` itself.
 """
