@@ -4,10 +4,10 @@
 use std::path::Path;
 
 use drift_fit::evaluate::ModelKind;
+use drift_fit::pipeline::{self, Options, Outcome};
 use drift_fit::summary::{summarise, Split};
 use drift_fit::FitSettings;
 use drift_sim::{simulate_campaign, Campaign, Protocol};
-use gyrodrift::pipeline::{self, Options, Outcome};
 
 fn small(seed: u64, noise_scale: f64) -> Campaign {
     Campaign {

@@ -12,7 +12,7 @@ use drift_sim::{Campaign, Field, Protocol, UnitModel};
 
 use super::progress::Steps;
 use super::report::{make, print_headline};
-use crate::pipeline::Options;
+use drift_fit::pipeline::Options;
 
 /// Options of `gyrodrift demo`.
 #[derive(Debug, clap::Args)]

@@ -8,7 +8,7 @@ use drift_fit::{FitSettings, FittedUnit};
 
 use super::progress::Steps;
 use crate::output::write_atomic;
-use crate::pipeline::{self, Options};
+use drift_fit::pipeline::{self, Options};
 
 /// Options of `gyrodrift fit`.
 #[derive(Debug, clap::Args)]

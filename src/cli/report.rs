@@ -6,8 +6,8 @@ use drift_fit::summary::Split;
 
 use super::fit::{load_settings, write_tables};
 use super::progress::Steps;
-use crate::pipeline::{self, Options, Outcome};
 use crate::report::{write_report, ReportInput};
+use drift_fit::pipeline::{self, Options, Outcome};
 
 /// Options of `gyrodrift report`.
 #[derive(Debug, clap::Args)]

@@ -11,13 +11,50 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::Context;
-use drift_fit::analyse::{analyse, Analysed};
-use drift_fit::evaluate::{evaluate, ActivationResult};
-use drift_fit::summary::Split;
-use drift_fit::{fit_unit, FitSettings, FittedUnit};
-use drift_recording::{read_metadata, read_recording, Segment, SeriesKind, RECORDINGS_DIR};
+use drift_recording::{
+    read_metadata, read_recording, ReadError, Segment, SeriesKind, RECORDINGS_DIR,
+};
 use rayon::prelude::*;
+
+use crate::analyse::{analyse, Analysed};
+use crate::error::FitError;
+use crate::evaluate::{evaluate, ActivationResult};
+use crate::fit::{fit_unit, FittedUnit};
+use crate::settings::FitSettings;
+use crate::summary::Split;
+
+/// Why the pipeline stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// A folder could not be listed.
+    #[error("listing recordings in {path}: {source}")]
+    List {
+        /// The folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A folder holds no recordings.
+    #[error("no .mcap recordings in {path}")]
+    NoRecordings {
+        /// The folder.
+        path: PathBuf,
+    },
+    /// A recording failed to read or validate (the error names file, topic and message).
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    /// Analysing or fitting failed (the error names the unit and activation).
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    /// None of the recordings has protocol activations at the calibration set points.
+    #[error("no protocol activations at the calibration set points {set_points:?} °C in {files} recordings")]
+    NoCalibration {
+        /// The calibration set points asked for.
+        set_points: Vec<f64>,
+        /// How many recordings were looked at.
+        files: usize,
+    },
+}
 
 /// What to fit on and what to evaluate on.
 #[derive(Debug, Clone)]
@@ -57,31 +94,32 @@ fn is_one_of(set_point: f64, list: &[f64]) -> bool {
 }
 
 /// The recordings of a campaign folder (or of a folder of `.mcap` files), sorted by name.
-pub fn recording_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+pub fn recording_files(dir: &Path) -> Result<Vec<PathBuf>, PipelineError> {
     let folder = if dir.join(RECORDINGS_DIR).is_dir() {
         dir.join(RECORDINGS_DIR)
     } else {
         dir.to_path_buf()
     };
     let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
-        .with_context(|| format!("listing recordings in {}", folder.display()))?
+        .map_err(|source| PipelineError::List {
+            path: folder.clone(),
+            source,
+        })?
         .filter_map(|entry| entry.ok().map(|e| e.path()))
         .filter(|p| {
             p.extension().is_some_and(|e| e == "mcap") && !drift_recording::is_truth_path(p)
         })
         .collect();
     files.sort();
-    anyhow::ensure!(
-        !files.is_empty(),
-        "no .mcap recordings in {}",
-        folder.display()
-    );
+    if files.is_empty() {
+        return Err(PipelineError::NoRecordings { path: folder });
+    }
     Ok(files)
 }
 
 /// Whether a recording's metadata says it may hold calibration activations. Files whose metadata
 /// lacks the set point or series kind are read in full (the segments' own labels then decide).
-fn may_hold_calibration(path: &Path, options: &Options) -> anyhow::Result<bool> {
+fn may_hold_calibration(path: &Path, options: &Options) -> Result<bool, PipelineError> {
     let metadata = read_metadata(path)?;
     let set_point = metadata
         .get("set_point_celsius")
@@ -113,7 +151,7 @@ pub fn run(
     options: &Options,
     noise_floor: bool,
     progress: Progress<'_>,
-) -> anyhow::Result<Outcome> {
+) -> Result<Outcome, PipelineError> {
     let mut outcome = Outcome::default();
     let settings = &options.fit;
 
@@ -145,13 +183,14 @@ pub fn run(
             .par_iter()
             .filter(|s| calibration_segment(s, options))
             .map(|s| analyse(s, settings))
-            .collect::<Result<_, _>>()
-            .with_context(|| format!("analysing {}", path.display()))?;
+            .collect::<Result<_, _>>()?;
         analyse_seconds += started.elapsed().as_secs_f64();
-        by_unit
-            .entry(recording.unit_id.clone())
-            .or_default()
-            .extend(analysed);
+        if !analysed.is_empty() {
+            by_unit
+                .entry(recording.unit_id.clone())
+                .or_default()
+                .extend(analysed);
+        }
     }
     progress(
         "reading and analysing calibration recordings",
@@ -159,22 +198,18 @@ pub fn run(
         files.len() as u64,
     );
 
-    anyhow::ensure!(
-        !by_unit.is_empty(),
-        "no protocol activations at the calibration set points {:?} °C in {} recordings",
-        options.calibration_set_points,
-        files.len()
-    );
+    // Units are entered only with analysed activations, so every entry is non-empty.
+    if by_unit.is_empty() {
+        return Err(PipelineError::NoCalibration {
+            set_points: options.calibration_set_points.clone(),
+            files: files.len(),
+        });
+    }
 
     // Fits: all calibration data, and one per left-out repeat.
     let started = Instant::now();
     let mut held_out: BTreeMap<(String, u32), FittedUnit> = BTreeMap::new();
     for (unit, analysed) in &by_unit {
-        anyhow::ensure!(
-            !analysed.is_empty(),
-            "unit {unit}: no protocol activations at the calibration set points {:?}",
-            options.calibration_set_points
-        );
         outcome.fitted.push(fit_unit(analysed, settings)?);
         if options.held_out_repeats {
             let repeats: BTreeSet<u32> = analysed.iter().map(|a| a.labels.repeat).collect();
