@@ -92,6 +92,23 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;
     steps.finish();
     write_tables(&args.out, &outcome.fitted)?;
+    let seconds = |step: &str| {
+        outcome
+            .timings
+            .iter()
+            .find(|(s, _)| s.starts_with(step))
+            .map_or(0.0, |(_, t)| *t)
+    };
+    let (read, analyse, fit) = (
+        seconds("read recordings"),
+        seconds("analyse"),
+        seconds("fit tables"),
+    );
+    println!(
+        "{} samples read in {read:.2} s; analysis {analyse:.2} s + fit {fit:.2} s = {:.2}× the reading time",
+        outcome.samples_read,
+        (analyse + fit) / read.max(1e-9)
+    );
     for unit in &outcome.fitted {
         let refs: Vec<String> = unit.modified.axes[0]
             .reference_ms
