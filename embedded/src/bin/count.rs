@@ -32,7 +32,11 @@ pub extern "C" fn gyrodrift_marker(id: u32) {
 /// firmware sees).
 fn activation(spacing_ms: u32) -> [Sample; SAMPLES] {
     core::array::from_fn(|i| {
-        let ms = if spacing_ms == 1 { (i as u32 / 12) * 12_000 + i as u32 % 12 + 1 } else { 1000 * i as u32 + 1 };
+        let ms = if spacing_ms == 1 {
+            (i as u32 / 12) * 12_000 + i as u32 % 12 + 1
+        } else {
+            1000 * i as u32 + 1
+        };
         let t = ms as f32 / 1000.0;
         // Rise follows an exponential approach, 4 °C after 2 min, kept inside the fixture's curves.
         let shape = 1.0 - libm_free_exp(-t / 60.0);
