@@ -1,42 +1,30 @@
 //! `gyrodrift diagnose`: which quantity explains what the paper's model leaves in the residual?
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use drift_fit::diagnose::{diagnose, series, ActivationSeries, AxisDiagnosis};
-use drift_fit::pipeline::{self, Options};
-use drift_recording::{read_metadata, read_recording, SeriesKind};
+use drift_fit::pipeline;
+use drift_recording::read_recording;
 use rayon::prelude::*;
 
-use super::fit::load_settings;
+use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use crate::output::write_atomic;
 
 /// Options of `gyrodrift diagnose`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Campaign folder (with `recordings/`) or a folder of `.mcap` recordings.
-    pub campaign: PathBuf,
-    /// Chamber set points to fit, °C (protocol activations).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "30,40",
-        allow_hyphen_values = true
-    )]
-    pub calibration: Vec<f64>,
+    /// Recordings and fit settings.
+    #[command(flatten)]
+    pub input: CampaignArgs,
     /// Output folder for `diagnosis.md` and `diagnosis.json`.
     #[arg(long, short = 'o', default_value = "out/diagnosis")]
     pub out: PathBuf,
     /// How many candidates to print per axis.
     #[arg(long, default_value_t = 5)]
     pub top: usize,
-    /// Fit settings as JSON.
-    #[arg(long)]
-    pub settings: Option<PathBuf>,
-    /// No progress bars.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
 }
 
 /// The ranking as Markdown.
@@ -76,33 +64,20 @@ pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
 
 /// Runs `gyrodrift diagnose`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let settings = load_settings(args.settings.as_deref())?;
-    let files = pipeline::recording_files(&args.campaign)?;
-    let options = Options {
-        calibration_set_points: args.calibration.clone(),
-        validation_set_points: Vec::new(),
-        fit: settings.clone(),
-        held_out_repeats: false,
-        evaluate: false,
-    };
-    let steps = Steps::new(args.quiet);
+    let input = &args.input;
+    let options = input.options(&[], false)?;
+    let files = pipeline::recording_files(&input.campaign)?;
+    let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;
     // Every activation the fit did not see: field sessions and non-calibration set points.
-    let mut by_unit: std::collections::BTreeMap<String, Vec<ActivationSeries>> = Default::default();
+    let mut by_unit: BTreeMap<String, Vec<ActivationSeries>> = BTreeMap::new();
     for (i, path) in files.iter().enumerate() {
         steps.update(
-            "putting validation activations on the diagnosis grid",
+            "putting unseen activations on the diagnosis grid",
             i as u64,
             files.len() as u64,
         );
-        let metadata = read_metadata(path)?;
-        let calibration_file = metadata.get("series_kind").map(String::as_str)
-            == Some(SeriesKind::Protocol.as_str())
-            && metadata
-                .get("set_point_celsius")
-                .and_then(|s| s.parse::<f64>().ok())
-                .is_some_and(|sp| args.calibration.iter().any(|c| (c - sp).abs() < 1e-6));
-        if calibration_file {
+        if pipeline::calibration_file(path, &options)? == Some(true) {
             continue;
         }
         let recording = read_recording(path)?;
@@ -116,7 +91,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let prepared: Vec<ActivationSeries> = recording
             .segments
             .par_iter()
-            .map(|s| series(fitted, s, &settings))
+            .filter(|s| !pipeline::calibration_segment(s, &options))
+            .map(|s| series(fitted, s, &options.fit))
             .collect();
         by_unit
             .entry(recording.unit_id.clone())
@@ -127,7 +103,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     anyhow::ensure!(
         !by_unit.is_empty(),
         "no activations outside the calibration set points {:?} to diagnose",
-        args.calibration
+        input.calibration
     );
     let mut md = String::from("# gyrodrift diagnosis\n\n");
     let mut json = Vec::new();

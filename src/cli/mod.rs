@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod campaign_args;
 pub mod demo;
 pub mod diagnose;
 pub mod fit;
