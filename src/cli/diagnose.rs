@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use drift_fit::diagnose::{diagnose, series, ActivationSeries, AxisDiagnosis};
+use drift_fit::diagnose::{diagnose, series, ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_fit::pipeline;
 use drift_recording::read_recording;
 use rayon::prelude::*;
@@ -12,6 +12,7 @@ use rayon::prelude::*;
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use crate::output::write_atomic;
+use crate::report::plots;
 
 /// Options of `gyrodrift diagnose`.
 #[derive(Debug, clap::Args)]
@@ -60,6 +61,54 @@ pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
         md.push('\n');
     }
     md
+}
+
+/// The residual against the top candidate of an axis, at the level where the candidate scored:
+/// activation means (between) or points less their activation means (within, every 10th point).
+fn residual_plot(
+    activations: &[ActivationSeries],
+    axis: usize,
+    top: &CandidateScore,
+) -> anyhow::Result<String> {
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let points: Vec<(f64, f64)> = if top.level == "between activations" {
+        activations
+            .iter()
+            .map(|a| {
+                (
+                    mean(&a.candidates[axis][&top.name]),
+                    mean(&a.residual_dps[axis]),
+                )
+            })
+            .collect()
+    } else {
+        activations
+            .iter()
+            .flat_map(|a| {
+                let c = &a.candidates[axis][&top.name];
+                let r = &a.residual_dps[axis];
+                let (mc, mr) = (mean(c), mean(r));
+                c.iter()
+                    .zip(r)
+                    .step_by(10)
+                    .map(move |(c, r)| (c - mc, r - mr))
+            })
+            .collect()
+    };
+    let title = format!("Residual against {} ({})", top.name, top.level);
+    let x = if top.level == "between activations" {
+        top.name.clone()
+    } else {
+        format!("{} − its activation mean", top.name)
+    };
+    plots::draw(
+        &plots::Chart {
+            title: &title,
+            x: &x,
+            y: "residual, °/s",
+        },
+        &[plots::Series::markers(top.name.clone(), points)],
+    )
 }
 
 /// Runs `gyrodrift diagnose`.
@@ -128,6 +177,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     c.explained,
                     c.p_value,
                     if c.significant { "  *" } else { "" }
+                );
+            }
+        }
+        for (axis_index, axis) in axes.iter().enumerate() {
+            if let Some(top) = axis
+                .ranking
+                .first()
+                .filter(|c| c.level != "absorbed by the model")
+            {
+                let file = format!("residual-{unit}-{}.svg", axis.axis);
+                write_atomic(
+                    &args.out.join(&file),
+                    residual_plot(activations, axis_index, top)?.as_bytes(),
+                )?;
+                let _ = writeln!(
+                    md,
+                    "![Residual of unit {unit}, axis {}, against {}]({file})\n",
+                    axis.axis, top.name
                 );
             }
         }

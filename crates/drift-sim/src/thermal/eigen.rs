@@ -11,7 +11,9 @@ pub(crate) fn symmetric_eigen(matrix: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) 
     debug_assert_eq!(matrix.len(), n * n);
     let decomposition = SymmetricEigen::new(DMatrix::from_row_slice(n, n, matrix));
     let values = decomposition.eigenvalues.iter().copied().collect();
-    let vectors = (0..n * n).map(|k| decomposition.eigenvectors[(k / n, k % n)]).collect();
+    let vectors = (0..n * n)
+        .map(|k| decomposition.eigenvectors[(k / n, k % n)])
+        .collect();
     (values, vectors)
 }
 
