@@ -28,13 +28,17 @@ def test_records_cover_every_split_model_and_axis(evaluation: gyrodrift.Evaluati
 
 def test_the_papers_method_beats_no_correction(evaluation: gyrodrift.Evaluation) -> None:
     def mean(model: str) -> float:
-        values = [r["drift_dps"] for r in evaluation.records if r["split"] == "validation" and r["model"] == model]
+        values = [
+            r["drift_dps"] for r in evaluation.records if r["split"] == "validation" and r["model"] == model
+        ]
         return sum(values) / len(values)
 
     assert mean("modified") < mean("uncorrected")
 
 
-def test_per_activation_evaluation_and_summarise_agree(campaign_dir, evaluation: gyrodrift.Evaluation) -> None:  # type: ignore[no-untyped-def]
+def test_per_activation_evaluation_and_summarise_agree(
+    campaign_dir, evaluation: gyrodrift.Evaluation
+) -> None:  # type: ignore[no-untyped-def]
     unit = evaluation.fitted[0]
     validation = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0"))
     results = [unit.evaluate(segment) for segment in validation.segments]

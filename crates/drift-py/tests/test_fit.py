@@ -59,9 +59,10 @@ def test_fitted_models_save_like_the_command_line(campaign_dir: Path, tmp_path: 
     (unit,) = gyrodrift.fit(campaign_dir)
     folder = unit.save(tmp_path)
     assert folder == tmp_path / "GIU-01"
-    assert sorted(p.name for p in folder.iterdir()) == [
-        "modified.bin", "modified.json", "standard.bin", "standard.json", "third_order.bin", "third_order.json"
-    ]  # fmt: skip
+    names = [
+        f"{model}.{kind}" for model in ("modified", "standard", "third_order") for kind in ("bin", "json")
+    ]
+    assert sorted(p.name for p in folder.iterdir()) == names
     assert gyrodrift.ModifiedTables.load_image(folder / "modified.bin") == unit.modified
     assert gyrodrift.PolynomialTables.load_json(folder / "third_order.json") == unit.third_order
 

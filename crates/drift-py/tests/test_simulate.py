@@ -38,7 +38,7 @@ def test_overrides_mean_what_the_flags_mean() -> None:
 
 
 def test_campaign_from_toml_json_and_file(tmp_path: Path) -> None:
-    toml = 'seed = 4\nunits = 1\n[protocol]\nintervals_min = [3]\n'
+    toml = "seed = 4\nunits = 1\n[protocol]\nintervals_min = [3]\n"
     json_text = '{"seed": 4, "units": 1, "protocol": {"intervals_min": [3]}}'
     (tmp_path / "c.toml").write_text(toml)
     (tmp_path / "c.json").write_text(json_text)

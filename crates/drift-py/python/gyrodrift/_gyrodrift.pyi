@@ -312,7 +312,7 @@ class Labels:
         """Chamber set point at switch-on, °C."""
     @property
     def series_kind(self) -> str:
-        """"protocol" or "field"."""
+        """ "protocol" or "field"."""
     @property
     def series(self) -> int:
         """Series number within the recording, from 1."""

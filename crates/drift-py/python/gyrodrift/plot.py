@@ -57,7 +57,9 @@ def _axis_index(axis: str) -> int:
     return AXES.index(axis)
 
 
-def _unit_and_set_point(evaluation: Evaluation, unit: str | None, set_point: float | None) -> tuple[str, float]:
+def _unit_and_set_point(
+    evaluation: Evaluation, unit: str | None, set_point: float | None
+) -> tuple[str, float]:
     fitted = evaluation.fitted
     if not fitted:
         raise ValueError("the evaluation has no fitted unit")
@@ -137,7 +139,10 @@ def rise_per_interval(
     ax = _new_axes(ax)
     _by_activation(ax, _activations(evaluation, unit, set_point), lambda a: float(a.rise_celsius[-1, i]))
     return _finish(
-        ax, f"Rise at the end of each activation ({unit}, {axis}, {set_point:+g} °C)", "off-time, min", "rise, °C"
+        ax,
+        f"Rise at the end of each activation ({unit}, {axis}, {set_point:+g} °C)",
+        "off-time, min",
+        "rise, °C",
     )
 
 
@@ -155,7 +160,10 @@ def drift_per_interval(
     ax = _new_axes(ax)
     _by_activation(ax, _activations(evaluation, unit, set_point), lambda a: float(a.drift_dps[-1, i]))
     return _finish(
-        ax, f"Drift at the end of each activation ({unit}, {axis}, {set_point:+g} °C)", "off-time, min", "drift g, °/s"
+        ax,
+        f"Drift at the end of each activation ({unit}, {axis}, {set_point:+g} °C)",
+        "off-time, min",
+        "drift g, °/s",
     )
 
 
@@ -181,8 +189,8 @@ def correlation_curves(
                 members[a.labels.activation].append(a)
         for act, group in sorted(members.items()):
             n = min(len(m) for m in group)
-            drift = np.mean([m.drift_dps[:n, i] for m in group], axis=0, dtype=np.float64)
-            rise = np.mean([m.rise_celsius[:n, i] for m in group], axis=0, dtype=np.float64)
+            drift = np.asarray(np.mean([m.drift_dps[:n, i] for m in group], axis=0, dtype=np.float64))
+            rise = np.asarray(np.mean([m.rise_celsius[:n, i] for m in group], axis=0, dtype=np.float64))
             t = group[0].time_s[:n]
             keep = (t >= 2.0) & (np.abs(rise) > 1e-3)
             ax.plot(t[keep], drift[keep] / rise[keep], label=f"activation {act}")
@@ -212,7 +220,11 @@ def k_per_interval(
     chosen = [a for a in activations if a.labels.activation == activation]
     ax = _new_axes(ax)
     for t in times_s:
-        points = _per_interval(chosen, lambda a, t=t: _k_at(a, t, i)).get(activation, {})
+
+        def k_at_t(a: AnalysedActivation, t: float = t) -> float | None:
+            return _k_at(a, t, i)
+
+        points = _per_interval(chosen, k_at_t).get(activation, {})
         ax.plot(list(points), list(points.values()), marker="o", label=f"{t:g} s")
     return _finish(
         ax,
@@ -238,7 +250,9 @@ def drift_before_after(
     for model in MODELS:
         values = [r.drift_dps[model][i] for r in results if model in r.drift_dps]
         ax.plot(range(len(values)), values, linestyle="none", marker="o", markersize=3, label=model)
-    return _finish(ax, f"Drift per {split} activation ({unit}, {axis})", "activation (recording order)", "drift, °/s")
+    return _finish(
+        ax, f"Drift per {split} activation ({unit}, {axis})", "activation (recording order)", "drift, °/s"
+    )
 
 
 FIGURES: dict[str, Callable[..., Axes]] = {

@@ -50,10 +50,10 @@ def paper_table(records: Iterable[Mapping[str, Any]], *, models: Sequence[str] =
             text = "".join(" – |" if v is None else f" {v:.4f} |" for v in cells)
             lines.append(f"| {model} | {set_point:+g} °C | {SPLIT_NAMES[split]} |{text}")
     for set_point, split in _rows(records):
-        cells = []
+        ratios: list[str] = []
         for u in units:
             for a in AXES:
                 s, d = drift(u, set_point, split, "standard", a), drift(u, set_point, split, "modified", a)
-                cells.append(" – |" if s is None or d is None or d <= 0 else f" {s / d:.2f}× |")
-        lines.append(f"| standard / modified | {set_point:+g} °C | {SPLIT_NAMES[split]} |{''.join(cells)}")
+                ratios.append(" – |" if s is None or d is None or d <= 0 else f" {s / d:.2f}× |")
+        lines.append(f"| standard / modified | {set_point:+g} °C | {SPLIT_NAMES[split]} |{''.join(ratios)}")
     return "\n".join(lines) + "\n"
