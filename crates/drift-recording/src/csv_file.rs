@@ -374,7 +374,8 @@ fn read_csv_from<R: Read>(
     let period_ns = 1_000_000_000 / u64::from(fs);
     let mut end_ns = 0u64;
     for (k, s) in segments.iter_mut().enumerate() {
-        if k > 0 && s.power_on_ns < end_ns {
+        // `<=`: a switch-on at the previous switch-off's time would repeat a power-event timestamp.
+        if k > 0 && s.power_on_ns <= end_ns {
             s.power_on_ns = end_ns.saturating_add(1_000_000_000);
         }
         end_ns = s.power_on_ns.saturating_add(s.len() as u64 * period_ns);

@@ -12,6 +12,7 @@ pub mod cdr;
 mod csv_file;
 mod error;
 mod layout;
+mod messages;
 mod read;
 pub mod schema;
 mod segment;
@@ -21,6 +22,7 @@ pub mod writer;
 pub use csv_file::{read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming};
 pub use error::{ReadError, WriteError};
 pub use layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+pub use messages::RECORD_LENGTH_LIMIT;
 pub use read::{
     is_truth_path, read_campaign_dir, read_metadata, read_recording, read_recording_bytes,
     Recording, REQUIRED_TOPICS,

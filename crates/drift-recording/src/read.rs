@@ -244,10 +244,10 @@ fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
         segments: Vec::new(),
         topics: HashMap::new(),
     };
-    for message in mcap::MessageStream::new(&buf).map_err(mcap_err)? {
-        let message = message.map_err(mcap_err)?;
-        reader.message(&message.channel.topic, message.log_time, &message.data)?;
-    }
+    crate::messages::for_each_message(&buf, |topic, log_ns, data| {
+        reader.message(topic, log_ns, data)
+    })
+    .map_err(|e| e.map_or_else(|e| e, mcap_err))?;
     if reader.open.is_some() {
         let index = reader
             .topics
