@@ -333,6 +333,13 @@ fn read_csv_from<R: Read>(
             if !rate.is_finite() {
                 return Err(bad(&c.rate_dps[axis], format!("non-finite rate {rate}")));
             }
+            // Segments hold f32: a finite f64 beyond f32's range would become ±∞ there.
+            if !(rate as f32).is_finite() {
+                return Err(bad(
+                    &c.rate_dps[axis],
+                    format!("rate {rate} °/s is beyond the f32 range of a segment"),
+                ));
+            }
             rows.rate[axis].push(rate);
             let name = &c.temperature_celsius[axis];
             let text = record
