@@ -43,24 +43,31 @@ fn image<M: Image>(model: &M) -> anyhow::Result<Vec<u8>> {
 }
 
 /// Writes each unit's models as `<out>/<unit>/{modified,standard,third_order}.{json,bin}`.
+///
+/// Every file is encoded in memory first, so an encoding error leaves the folder untouched; each
+/// file is then replaced atomically (`write_atomic`), so none is ever half-written.
 pub fn write_tables(out: &Path, fitted: &[FittedUnit]) -> anyhow::Result<()> {
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     for unit in fitted {
         let dir = out.join(&unit.unit_id);
-        write_atomic(
-            &dir.join("modified.json"),
-            serde_json::to_string_pretty(&unit.modified)?.as_bytes(),
-        )?;
-        write_atomic(&dir.join("modified.bin"), &image(&unit.modified)?)?;
+        files.push((
+            dir.join("modified.json"),
+            serde_json::to_string_pretty(&unit.modified)?.into_bytes(),
+        ));
+        files.push((dir.join("modified.bin"), image(&unit.modified)?));
         for (name, model) in [
             ("standard", &unit.standard),
             ("third_order", &unit.third_order),
         ] {
-            write_atomic(
-                &dir.join(format!("{name}.json")),
-                serde_json::to_string_pretty(model)?.as_bytes(),
-            )?;
-            write_atomic(&dir.join(format!("{name}.bin")), &image(model)?)?;
+            files.push((
+                dir.join(format!("{name}.json")),
+                serde_json::to_string_pretty(model)?.into_bytes(),
+            ));
+            files.push((dir.join(format!("{name}.bin")), image(model)?));
         }
+    }
+    for (path, bytes) in &files {
+        write_atomic(path, bytes)?;
     }
     Ok(())
 }

@@ -132,7 +132,8 @@ fn k(table: &Table, celsius: f32, ms: u32, rise: f32) -> f32 {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(512))]
+    // Miri runs a handful of cases (each is ~10⁴× slower there); natively all 512.
+    #![proptest_config(ProptestConfig::with_cases(if cfg!(miri) { 4 } else { 512 }))]
 
     #[test]
     fn table_is_valid(table in table()) {

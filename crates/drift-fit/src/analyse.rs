@@ -77,6 +77,19 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
             what: "rate and temperature arrays differ in length".into(),
         });
     }
+    if let Some((axis, sample)) = segment.first_missing_temperature() {
+        // A calibration curve with a hole would be fitted from invented temperatures: refuse it.
+        return Err(FitError::Inconsistent {
+            unit: segment.labels.unit_id.clone(),
+            series: segment.labels.series,
+            activation: segment.labels.activation,
+            what: format!(
+                "axis {} temperature reading missing at sample {sample} (sensor dropout); \
+                 calibration activations must be complete",
+                ["X", "Y", "Z"][axis]
+            ),
+        });
+    }
     if n < needed {
         return Err(FitError::TooShort {
             unit: segment.labels.unit_id.clone(),

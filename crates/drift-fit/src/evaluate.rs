@@ -7,7 +7,7 @@
 //! it includes the error of the initial bias.
 
 use drift_core::{Corrector, Model, Sample};
-use drift_recording::{Segment, SegmentLabels};
+use drift_recording::{temperature_reading, Segment, SegmentLabels};
 
 use crate::fit::FittedUnit;
 use crate::lowpass::centred_moving_average;
@@ -91,8 +91,18 @@ pub fn switch_on_raw(segment: &Segment, settings: &FitSettings) -> [f32; 3] {
         .round() as usize)
         .clamp(1, segment.len().max(1));
     segment.temperature_raw.clone().map(|raw| {
-        let head = &raw[..n.min(raw.len())];
-        (head.iter().map(|&r| f64::from(r)).sum::<f64>() / head.len().max(1) as f64) as f32
+        // Missing readings (dropouts) are left out of the mean; a window without any reading
+        // gives NaN, which `power_on` refuses: the activation then passes through, flagged.
+        let head = raw[..n.min(raw.len())]
+            .iter()
+            .map(|&r| temperature_reading(r))
+            .filter(|r| r.is_finite());
+        let (sum, count) = head.fold((0.0, 0usize), |(s, c), r| (s + f64::from(r), c + 1));
+        if count == 0 {
+            f32::NAN
+        } else {
+            (sum / count as f64) as f32
+        }
     })
 }
 
@@ -130,7 +140,7 @@ pub fn correct_segment<M: Model>(
                 segment.rate_dps[1][i],
                 segment.rate_dps[2][i],
             ],
-            temperature_raw: [0, 1, 2].map(|a| f32::from(segment.temperature_raw[a][i])),
+            temperature_raw: [0, 1, 2].map(|a| temperature_reading(segment.temperature_raw[a][i])),
         };
         let out = corrector.correct(&sample);
         for axis in 0..3 {

@@ -146,3 +146,70 @@ fn mismatched_axis_lengths_and_short_activations_are_named() {
     let error = analyse(&s, &settings).unwrap_err().to_string();
     assert!(error.contains("1500 samples is too short"), "{error}");
 }
+
+/// Calibration data in which one activation's X sensor is stuck (its switch-on reading throughout)
+/// or saturated (the int16 limit throughout).
+fn calibration_with(
+    bad: &dyn Fn(&mut Segment),
+) -> Result<drift_fit::FittedUnit, drift_fit::FitError> {
+    let settings = FitSettings::default();
+    let mut calibration = Vec::new();
+    for set_point in [30.0, 40.0] {
+        for interval in [1.0, 5.0, 30.0] {
+            for activation in 1..=5 {
+                let mut s = segment(set_point, interval, activation);
+                if set_point == 30.0 && interval == 5.0 && activation == 2 {
+                    bad(&mut s);
+                }
+                calibration.push(analyse(&s, &settings)?);
+            }
+        }
+    }
+    fit_unit(&calibration, &settings)
+}
+
+#[test]
+fn a_stuck_or_saturated_sensor_is_a_documented_degradation() {
+    let settings = FitSettings::default();
+    let score = |f: &drift_fit::FittedUnit| {
+        [(1.0, 5), (5.0, 2), (30.0, 1)]
+            .iter()
+            .map(|&(i, a)| evaluate(f, &segment(33.0, i, a), &settings).models[3].drift_dps[0])
+            .sum::<f64>()
+    };
+    let clean = score(&calibration_with(&|_| {}).unwrap());
+    // In calibration: one activation of 30 is outvoted (curves average over activations and set
+    // points); the tables leave no more drift on unseen data. (All activations stuck on an axis:
+    // "never rises", above.)
+    let stuck = score(
+        &calibration_with(&|s| {
+            let v = s.temperature_raw[0][0];
+            s.temperature_raw[0].iter_mut().for_each(|r| *r = v);
+        })
+        .unwrap(),
+    );
+    let saturated = score(
+        &calibration_with(&|s| s.temperature_raw[0].iter_mut().for_each(|r| *r = i16::MAX))
+            .unwrap(),
+    );
+    assert!(
+        stuck < 1.5 * clean && saturated < 1.5 * clean,
+        "clean {clean} stuck {stuck} saturated {saturated}"
+    );
+
+    // At correction time: a saturated sensor reads +163.8 °C at switch-on, far outside the
+    // calibrated ambients (flagged for the whole activation), and its unchanging reading is flagged
+    // stuck after `stuck_after_samples`; the correction holds. The other axes are unaffected.
+    let fitted = calibration_with(&|_| {}).unwrap();
+    let mut s = segment(33.0, 30.0, 1);
+    s.temperature_raw[0].iter_mut().for_each(|r| *r = i16::MAX);
+    let result = evaluate(&fitted, &s, &settings);
+    let flags = drift_core::Flags(result.models[3].flags[0]);
+    assert!(
+        flags.contains(
+            drift_core::Flags::AMBIENT_OUT_OF_RANGE | drift_core::Flags::TEMPERATURE_STUCK
+        ),
+        "{flags:?}"
+    );
+    assert!(!drift_core::Flags(result.models[3].flags[1]).intersects(drift_core::Flags::FAULTS));
+}

@@ -5,21 +5,30 @@
 //! batches of samples, one topic per signal, zstd chunks. [`read_recording`] validates while it
 //! reads and yields [`Segment`]s, one per activation, with their protocol labels; it refuses
 //! simulator ground truth, so code that reads through it cannot see the truth.
-//! [`write_recording`] writes the same format from a real test bench's data.
+//! [`write_recording`] writes the same format from a real test bench's data, and [`read_csv`] reads
+//! measured data from CSV into the same segments.
 
 pub mod cdr;
+mod csv_file;
 mod error;
 mod layout;
+mod messages;
 mod read;
 pub mod schema;
 mod segment;
 mod write;
 pub mod writer;
 
+pub use csv_file::{read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming};
 pub use error::{ReadError, WriteError};
 pub use layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+pub use messages::RECORD_LENGTH_LIMIT;
 pub use read::{
-    is_truth_path, read_campaign_dir, read_metadata, read_recording, Recording, REQUIRED_TOPICS,
+    is_truth_path, read_campaign_dir, read_metadata, read_recording, read_recording_bytes,
+    Recording, REQUIRED_TOPICS,
 };
-pub use segment::{AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS};
+pub use segment::{
+    temperature_reading, AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS,
+    TEMPERATURE_MISSING_RAW,
+};
 pub use write::{create_recording, write_recording};

@@ -105,16 +105,26 @@ struct Opened {
 }
 
 fn open(path: &Path) -> Result<Opened, ReadError> {
+    refuse_truth_name(path)?;
+    let buf = std::fs::read(path).map_err(|e| ReadError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    open_bytes(path, buf)
+}
+
+/// The name check happens before anything is read, so a sidecar is never even opened.
+fn refuse_truth_name(path: &Path) -> Result<(), ReadError> {
     if is_truth_path(path) {
         return Err(ReadError::GroundTruth {
             path: path.to_path_buf(),
             why: "sidecar file name or truth/ folder".into(),
         });
     }
-    let buf = std::fs::read(path).map_err(|e| ReadError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
+    Ok(())
+}
+
+fn open_bytes(path: &Path, buf: Vec<u8>) -> Result<Opened, ReadError> {
     let mcap_err = |e| ReadError::Mcap {
         path: path.to_path_buf(),
         source: e,
@@ -204,12 +214,24 @@ pub fn read_metadata(path: &Path) -> Result<BTreeMap<String, String>, ReadError>
 
 /// Reads and validates one recording.
 pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
+    decode(path, open(path)?)
+}
+
+/// Reads and validates a recording held in memory; `name` stands for the file in errors and in
+/// [`Recording::path`] (and is checked like a file name: a ground-truth name is refused). The same
+/// checks as [`read_recording`], which reads the file and calls this; fuzzing drives it directly.
+pub fn read_recording_bytes(name: &Path, bytes: &[u8]) -> Result<Recording, ReadError> {
+    refuse_truth_name(name)?;
+    decode(name, open_bytes(name, bytes.to_vec())?)
+}
+
+fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
     let Opened {
         buf,
         metadata,
         unit_id,
         sample_rate_hz,
-    } = open(path)?;
+    } = opened;
     let mcap_err = |e| ReadError::Mcap {
         path: path.to_path_buf(),
         source: e,
@@ -222,10 +244,10 @@ pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
         segments: Vec::new(),
         topics: HashMap::new(),
     };
-    for message in mcap::MessageStream::new(&buf).map_err(mcap_err)? {
-        let message = message.map_err(mcap_err)?;
-        reader.message(&message.channel.topic, message.log_time, &message.data)?;
-    }
+    crate::messages::for_each_message(&buf, |topic, log_ns, data| {
+        reader.message(topic, log_ns, data)
+    })
+    .map_err(|e| e.map_or_else(|e| e, mcap_err))?;
     if reader.open.is_some() {
         let index = reader
             .topics

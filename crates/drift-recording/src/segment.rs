@@ -7,6 +7,23 @@ use serde::{Deserialize, Serialize};
 /// Temperature-sensor scale: raw units per °C (the paper's sensor: 1 °C = 200 units).
 pub const RAW_PER_CELSIUS: f64 = 200.0;
 
+/// The raw temperature value that marks a missing reading (a temperature-sensor dropout) in
+/// `/gyro/temperature_raw` and in [`Segment::temperature_raw`]. A raw temperature is an `int16`,
+/// which has no NaN; −32768 (−163.84 °C at 200 raw/°C) is outside any sensor's range, so it cannot
+/// be mistaken for a reading. Rates have no such marker: a NaN rate is refused by the reader.
+pub const TEMPERATURE_MISSING_RAW: i16 = i16::MIN;
+
+/// A raw temperature as the corrector takes it: the reading as `f32`, or NaN for
+/// [`TEMPERATURE_MISSING_RAW`] (the corrector then holds its last good drift and flags
+/// `TEMPERATURE_INVALID`).
+pub fn temperature_reading(raw: i16) -> f32 {
+    if raw == TEMPERATURE_MISSING_RAW {
+        f32::NAN
+    } else {
+        f32::from(raw)
+    }
+}
+
 /// Which kind of series an activation belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -105,9 +122,22 @@ impl Segment {
         Some(u64::from(index) * 1000 / u64::from(self.sample_rate_hz.max(1)))
     }
 
-    /// Raw temperature of `axis` at sample `i` in °C (`None` past the end).
+    /// Raw temperature of `axis` at sample `i` in °C (`None` past the end; NaN for a missing
+    /// reading, [`TEMPERATURE_MISSING_RAW`]).
     pub fn temperature_celsius(&self, axis: usize, i: usize) -> Option<f64> {
         let raw = *self.temperature_raw.get(axis)?.get(i)?;
-        Some(f64::from(raw) / RAW_PER_CELSIUS)
+        Some(f64::from(temperature_reading(raw)) / RAW_PER_CELSIUS)
+    }
+
+    /// The first missing temperature reading ([`TEMPERATURE_MISSING_RAW`]) as `(axis, sample)`.
+    pub fn first_missing_temperature(&self) -> Option<(usize, usize)> {
+        self.temperature_raw
+            .iter()
+            .enumerate()
+            .find_map(|(axis, raw)| {
+                raw.iter()
+                    .position(|&r| r == TEMPERATURE_MISSING_RAW)
+                    .map(|i| (axis, i))
+            })
     }
 }

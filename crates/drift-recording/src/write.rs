@@ -100,21 +100,30 @@ pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteE
             );
             f.write_encoded(schema::TOPIC_TEMPERATURE_RAW, log_ns)?;
             let (a0, a1) = (first.div_ceil(aux_every), end.div_ceil(aux_every));
+            // A channel shorter than the activation (or absent, as from a CSV file) continues
+            // where it ended, with empty batches: its `first_sample` never jumps ahead of what
+            // was written, which the reader would refuse as a gap.
+            let start = |name: &str| a0.min(aux(segment, name).len());
             let slice = |name: &str| {
                 let v = aux(segment, name);
                 &v[a0.min(v.len())..a1.min(v.len())]
             };
             Vector3Batch::encode(
-                a0 as u32,
+                start("accel_x") as u32,
                 AUX_RATE_HZ,
                 [slice("accel_x"), slice("accel_y"), slice("accel_z")],
                 &mut f.enc,
             );
             f.write_encoded(schema::TOPIC_ACCEL, log_ns)?;
-            ScalarBatch::encode(a0 as u32, AUX_RATE_HZ, slice("supply_voltage"), &mut f.enc);
+            ScalarBatch::encode(
+                start("supply_voltage") as u32,
+                AUX_RATE_HZ,
+                slice("supply_voltage"),
+                &mut f.enc,
+            );
             f.write_encoded(schema::TOPIC_SUPPLY, log_ns)?;
             ScalarBatch::encode(
-                a0 as u32,
+                start("chamber_set_point") as u32,
                 AUX_RATE_HZ,
                 slice("chamber_set_point"),
                 &mut f.enc,

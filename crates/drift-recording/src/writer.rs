@@ -145,7 +145,16 @@ impl McapFile {
     }
 
     /// Finishes the MCAP (summary, footer), flushes, and renames into place. Returns bytes.
+    /// On any error the temporary file is removed and the target is untouched.
     pub fn finish(mut self) -> Result<u64, WriteError> {
+        let result = self.finish_into_place();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+        result
+    }
+
+    fn finish_into_place(&mut self) -> Result<u64, WriteError> {
         let temp = self.temp.clone();
         let mut writer = self
             .writer

@@ -2,6 +2,7 @@
 //! the default.
 
 use crate::error::SimError;
+use crate::faults::SensorFaults;
 use crate::hidden::HiddenEffects;
 use crate::unit::UnitModel;
 use serde::{Deserialize, Serialize};
@@ -39,6 +40,8 @@ pub struct Campaign {
     pub effects: HiddenEffects,
     /// Rate of the ground-truth bias in the sidecar.
     pub truth_bias: TruthBias,
+    /// Temperature-sensor faults injected at run time (all off by default; ground truth).
+    pub faults: SensorFaults,
 }
 
 /// How densely the sidecar stores the true (noise-free) bias.
@@ -150,6 +153,7 @@ impl Default for Campaign {
             field: None,
             effects: HiddenEffects::default(),
             truth_bias: TruthBias::EverySample,
+            faults: SensorFaults::default(),
         }
     }
 }
@@ -233,6 +237,7 @@ impl Campaign {
                 "nothing to record: give [protocol] and/or [field]",
             ));
         }
+        self.faults.validate()?;
         if let Some(p) = &self.protocol {
             if p.intervals_min.is_empty() {
                 return Err(bad("protocol.intervals_min", "need at least one interval"));

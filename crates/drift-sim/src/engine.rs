@@ -5,6 +5,7 @@
 use crate::bias::{self, BiasInputs};
 use crate::campaign::{Campaign, TruthBias};
 use crate::error::SimError;
+use crate::faults::{FaultEvent, Injector, FAULTS_METADATA};
 use crate::rng;
 use crate::schedule::{ActivationPlan, FilePlan};
 use crate::thermal::network::{asic, element, NODES};
@@ -204,7 +205,28 @@ impl FileSim<'_> {
         let mut clock_ms = self.plan.start_ms;
         let mut counts = FileCounts::default();
         let mut buffers = Buffers::new((c.sample_rate_hz / 10) as usize);
-        for act in &self.plan.activations {
+        let mut fault_log: Vec<FaultEvent> = Vec::new();
+        for (index, act) in self.plan.activations.iter().enumerate() {
+            // A stream of their own: switching faults on changes no other draw.
+            let faults = if c.faults.any() {
+                let mut fr = rng::stream(
+                    c.seed,
+                    &[
+                        rng::tag("faults"),
+                        u64::from(self.plan.unit_index),
+                        u64::from(self.plan.file_index),
+                        index as u64,
+                    ],
+                );
+                c.faults.draw(
+                    &mut fr,
+                    (act.series, act.repeat, act.activation),
+                    act.samples,
+                    c.sample_rate_hz,
+                )
+            } else {
+                Vec::new()
+            };
             // Off-time: unpowered, ambient held: the exact solution, however long.
             let off_s = act.off_before_ms as f64 / 1000.0;
             let cooled = self
@@ -223,6 +245,7 @@ impl FileSim<'_> {
             clock_ms += act.off_before_ms;
             self.activation(
                 act,
+                &faults,
                 clock_ms,
                 &mut x,
                 &mut instability,
@@ -232,9 +255,21 @@ impl FileSim<'_> {
                 &mut buffers,
                 progress,
             )?;
+            fault_log.extend(faults);
             clock_ms += u64::from(act.samples) * 1000 / u64::from(c.sample_rate_hz);
             counts.samples += u64::from(act.samples);
             counts.activations += 1;
+        }
+        if c.faults.any() {
+            // Ground truth only: where each fault was injected, for evaluation code.
+            let events = serde_json::to_string(&fault_log).map_err(|e| SimError::Json {
+                path: truth.to_path_buf(),
+                source: e,
+            })?;
+            tru.metadata(
+                FAULTS_METADATA,
+                BTreeMap::from([("events".to_owned(), events)]),
+            )?;
         }
         counts.recording_bytes = rec.finish()?;
         counts.truth_bytes = tru.finish()?;
@@ -258,6 +293,7 @@ impl FileSim<'_> {
     fn activation(
         &self,
         act: &ActivationPlan,
+        faults: &[FaultEvent],
         on_ms: u64,
         x: &mut [f64; NODES],
         instability: &mut [f64; 3],
@@ -314,6 +350,7 @@ impl FileSim<'_> {
         let accel_true = act.gravity_body;
 
         let grid_s = f64::from(aux_every) * h;
+        let mut inject = (!faults.is_empty()).then(|| Injector::new(faults));
         for i in 0..act.samples {
             let t = f64::from(i) * h;
             let ambient = act.ambient_on_c + ramp * t;
@@ -381,7 +418,11 @@ impl FileSim<'_> {
                 buf.rate[a].push((f64::from(counts) * RATE_LSB_DPS) as f32);
                 // Round half away from zero; `as` saturates at the i16 limits (the sensor's
                 // range). Cheaper than f64::round, which is a libm call on baseline x86-64.
-                buf.raw[a].push((raw + 0.5f64.copysign(raw)) as i16);
+                let reading = (raw + 0.5f64.copysign(raw)) as i16;
+                buf.raw[a].push(match inject.as_mut() {
+                    Some(inject) => inject.apply(a, i, reading),
+                    None => reading,
+                });
                 if every_sample_truth || phase == 0 {
                     buf.truth_bias[a].push(systematic as f32);
                 }

@@ -6,6 +6,7 @@ pub mod bias;
 pub mod campaign;
 mod engine;
 pub mod error;
+pub mod faults;
 pub mod hidden;
 mod rng;
 pub mod schedule;
@@ -16,6 +17,7 @@ pub mod unit;
 
 pub use campaign::{Campaign, Field, Protocol};
 pub use error::SimError;
+pub use faults::SensorFaults;
 pub use hidden::HiddenEffects;
 // The recording format lives in drift-recording; re-exported for the simulator's users.
 pub use drift_recording::{

@@ -68,3 +68,35 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthSegment>, ReadError> {
     }
     Ok(out)
 }
+
+/// Reads the sensor faults injected into a recording from its `.truth.mcap` sidecar (empty when
+/// the campaign injected none).
+pub fn read_faults(path: &Path) -> Result<Vec<crate::faults::FaultEvent>, ReadError> {
+    let buf = std::fs::read(path).map_err(|e| ReadError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    let mcap_err = |e| ReadError::Mcap {
+        path: path.to_path_buf(),
+        source: e,
+    };
+    let meta_err = |reason: String| ReadError::Metadata {
+        path: path.to_path_buf(),
+        name: crate::faults::FAULTS_METADATA.into(),
+        reason,
+    };
+    let Some(summary) = mcap::read::Summary::read(&buf).map_err(mcap_err)? else {
+        return Err(meta_err("the sidecar has no summary section".into()));
+    };
+    for index in &summary.metadata_indexes {
+        if index.name == crate::faults::FAULTS_METADATA {
+            let record = mcap::read::metadata(&buf, index).map_err(mcap_err)?;
+            let events = record
+                .metadata
+                .get("events")
+                .ok_or_else(|| meta_err("key `events` missing".into()))?;
+            return serde_json::from_str(events).map_err(|e| meta_err(e.to_string()));
+        }
+    }
+    Ok(Vec::new())
+}

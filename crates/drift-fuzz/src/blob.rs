@@ -1,0 +1,71 @@
+//! Target `blob`: the firmware table image decoder, for both model kinds and two capacities.
+//!
+//! Input: one mode byte, then the image. Mode bit 0 rewrites the declared payload length and
+//! bit 1 recomputes the CRC before decoding, so mutations reach the postcard payload and the
+//! model validation behind the checksum instead of all dying at the CRC check.
+//!
+//! Invariants: decoding never panics; an accepted image validates, runs a corrector, and
+//! survives encode → decode unchanged (images are not canonical: finding F1).
+
+use drift_core::blob::{decode, encode, Image, HEADER_LEN, TRAILER_LEN};
+use drift_core::{Corrector, ModifiedTables, PolynomialTables, Sample};
+
+const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
+
+/// Fixes the declared length and/or the CRC of `bytes` as the mode byte asks.
+pub fn prepare(mode: u8, bytes: &mut [u8]) {
+    let len = bytes.len();
+    if len < HEADER_LEN + TRAILER_LEN {
+        return;
+    }
+    let body = len - TRAILER_LEN;
+    if mode & 1 != 0 {
+        let payload = u32::try_from(body - HEADER_LEN).unwrap_or(u32::MAX);
+        bytes[8..12].copy_from_slice(&payload.to_le_bytes());
+    }
+    if mode & 2 != 0 {
+        let crc = CRC32.checksum(&bytes[..body]);
+        bytes[body..].copy_from_slice(&crc.to_le_bytes());
+    }
+}
+
+fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8]) {
+    let Ok(model) = decode::<M>(bytes) else {
+        return;
+    };
+    assert!(model.validate().is_ok(), "decoded model fails validation");
+    let mut buffer = vec![0; bytes.len() + 64];
+    let len = encode(&model, &mut buffer).expect("a decoded model re-encodes");
+    // Finding F1 (docs/reliability.md): images are not canonical (the reserved header byte is
+    // ignored, postcard accepts overlong varints), so several byte strings decode to one model.
+    // The CRC still covers every byte. What must hold: the model survives encode → decode, and the
+    // canonical image is never longer than the one decoded.
+    assert!(len <= bytes.len(), "re-encoding is longer than the image");
+    let again = decode::<M>(&buffer[..len]).expect("a re-encoded model decodes");
+    assert_eq!(again, model, "the model changes through encode → decode");
+    let mut corrector = Corrector::new(&model).expect("a decoded model is accepted");
+    corrector
+        .power_on([6000.0; 3])
+        .expect("finite switch-on is accepted");
+    for ms in [0, 1, 10_000, 200_000] {
+        let out = corrector.correct(&Sample {
+            since_power_on_ms: ms,
+            rate_dps: [0.1; 3],
+            temperature_raw: [6100.0; 3],
+        });
+        assert!(out.corrected_dps.iter().all(|v| v.is_finite()), "{out:?}");
+    }
+}
+
+/// Runs one input.
+pub fn run(data: &[u8]) {
+    let Some((&mode, image)) = data.split_first() else {
+        return;
+    };
+    let mut bytes = image.to_vec();
+    prepare(mode, &mut bytes);
+    check::<ModifiedTables>(&bytes);
+    // A small firmware capacity: over-capacity counts must be refused, not truncated.
+    check::<ModifiedTables<8, 4, 8>>(&bytes);
+    check::<PolynomialTables>(&bytes);
+}

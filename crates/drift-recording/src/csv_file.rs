@@ -1,0 +1,583 @@
+//! Measured data from CSV (plain or gzip): rows of time, three rates and three temperatures →
+//! one [`Segment`] per activation, validated like the MCAP reader (errors name the file, the
+//! column and the row).
+//!
+//! Column mapping ([`CsvColumns`], defaults in brackets): time in seconds [`t_s`], rates in °/s
+//! [`gx_dps`, `gy_dps`, `gz_dps`], temperatures in °C per axis [`temp_c` for all three: a
+//! single die sensor], and an optional activation column [`segment_id`]: consecutive rows with
+//! the same value are one activation. Temperatures become raw readings at 200 raw/°C (the
+//! recording format's scale), rounded. Any other column is ignored. The defaults read the
+//! MPU6050 static recordings of `sunsided/sensor-fusion` (`../shared/data/measured/`).
+//!
+//! Timing ([`CsvTiming`]): `Strict` takes every row as one sample of a fixed-rate stream: times
+//! must sit on the grid, with no gap; `Resample` is for host-timestamped logs with jitter
+//! (times strictly increasing, gaps up to a limit), linearly interpolated onto the fixed grid.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use crate::read::Recording;
+use crate::segment::{
+    Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS, TEMPERATURE_MISSING_RAW,
+};
+
+/// Which CSV column holds what (header names).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsvColumns {
+    /// Time, seconds (any origin: each activation starts at its first row).
+    pub time_s: String,
+    /// Angular rate X, Y, Z, °/s.
+    pub rate_dps: [String; 3],
+    /// Temperature for X, Y, Z, °C (the same column three times for a single sensor).
+    pub temperature_celsius: [String; 3],
+    /// Activation id: consecutive rows with the same value form one activation. `None`: the whole
+    /// file is one activation.
+    pub segment: Option<String>,
+}
+
+impl Default for CsvColumns {
+    fn default() -> Self {
+        let s = |v: &str| v.to_owned();
+        Self {
+            time_s: s("t_s"),
+            rate_dps: [s("gx_dps"), s("gy_dps"), s("gz_dps")],
+            temperature_celsius: [s("temp_c"), s("temp_c"), s("temp_c")],
+            segment: Some(s("segment_id")),
+        }
+    }
+}
+
+/// How row times map onto the fixed sample grid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CsvTiming {
+    /// Every row is the next sample: `(t − t_first) · rate` must be within 0.25 of the row's index
+    /// in its activation. A late row is a gap, an early or repeated one an error.
+    Strict,
+    /// Host timestamps: times strictly increasing, no step longer than `max_gap_s`; the values
+    /// are interpolated linearly onto the grid `k / rate` from the activation's first row.
+    Resample {
+        /// Longest accepted step between consecutive rows, s.
+        max_gap_s: f64,
+    },
+}
+
+/// How to read a CSV file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsvOptions {
+    /// Column mapping.
+    pub columns: CsvColumns,
+    /// Sample rate of the segments, Hz (must divide 10⁹, like the recording format's).
+    pub sample_rate_hz: u32,
+    /// Timing policy.
+    pub timing: CsvTiming,
+    /// Unit id of every activation.
+    pub unit_id: String,
+    /// Chamber set point of every activation, °C; `None`: each activation's first temperature
+    /// (mean over the axes), i.e. the ambient at switch-on.
+    pub set_point_celsius: Option<f64>,
+    /// Series kind of every activation.
+    pub series_kind: SeriesKind,
+    /// Accept an empty or NaN temperature cell as a sensor dropout
+    /// ([`TEMPERATURE_MISSING_RAW`]); otherwise it is an error. Rates never accept one.
+    pub temperature_dropouts: bool,
+}
+
+impl Default for CsvOptions {
+    fn default() -> Self {
+        Self {
+            columns: CsvColumns::default(),
+            sample_rate_hz: 1000,
+            timing: CsvTiming::Strict,
+            unit_id: "csv".into(),
+            set_point_celsius: None,
+            series_kind: SeriesKind::Protocol,
+            temperature_dropouts: false,
+        }
+    }
+}
+
+impl CsvOptions {
+    /// The MPU6050 static recordings (`mpu6050_static.csv.gz`): 100 Hz host timestamps with jitter
+    /// and pauses up to 0.5 s, one die temperature.
+    pub fn mpu6050_static() -> Self {
+        Self {
+            sample_rate_hz: 100,
+            timing: CsvTiming::Resample { max_gap_s: 0.5 },
+            unit_id: "MPU6050".into(),
+            ..Self::default()
+        }
+    }
+}
+
+/// A CSV file could not be read or failed validation. Every variant names the file; value
+/// errors name the column and the row.
+#[derive(Debug, thiserror::Error)]
+pub enum CsvError {
+    /// File-system or decompression error.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The options cannot be used.
+    #[error("{path}: option `{field}`: {reason}")]
+    Options {
+        /// The file.
+        path: PathBuf,
+        /// The option.
+        field: &'static str,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A mapped column is not in the header.
+    #[error("{path}: missing column `{column}` (the header has: {header})")]
+    MissingColumn {
+        /// The file.
+        path: PathBuf,
+        /// The column asked for.
+        column: String,
+        /// The header's columns, comma-separated.
+        header: String,
+    },
+    /// A row is malformed or inconsistent with its neighbours.
+    #[error("{path}: row {row} (line {line}){}: {reason}", column.as_ref().map(|c| format!(", column `{c}`")).unwrap_or_default())]
+    Row {
+        /// The file.
+        path: PathBuf,
+        /// Data row, from 1 (the header is not counted).
+        row: u64,
+        /// Line in the file, from 1 (the header is line 1).
+        line: u64,
+        /// The column, when one value is at fault.
+        column: Option<String>,
+        /// What is wrong: expected vs found.
+        reason: String,
+    },
+    /// The file has a header but no data row.
+    #[error("{path}: no data rows")]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+}
+
+/// Reads a CSV file (gzip-compressed if its name ends in `.gz`) into a [`Recording`] whose
+/// metadata says where it came from; [`crate::write_recording`] then converts it to MCAP.
+pub fn read_csv(path: &Path, options: &CsvOptions) -> Result<Recording, CsvError> {
+    let io = |source| CsvError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let gz = path.extension().is_some_and(|e| e == "gz");
+    let reader: Box<dyn Read> = if gz {
+        Box::new(flate2::read::MultiGzDecoder::new(std::io::BufReader::new(
+            file,
+        )))
+    } else {
+        Box::new(std::io::BufReader::new(file))
+    };
+    read_csv_from(path, reader, options)
+}
+
+/// Reads CSV text held in memory (not compressed); `name` stands for the file in errors. The same
+/// checks as [`read_csv`]; fuzzing drives it directly.
+pub fn read_csv_bytes(
+    name: &Path,
+    bytes: &[u8],
+    options: &CsvOptions,
+) -> Result<Recording, CsvError> {
+    read_csv_from(name, bytes, options)
+}
+
+/// One activation's rows as read, before they are put on the grid.
+#[derive(Default)]
+struct Rows {
+    id: String,
+    time_s: Vec<f64>,
+    rate: [Vec<f64>; 3],
+    celsius: [Vec<f64>; 3],
+    /// (row, line) of every row, for errors found after reading.
+    at: Vec<(u64, u64)>,
+}
+
+struct Columns {
+    time: usize,
+    rate: [usize; 3],
+    temperature: [usize; 3],
+    segment: Option<usize>,
+}
+
+fn read_csv_from<R: Read>(
+    path: &Path,
+    input: R,
+    options: &CsvOptions,
+) -> Result<Recording, CsvError> {
+    let fs = options.sample_rate_hz;
+    if fs == 0 || 1_000_000_000 % fs != 0 {
+        return Err(CsvError::Options {
+            path: path.to_path_buf(),
+            field: "sample_rate_hz",
+            reason: format!("must divide 10⁹, got {fs}"),
+        });
+    }
+    if let CsvTiming::Resample { max_gap_s } = options.timing {
+        if !(max_gap_s.is_finite() && max_gap_s > 0.0) {
+            return Err(CsvError::Options {
+                path: path.to_path_buf(),
+                field: "timing.max_gap_s",
+                reason: format!("must be > 0 s, got {max_gap_s}"),
+            });
+        }
+    }
+    let mut reader = csv::ReaderBuilder::new().flexible(false).from_reader(input);
+    let header = reader
+        .headers()
+        .map_err(|e| row_error(path, &e, 0, 1))?
+        .clone();
+    let find = |name: &str| {
+        header
+            .iter()
+            .position(|h| h.trim() == name)
+            .ok_or_else(|| CsvError::MissingColumn {
+                path: path.to_path_buf(),
+                column: name.to_owned(),
+                header: header.iter().collect::<Vec<_>>().join(","),
+            })
+    };
+    let c = &options.columns;
+    let columns = Columns {
+        time: find(&c.time_s)?,
+        rate: [
+            find(&c.rate_dps[0])?,
+            find(&c.rate_dps[1])?,
+            find(&c.rate_dps[2])?,
+        ],
+        temperature: [
+            find(&c.temperature_celsius[0])?,
+            find(&c.temperature_celsius[1])?,
+            find(&c.temperature_celsius[2])?,
+        ],
+        segment: c.segment.as_deref().map(find).transpose()?,
+    };
+    let mut done: Vec<Rows> = Vec::new();
+    let mut current: Option<Rows> = None;
+    let mut record = csv::StringRecord::new();
+    let mut row = 0u64;
+    loop {
+        let line = reader.position().line();
+        match reader.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(row_error(path, &e, row + 1, line)),
+        }
+        row += 1;
+        let line = record.position().map_or(line, csv::Position::line);
+        let bad = |column: &str, reason: String| CsvError::Row {
+            path: path.to_path_buf(),
+            row,
+            line,
+            column: Some(column.to_owned()),
+            reason,
+        };
+        let id = columns
+            .segment
+            .map(|i| record.get(i).unwrap_or_default().trim().to_owned())
+            .unwrap_or_default();
+        if current.as_ref().is_none_or(|r| r.id != id) {
+            if let Some(finished) = current.take() {
+                if done.iter().any(|d| d.id == id) || finished.id == id {
+                    let column = c.segment.as_deref().unwrap_or_default();
+                    return Err(bad(
+                        column,
+                        format!("activation `{id}` resumes after activation `{}`: rows of one activation must be consecutive", finished.id),
+                    ));
+                }
+                done.push(finished);
+            }
+            current = Some(Rows {
+                id,
+                ..Rows::default()
+            });
+        }
+        let rows = current
+            .as_mut()
+            .ok_or_else(|| bad(&c.time_s, "internal: no activation".into()))?;
+        let number = |index: usize, name: &str| -> Result<f64, CsvError> {
+            let text = record.get(index).unwrap_or_default().trim();
+            text.parse::<f64>()
+                .map_err(|_| bad(name, format!("`{text}` is not a number")))
+        };
+        let time = number(columns.time, &c.time_s)?;
+        if !time.is_finite() {
+            return Err(bad(&c.time_s, format!("time is {time}")));
+        }
+        if let Some(&previous) = rows.time_s.last() {
+            if time == previous {
+                return Err(bad(
+                    &c.time_s,
+                    format!("duplicate time {time} s (the previous row has the same)"),
+                ));
+            }
+            if time < previous {
+                return Err(bad(
+                    &c.time_s,
+                    format!("time {time} s goes back (previous row {previous} s)"),
+                ));
+            }
+        }
+        for axis in 0..3 {
+            let rate = number(columns.rate[axis], &c.rate_dps[axis])?;
+            if !rate.is_finite() {
+                return Err(bad(&c.rate_dps[axis], format!("non-finite rate {rate}")));
+            }
+            // Segments hold f32: a finite f64 beyond f32's range would become ±∞ there.
+            if !(rate as f32).is_finite() {
+                return Err(bad(
+                    &c.rate_dps[axis],
+                    format!("rate {rate} °/s is beyond the f32 range of a segment"),
+                ));
+            }
+            rows.rate[axis].push(rate);
+            let name = &c.temperature_celsius[axis];
+            let text = record
+                .get(columns.temperature[axis])
+                .unwrap_or_default()
+                .trim();
+            let celsius = if text.is_empty() {
+                f64::NAN
+            } else {
+                number(columns.temperature[axis], name)?
+            };
+            if celsius.is_nan() && !options.temperature_dropouts {
+                return Err(bad(name, format!("missing temperature `{text}` (set temperature_dropouts to read it as a sensor dropout)")));
+            }
+            if celsius.is_infinite() || (celsius.is_finite() && !raw_in_range(celsius)) {
+                return Err(bad(
+                    name,
+                    format!("temperature {celsius} °C is outside the raw range (±163.8 °C)"),
+                ));
+            }
+            rows.celsius[axis].push(celsius);
+        }
+        rows.time_s.push(time);
+        rows.at.push((row, line));
+    }
+    done.extend(current);
+    if done.is_empty() {
+        return Err(CsvError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    let mut segments = done
+        .iter()
+        .enumerate()
+        .map(|(k, rows)| to_segment(path, rows, k, options))
+        .collect::<Result<Vec<_>, _>>()?;
+    // Activations whose clock restarts (each from t = 0, as in the MPU6050 file) are laid out one
+    // second apart, so the recording's log times increase and it can be written as MCAP.
+    let period_ns = 1_000_000_000 / u64::from(fs);
+    let mut end_ns = 0u64;
+    for (k, s) in segments.iter_mut().enumerate() {
+        // `<=`: a switch-on at the previous switch-off's time would repeat a power-event timestamp.
+        if k > 0 && s.power_on_ns <= end_ns {
+            s.power_on_ns = end_ns.saturating_add(1_000_000_000);
+        }
+        end_ns = s.power_on_ns.saturating_add(s.len() as u64 * period_ns);
+    }
+    let metadata = [
+        ("format_version", crate::schema::FORMAT_VERSION.to_owned()),
+        ("unit_id", options.unit_id.clone()),
+        ("sample_rate_hz", fs.to_string()),
+        ("series_kind", options.series_kind.as_str().to_owned()),
+        ("temperature_raw_per_celsius", format!("{RAW_PER_CELSIUS}")),
+        ("source", format!("csv: {}", path.display())),
+    ]
+    .into_iter()
+    .chain(
+        options
+            .set_point_celsius
+            .map(|s| ("set_point_celsius", format!("{s}"))),
+    )
+    .map(|(k, v)| (k.to_owned(), v))
+    .collect();
+    Ok(Recording {
+        path: path.to_path_buf(),
+        metadata,
+        unit_id: options.unit_id.clone(),
+        sample_rate_hz: fs,
+        segments,
+    })
+}
+
+fn row_error(path: &Path, e: &csv::Error, row: u64, line: u64) -> CsvError {
+    let (line, reason) = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            pos,
+            expected_len,
+            len,
+        } => (
+            pos.as_ref().map_or(line, csv::Position::line),
+            format!("{len} fields, the header has {expected_len}"),
+        ),
+        csv::ErrorKind::Io(io) => (line, format!("read error: {io}")),
+        _ => (line, e.to_string()),
+    };
+    CsvError::Row {
+        path: path.to_path_buf(),
+        row,
+        line,
+        column: None,
+        reason,
+    }
+}
+
+/// Raw readings are `int16` at 200 raw/°C, and −32768 is the dropout marker.
+fn raw_in_range(celsius: f64) -> bool {
+    let raw = (celsius * RAW_PER_CELSIUS).round();
+    raw > f64::from(TEMPERATURE_MISSING_RAW) && raw <= f64::from(i16::MAX)
+}
+
+fn to_raw(celsius: f64) -> i16 {
+    if celsius.is_finite() {
+        // In range: checked per row (interpolation stays between two checked values).
+        (celsius * RAW_PER_CELSIUS).round() as i16
+    } else {
+        TEMPERATURE_MISSING_RAW
+    }
+}
+
+fn to_segment(
+    path: &Path,
+    rows: &Rows,
+    k: usize,
+    options: &CsvOptions,
+) -> Result<Segment, CsvError> {
+    let fs = f64::from(options.sample_rate_hz);
+    let t0 = rows.time_s.first().copied().unwrap_or_default();
+    let at = |i: usize| rows.at.get(i).copied().unwrap_or_default();
+    let timing_error = |i: usize, reason: String| {
+        let (row, line) = at(i);
+        CsvError::Row {
+            path: path.to_path_buf(),
+            row,
+            line,
+            column: Some(options.columns.time_s.clone()),
+            reason,
+        }
+    };
+    let mut rate: [Vec<f32>; 3] = Default::default();
+    let mut raw: [Vec<i16>; 3] = Default::default();
+    match options.timing {
+        CsvTiming::Strict => {
+            for (i, &t) in rows.time_s.iter().enumerate() {
+                let position = (t - t0) * fs;
+                let index = position.round();
+                if (position - i as f64).abs() > 0.25 {
+                    let what = if index > i as f64 {
+                        "gap"
+                    } else {
+                        "early sample"
+                    };
+                    return Err(timing_error(
+                        i,
+                        format!(
+                            "{what}: time {t} s is sample {position:.2} of the activation at {} Hz, expected sample {i}",
+                            options.sample_rate_hz
+                        ),
+                    ));
+                }
+                for axis in 0..3 {
+                    rate[axis].push(rows.rate[axis][i] as f32);
+                    raw[axis].push(to_raw(rows.celsius[axis][i]));
+                }
+            }
+        }
+        CsvTiming::Resample { max_gap_s } => {
+            if let Some(i) = rows.time_s.windows(2).position(|w| w[1] - w[0] > max_gap_s) {
+                return Err(timing_error(
+                    i + 1,
+                    format!(
+                        "gap: {:.3} s since the previous row (at most {max_gap_s} s)",
+                        rows.time_s[i + 1] - rows.time_s[i]
+                    ),
+                ));
+            }
+            let last = rows.time_s.last().copied().unwrap_or(t0);
+            let n = ((last - t0) * fs + 1e-9).floor() as usize + 1;
+            if n > u32::MAX as usize / 2 {
+                return Err(timing_error(
+                    rows.time_s.len() - 1,
+                    format!("activation of {} s is too long", last - t0),
+                ));
+            }
+            let mut j = 0;
+            for s in 0..n {
+                let t = t0 + s as f64 / fs;
+                while j + 2 < rows.time_s.len() && rows.time_s[j + 1] <= t {
+                    j += 1;
+                }
+                let ta = rows.time_s[j];
+                let tb = rows.time_s.get(j + 1).copied().unwrap_or(ta);
+                let w = if tb > ta {
+                    ((t - ta) / (tb - ta)).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let lerp = |v: &[f64]| {
+                    let a = v[j];
+                    let b = v.get(j + 1).copied().unwrap_or(a);
+                    if w == 0.0 {
+                        a
+                    } else if w == 1.0 {
+                        b
+                    } else {
+                        a + (b - a) * w
+                    }
+                };
+                for axis in 0..3 {
+                    rate[axis].push(lerp(&rows.rate[axis]) as f32);
+                    raw[axis].push(to_raw(lerp(&rows.celsius[axis])));
+                }
+            }
+        }
+    }
+    let n = rate[0].len();
+    let first: Vec<f64> = (0..3)
+        .map(|a| rows.celsius[a][0])
+        .filter(|c| c.is_finite())
+        .collect();
+    let set_point = match options.set_point_celsius {
+        Some(s) => s,
+        None if first.is_empty() => {
+            return Err(timing_error(
+                0,
+                "no temperature in the activation's first row to take the set point from \
+                 (give set_point_celsius)"
+                    .into(),
+            ))
+        }
+        None => first.iter().sum::<f64>() / first.len() as f64,
+    };
+    let labels = SegmentLabels {
+        unit_id: options.unit_id.clone(),
+        set_point_celsius: set_point,
+        series_kind: options.series_kind,
+        series: u32::try_from(k + 1).unwrap_or(u32::MAX),
+        repeat: 1,
+        activation: 1,
+        interval_min: None,
+        off_before_s: None,
+    };
+    Ok(Segment {
+        labels,
+        sample_rate_hz: options.sample_rate_hz,
+        power_on_ns: (t0 * 1e9).max(0.0) as u64,
+        since_power_on: (0..n as u32).collect(),
+        rate_dps: rate,
+        temperature_raw: raw,
+        aux: Default::default(),
+    })
+}
