@@ -12,8 +12,11 @@ pub mod models;
 pub mod recording;
 pub mod seeds;
 
+/// A target's body: runs one input, panics only on a broken invariant.
+pub type Target = fn(&[u8]);
+
 /// Every target by its cargo-fuzz name (the folder of its corpus under `fuzz/corpus/`).
-pub const TARGETS: [(&str, fn(&[u8])); 4] = [
+pub const TARGETS: [(&str, Target); 4] = [
     ("blob", blob::run),
     ("recording", recording::run),
     ("csv", csv::run),
