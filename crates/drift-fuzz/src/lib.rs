@@ -12,7 +12,7 @@ pub mod models;
 pub mod recording;
 pub mod seeds;
 
-/// A fuzz target's body: takes any bytes, must not panic.
+/// A target's body: runs one input, panics only on a broken invariant.
 pub type Target = fn(&[u8]);
 
 /// Every target by its cargo-fuzz name (the folder of its corpus under `fuzz/corpus/`).

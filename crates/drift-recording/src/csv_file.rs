@@ -24,7 +24,7 @@ use crate::segment::{
 /// Which CSV column holds what (header names).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CsvColumns {
-    /// Time, seconds (any origin: each activation starts at its first row).
+    /// Time, seconds, 0 … 292 years (any origin: each activation starts at its first row).
     pub time_s: String,
     /// Angular rate X, Y, Z, °/s.
     pub rate_dps: [String; 3],
@@ -561,6 +561,14 @@ fn to_segment(
         }
         None => first.iter().sum::<f64>() / first.len() as f64,
     };
+    // The recording clock is u64 ns (584 years): a time beyond it is a bad row, not a wrap.
+    let end_s = t0 + n as f64 / fs;
+    if !(t0 >= 0.0 && end_s * 1e9 < u64::MAX as f64 / 2.0) {
+        return Err(timing_error(
+            0,
+            format!("time {t0} s is outside the recording clock (0 … 292 years in ns)"),
+        ));
+    }
     let labels = SegmentLabels {
         unit_id: options.unit_id.clone(),
         set_point_celsius: set_point,

@@ -28,6 +28,14 @@ pub enum WriteError {
         /// The topic.
         topic: String,
     },
+    /// The recording cannot be written as given (e.g. its times overflow the ns clock).
+    #[error("{path}: {reason}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
     /// The file was already finished.
     #[error("{path}: already finished")]
     Finished {

@@ -174,6 +174,20 @@ fn open_bytes(path: &Path, buf: Vec<u8>) -> Result<Opened, ReadError> {
     let mut metadata = None;
     for index in &summary.metadata_indexes {
         if index.name == schema::METADATA_RECORDING {
+            // mcap 0.26 adds offset + length unchecked and slices with them (found by fuzzing,
+            // F9): check the index against the file first.
+            let fits = index
+                .offset
+                .checked_add(index.length)
+                .is_some_and(|end| end <= buf.len() as u64);
+            if !fits {
+                return Err(meta_err(format!(
+                    "metadata index points outside the file (offset {}, length {}, file {} bytes)",
+                    index.offset,
+                    index.length,
+                    buf.len()
+                )));
+            }
             metadata = Some(
                 mcap::read::metadata(&buf, index)
                     .map_err(mcap_err)?
@@ -394,7 +408,10 @@ impl Reader<'_> {
             return Err("activation without samples".into());
         }
         let period_ns = 1_000_000_000 / u64::from(self.rate_hz);
-        let expected_off = open.on_ns + n as u64 * period_ns;
+        let expected_off = (n as u64)
+            .checked_mul(period_ns)
+            .and_then(|d| open.on_ns.checked_add(d))
+            .ok_or("the activation ends beyond the u64 ns clock (584 years)")?;
         if log_ns < expected_off {
             return Err(format!(
                 "switch-off at {log_ns} ns precedes the end of the last sample ({expected_off} ns)"

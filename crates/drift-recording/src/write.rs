@@ -74,7 +74,19 @@ pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteE
     let mut f = create_recording(path, recording.metadata.clone())?;
     for segment in &recording.segments {
         let fs = segment.sample_rate_hz;
-        let period_ns = 1_000_000_000 / u64::from(fs);
+        let period_ns = 1_000_000_000 / u64::from(fs.max(1));
+        // Every log time below is at most the switch-off time: check it once.
+        let off_ns = (segment.len() as u64)
+            .checked_mul(period_ns)
+            .and_then(|d| segment.power_on_ns.checked_add(d))
+            .ok_or_else(|| WriteError::Invalid {
+                path: path.to_path_buf(),
+                reason: format!(
+                    "activation at {} ns with {} samples ends beyond the u64 ns clock",
+                    segment.power_on_ns,
+                    segment.len()
+                ),
+            })?;
         let batch = (fs / 10).max(1) as usize;
         let aux_every = (fs / AUX_RATE_HZ).max(1) as usize;
         f.power(&event(segment, true), segment.power_on_ns)?;
@@ -131,10 +143,7 @@ pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteE
             f.write_encoded(schema::TOPIC_SET_POINT, log_ns)?;
             first = end;
         }
-        f.power(
-            &event(segment, false),
-            segment.power_on_ns + n as u64 * period_ns,
-        )?;
+        f.power(&event(segment, false), off_ns)?;
     }
     f.finish()
 }
