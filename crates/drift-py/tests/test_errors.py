@@ -443,7 +443,7 @@ def test_path_must_be_a_path(modified: ModifiedTables) -> None:
     [
         ({"raw_per_celsius": 0.0}, TableError, "invalid tables: raw_per_celsius: must be greater than zero"),
         ({"raw_per_celsius": float("nan")}, TableError, "raw_per_celsius: value is NaN or infinite"),
-        ({"rise_margin_celsius": -0.1}, TableError, "rise_margin_celsius: must be greater than zero"),
+        ({"rise_margin_celsius": -0.1}, TableError, "rise_margin_celsius: must not be negative"),
         ({"raw_at_zero_celsius": "zero"}, InputError, "`raw_at_zero_celsius` must be a float, got str"),
         (
             {"stuck_after_samples": 70000},
