@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The Python module's checks, from a really clean state: a fresh venv in .venv-check/ (deleted and
-# recreated on every run), `pip install ./crates/drift-py[test]` (a real PEP 517 build through
-# maturin), then pytest, mypy's stubtest, a strict type check of the examples, ruff, and the
-# examples themselves. Prints how long each step took. Safe to re-run; meant to be called from
+# recreated on every run), `pip install ./crates/drift-py[test,plot]` (a real PEP 517 build through
+# maturin, with matplotlib, pandas and mcap so the optional paths run), then pytest (with the CLI
+# binary, to compare simulated bytes), mypy's stubtest, a strict type check of the package's Python
+# code and the examples, ruff, and the examples themselves. Prints how long each step took. Safe to re-run; meant to be called from
 # scripts/check.sh (the single test command).
 #
 # Needs: python3 >= 3.9 (with venv; installed via apt-get if missing), Rust (cargo), and PyPI.
@@ -42,14 +43,21 @@ make_venv() {
 
 install_package() {
     # Builds the abi3 wheel with maturin (fetched by pip into an isolated build environment) and
-    # installs it with its test tools (pytest, hypothesis, mypy; numpy is a runtime dependency).
-    "$VENV/bin/python" -m pip install --quiet "./crates/drift-py[test]"
-    "$VENV/bin/python" -c 'import gyrodrift, numpy; print("gyrodrift", gyrodrift.__version__, "from", gyrodrift.__file__, "| numpy", numpy.__version__)'
+    # installs it with its test tools (pytest, hypothesis, mypy, ruff, pandas, mcap) and the plot
+    # extra (matplotlib); numpy is a runtime dependency.
+    "$VENV/bin/python" -m pip install --quiet "./crates/drift-py[test,plot]"
+    "$VENV/bin/python" -c 'import gyrodrift, numpy, pandas, matplotlib; print("gyrodrift", gyrodrift.__version__, "from", gyrodrift.__file__, "| numpy", numpy.__version__, "| pandas", pandas.__version__, "| matplotlib", matplotlib.__version__)'
+}
+
+build_cli() {
+    # The command line, for the test that `gyrodrift simulate` and `gyrodrift.simulate` write the
+    # same bytes, and for the Python mcap reader test below.
+    cargo build --quiet --release --locked -p gyrodrift
 }
 
 run_pytest() {
     # From the repository root, so `import gyrodrift` is the installed wheel, not the source tree.
-    "$VENV/bin/python" -m pytest crates/drift-py/tests -q -p no:cacheprovider
+    GYRODRIFT_BIN=target/release/gyrodrift "$VENV/bin/python" -m pytest crates/drift-py/tests -q -p no:cacheprovider --durations=5
 }
 
 run_stubtest() {
@@ -59,6 +67,8 @@ run_stubtest() {
 
 run_mypy_examples() {
     "$VENV/bin/python" -m mypy --strict --no-incremental crates/drift-py/examples crates/drift-py/bench
+    # The package's own Python (plot.py, tables.py, __init__.py) against the hand-written stubs.
+    (cd crates/drift-py/python && "../../../$VENV/bin/python" -m mypy --strict --no-incremental -p gyrodrift)
 }
 
 run_ruff() {
@@ -68,8 +78,7 @@ run_ruff() {
 
 run_recording_read_test() {
     # The Python `mcap` package must read what `gyrodrift simulate` writes (issue 3).
-    "$VENV/bin/python" -m pip install --quiet mcap mcap-ros2-support
-    cargo build --quiet --release --locked -p gyrodrift
+    "$VENV/bin/python" -m pip install --quiet mcap-ros2-support
     GYRODRIFT_BIN=target/release/gyrodrift "$VENV/bin/python" -m pytest crates/drift-sim/tests/python -q -p no:cacheprovider
 }
 
@@ -83,10 +92,11 @@ run_examples() {
 "$PYTHON" --version
 command -v cargo >/dev/null || { echo "cargo not found: install Rust (rustup) first" >&2; exit 1; }
 step "fresh venv in $VENV" make_venv
-step "pip install ./crates/drift-py[test] (maturin build)" install_package
+step "pip install ./crates/drift-py[test,plot] (maturin build)" install_package
+step "cargo build --release -p gyrodrift (the CLI)" build_cli
 step "pytest crates/drift-py/tests" run_pytest
 step "stubtest gyrodrift._gyrodrift" run_stubtest
-step "mypy --strict examples and bench" run_mypy_examples
+step "mypy --strict examples, bench and the package" run_mypy_examples
 step "ruff check and format --check" run_ruff
 step "examples" run_examples
 step "Python mcap reads gyrodrift recordings" run_recording_read_test

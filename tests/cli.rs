@@ -64,6 +64,11 @@ fn simulate_fit_and_report_from_the_command_line() {
         "{md}"
     );
     assert!(report.join("fig-correlation.svg").exists() && report.join("report.json").exists());
+    let diagnosis = dir.path().join("diagnosis");
+    let text = run(&["diagnose", c, "-q", "-o", diagnosis.to_str().unwrap()]);
+    assert!(text.contains("GIU-01:") && text.contains("  X: "), "{text}");
+    let md = std::fs::read_to_string(diagnosis.join("diagnosis.md")).unwrap();
+    assert!(md.contains("absorbed by the model"), "{md}");
 }
 
 #[test]

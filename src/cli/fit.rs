@@ -6,32 +6,20 @@ use anyhow::Context;
 use drift_core::blob::{encode, Image};
 use drift_fit::{FitSettings, FittedUnit};
 
+use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use crate::output::write_atomic;
-use drift_fit::pipeline::{self, Options};
+use drift_fit::pipeline;
 
 /// Options of `gyrodrift fit`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Campaign folder (with `recordings/`) or a folder of `.mcap` recordings.
-    pub campaign: PathBuf,
-    /// Chamber set points to fit, °C (protocol activations only).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "30,40",
-        allow_hyphen_values = true
-    )]
-    pub calibration: Vec<f64>,
+    /// Recordings and fit settings.
+    #[command(flatten)]
+    pub input: CampaignArgs,
     /// Output folder: one subfolder per unit.
     #[arg(long, short = 'o', default_value = "out/tables")]
     pub out: PathBuf,
-    /// Fit settings as JSON (fields of `drift_fit::FitSettings`; missing fields keep defaults).
-    #[arg(long)]
-    pub settings: Option<PathBuf>,
-    /// No progress bars.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
 }
 
 /// Reads fit settings from a JSON file, or the defaults.
@@ -86,19 +74,29 @@ pub fn write_tables(out: &Path, fitted: &[FittedUnit]) -> anyhow::Result<()> {
 
 /// Runs `gyrodrift fit`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let settings = load_settings(args.settings.as_deref())?;
-    let files = pipeline::recording_files(&args.campaign)?;
-    let options = Options {
-        calibration_set_points: args.calibration.clone(),
-        validation_set_points: Vec::new(),
-        fit: settings,
-        held_out_repeats: false,
-        evaluate: false,
-    };
-    let steps = Steps::new(args.quiet);
+    let files = pipeline::recording_files(&args.input.campaign)?;
+    let options = args.input.options(&[], false)?;
+    let steps = Steps::new(args.input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;
     steps.finish();
     write_tables(&args.out, &outcome.fitted)?;
+    let seconds = |step: &str| {
+        outcome
+            .timings
+            .iter()
+            .find(|(s, _)| s.starts_with(step))
+            .map_or(0.0, |(_, t)| *t)
+    };
+    let (read, analyse, fit) = (
+        seconds("read recordings"),
+        seconds("analyse"),
+        seconds("fit tables"),
+    );
+    println!(
+        "{} samples read in {read:.2} s; analysis {analyse:.2} s + fit {fit:.2} s = {:.2}× the reading time",
+        outcome.samples_read,
+        (analyse + fit) / read.max(1e-9)
+    );
     for unit in &outcome.fitted {
         let refs: Vec<String> = unit.modified.axes[0]
             .reference_ms

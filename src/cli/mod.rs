@@ -2,7 +2,9 @@
 
 use clap::{Parser, Subcommand};
 
+mod campaign_args;
 pub mod demo;
+pub mod diagnose;
 pub mod fit;
 mod progress;
 pub mod report;
@@ -28,6 +30,8 @@ pub enum Command {
     Fit(fit::Args),
     /// Fit, evaluate on data the fit did not see, and write the report.
     Report(report::Args),
+    /// Rank what explains the residual the paper's model leaves.
+    Diagnose(diagnose::Args),
 }
 
 /// Runs one parsed command line.
@@ -37,5 +41,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Simulate(args) => simulate::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Report(args) => report::run(&args),
+        Command::Diagnose(args) => diagnose::run(&args),
     }
 }

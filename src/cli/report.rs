@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 
 use drift_fit::summary::Split;
 
-use super::fit::{load_settings, write_tables};
+use super::campaign_args::CampaignArgs;
+use super::fit::write_tables;
 use super::progress::Steps;
 use crate::report::{write_report, ReportInput};
 use drift_fit::pipeline::{self, Options, Outcome};
@@ -12,16 +13,9 @@ use drift_fit::pipeline::{self, Options, Outcome};
 /// Options of `gyrodrift report`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Campaign folder (with `recordings/`) or a folder of `.mcap` recordings.
-    pub campaign: PathBuf,
-    /// Chamber set points to fit, °C.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "30,40",
-        allow_hyphen_values = true
-    )]
-    pub calibration: Vec<f64>,
+    /// Recordings and fit settings.
+    #[command(flatten)]
+    pub input: CampaignArgs,
     /// Chamber set points to validate on (never fitted), °C.
     #[arg(
         long,
@@ -36,12 +30,6 @@ pub struct Args {
     /// Output folder for the report, its figures and the fitted tables.
     #[arg(long, short = 'o', default_value = "out/report")]
     pub out: PathBuf,
-    /// Fit settings as JSON.
-    #[arg(long)]
-    pub settings: Option<PathBuf>,
-    /// No progress bars.
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
 }
 
 /// Fits, evaluates and writes the report; returns the report's path and the main outcome.
@@ -117,26 +105,21 @@ fn noise_ids(outcome: &Outcome) -> Vec<String> {
 
 /// Runs `gyrodrift report`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let options = Options {
-        calibration_set_points: args.calibration.clone(),
-        validation_set_points: args.validation.clone(),
-        fit: load_settings(args.settings.as_deref())?,
-        held_out_repeats: true,
-        evaluate: true,
-    };
+    let input = &args.input;
+    let options = input.options(&args.validation, true)?;
     let provenance = vec![format!(
         "Recordings: `{}`; calibration {:?} °C, validation {:?} °C.",
-        args.campaign.display(),
-        args.calibration,
+        input.campaign.display(),
+        input.calibration,
         args.validation
     )];
     let (path, outcome) = make(
-        &args.campaign,
+        &input.campaign,
         args.noise_floor.as_deref(),
         &options,
         &args.out,
         provenance,
-        args.quiet,
+        input.quiet,
     )?;
     print_headline(&outcome);
     println!("report: {}", path.display());

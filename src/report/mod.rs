@@ -2,7 +2,7 @@
 //! results.
 
 mod figures;
-mod plots;
+pub mod plots;
 mod tables;
 
 use std::fmt::Write as _;

@@ -157,6 +157,15 @@ fn le_u32(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(out)
 }
 
+/// The length in bytes of `model`'s image, without writing it (to size a buffer exactly).
+pub fn encoded_len<M: Image>(model: &M) -> Result<usize, BlobError> {
+    let payload = postcard::serialize_with_flavor(model, postcard::ser_flavors::Size::default())
+        .map_err(BlobError::Malformed)?;
+    Ok(HEADER_LEN
+        .saturating_add(payload)
+        .saturating_add(TRAILER_LEN))
+}
+
 /// Encodes `model` into `buffer`; returns the image's length. The model is validated first, so an
 /// image is never written from tables the firmware would reject.
 pub fn encode<M: Image>(model: &M, buffer: &mut [u8]) -> Result<usize, BlobError> {

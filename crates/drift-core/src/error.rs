@@ -79,6 +79,8 @@ pub enum Problem {
     NotIncreasing,
     /// Must be strictly positive.
     NotPositive,
+    /// Must not be negative.
+    Negative,
     /// The field has no entries but needs at least one.
     Empty,
     /// The field's length differs from the length it must match.
@@ -132,6 +134,7 @@ impl fmt::Display for Error {
             Problem::NonFinite => f.write_str(": value is NaN or infinite"),
             Problem::NotIncreasing => f.write_str(": not strictly greater than the previous value"),
             Problem::NotPositive => f.write_str(": must be greater than zero"),
+            Problem::Negative => f.write_str(": must not be negative"),
             Problem::Empty => f.write_str(": needs at least one entry"),
             Problem::LengthMismatch { expected, found } => {
                 write!(f, ": has {found} entries, expected {expected}")

@@ -39,6 +39,20 @@ impl Flags {
     /// good drift estimate is held.
     pub const MODEL_INVALID: Self = Self(1 << 8);
 
+    /// Every flag with its name, in bit order (for bindings, logs and reports: a flag added here is
+    /// listed everywhere).
+    pub const ALL: [(Self, &'static str); 9] = [
+        (Self::AMBIENT_OUT_OF_RANGE, "AMBIENT_OUT_OF_RANGE"),
+        (Self::RISE_OUT_OF_SPAN, "RISE_OUT_OF_SPAN"),
+        (Self::PAST_LAST_REFERENCE, "PAST_LAST_REFERENCE"),
+        (Self::TEMPERATURE_OUT_OF_RANGE, "TEMPERATURE_OUT_OF_RANGE"),
+        (Self::TEMPERATURE_INVALID, "TEMPERATURE_INVALID"),
+        (Self::TEMPERATURE_STUCK, "TEMPERATURE_STUCK"),
+        (Self::RATE_INVALID, "RATE_INVALID"),
+        (Self::NOT_POWERED_ON, "NOT_POWERED_ON"),
+        (Self::MODEL_INVALID, "MODEL_INVALID"),
+    ];
+
     /// Flags that mean the correction of this sample is degraded (a hold or pass-through), as opposed
     /// to an envelope clamp.
     pub const FAULTS: Self = Self(
@@ -81,5 +95,20 @@ impl BitOr for Flags {
 impl BitOrAssign for Flags {
     fn bitor_assign(&mut self, rhs: Self) {
         *self = self.union(rhs);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Flags;
+
+    #[test]
+    fn all_lists_every_bit_once_in_order() {
+        let mut seen = 0u16;
+        for (i, (flag, _)) in Flags::ALL.iter().enumerate() {
+            assert_eq!(flag.0, 1 << i);
+            seen |= flag.0;
+        }
+        assert_eq!(seen.count_ones() as usize, Flags::ALL.len());
     }
 }

@@ -38,6 +38,7 @@ pub use polynomial::{
 };
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
+pub use stage::heating::BracketCache;
 pub use stage::since_power_on::TimePosition;
 pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedAxisState, ModifiedTables};
 

@@ -65,7 +65,7 @@ impl Settings {
             ("rise_margin_celsius", self.rise_margin_celsius),
         ] {
             if value < 0.0 {
-                return Err(Error::new(field, at, Problem::NotPositive));
+                return Err(Error::new(field, at, Problem::Negative));
             }
         }
         Ok(())

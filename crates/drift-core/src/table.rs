@@ -7,7 +7,7 @@ use crate::flags::Flags;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
 use crate::stage::ambient::AmbientPosition;
-use crate::stage::heating::BlendedCurves;
+use crate::stage::heating::{BlendedCurves, BracketCache};
 use crate::stage::since_power_on::TimePosition;
 use crate::AXES;
 
@@ -167,15 +167,15 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
 /// Per-axis run-time state of the modified model: where the switch-on temperature fell among the
 /// calibration ambients (fixed for the activation), and where the previous sample's searches ended.
 ///
-/// The search hints only make the next search shorter; any hint gives the same result.
+/// The hints and the cache only make the next sample cheaper; they never change a result.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ModifiedAxisState {
     /// Stage 2's position, located at switch-on.
     pub ambient: AmbientPosition,
     /// Stage 1's last reference-time segment.
     pub segment_hint: u8,
-    /// Stage 3's last curve bracket.
-    pub curve_hint: u8,
+    /// Stage 3's last bracket and its knots.
+    pub bracket: BracketCache,
 }
 
 impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, A, C> {
@@ -247,7 +247,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         let (k, out_of_span) = curves.k_at(
             rise_celsius,
             settings.rise_margin_celsius,
-            &mut state.curve_hint,
+            &mut state.bracket,
         );
         let mut flags = Flags::NONE;
         if out_of_span {

@@ -230,3 +230,13 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn encoded_len_is_exact() {
+    use drift_core::blob::encoded_len;
+    let model = fixture::modified();
+    let mut buffer = vec![0; encoded_len(&model).unwrap()];
+    assert_eq!(encode(&model, &mut buffer).unwrap(), buffer.len());
+    let mut short = vec![0; buffer.len() - 1];
+    assert_eq!(encode(&model, &mut short), Err(BlobError::BufferTooSmall));
+}

@@ -15,7 +15,8 @@
 )]
 
 use drift_core::{
-    AmbientCurves, AmbientPosition, AxisTable, Curve, CurvePoint, ModifiedAxisState, Settings,
+    AmbientCurves, AmbientPosition, AxisTable, BracketCache, Curve, CurvePoint, ModifiedAxisState,
+    Settings,
 };
 use proptest::prelude::*;
 
@@ -86,8 +87,9 @@ fn position(table: &Table, celsius: f32) -> AmbientPosition {
     AmbientPosition::locate(&table.ambients, celsius, 0.5, |a| a.ambient_celsius)
 }
 
-/// `k` from a fresh state (no search hints), checked to be the same from states whose hints point
-/// elsewhere: hints may only shorten the search.
+/// `k` from a fresh state (no hints, empty cache), checked to be the same bits from states whose
+/// hints point elsewhere and from a state warmed up on other samples of the same activation: the
+/// hints and the bracket cache may only save work.
 fn k(table: &Table, celsius: f32, ms: u32, rise: f32) -> f32 {
     let fresh = ModifiedAxisState {
         ambient: position(table, celsius),
@@ -99,7 +101,10 @@ fn k(table: &Table, celsius: f32, ms: u32, rise: f32) -> f32 {
     for hint in [1, 4, 255] {
         let mut hinted = ModifiedAxisState {
             segment_hint: hint,
-            curve_hint: hint,
+            bracket: BracketCache {
+                curve: hint,
+                ..BracketCache::default()
+            },
             ..fresh
         };
         let hinted_k = table.correlation(&settings(), &mut hinted, ms, rise).0;
@@ -109,6 +114,20 @@ fn k(table: &Table, celsius: f32, ms: u32, rise: f32) -> f32 {
             "hint {hint} changed the result"
         );
     }
+    let mut warm = fresh;
+    for (other_ms, other_rise) in [
+        (ms / 2, rise * 0.5),
+        (ms.saturating_add(1), rise + 0.3),
+        (ms, rise * 1.5 + 0.1),
+    ] {
+        table.correlation(&settings(), &mut warm, other_ms, other_rise);
+    }
+    let warm_k = table.correlation(&settings(), &mut warm, ms, rise).0;
+    assert_eq!(
+        warm_k.to_bits(),
+        fresh_k.to_bits(),
+        "a warm cache changed the result"
+    );
     fresh_k
 }
 

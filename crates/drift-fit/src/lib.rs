@@ -10,6 +10,7 @@
 pub mod analyse;
 pub mod baselines;
 pub mod curves;
+pub mod diagnose;
 pub mod error;
 pub mod evaluate;
 pub mod fit;

@@ -117,9 +117,10 @@ pub fn recording_files(dir: &Path) -> Result<Vec<PathBuf>, PipelineError> {
     Ok(files)
 }
 
-/// Whether a recording's metadata says it may hold calibration activations. Files whose metadata
-/// lacks the set point or series kind are read in full (the segments' own labels then decide).
-fn may_hold_calibration(path: &Path, options: &Options) -> Result<bool, PipelineError> {
+/// What a recording's metadata says about it, without decoding a message: `Some(true)` for a
+/// protocol recording at a calibration set point, `Some(false)` for any other, `None` when the
+/// metadata lacks the set point or series kind (then the segments' own labels must decide).
+pub fn calibration_file(path: &Path, options: &Options) -> Result<Option<bool>, PipelineError> {
     let metadata = read_metadata(path)?;
     let set_point = metadata
         .get("set_point_celsius")
@@ -127,15 +128,13 @@ fn may_hold_calibration(path: &Path, options: &Options) -> Result<bool, Pipeline
     let kind = metadata
         .get("series_kind")
         .and_then(|s| SeriesKind::parse(s));
-    Ok(match (set_point, kind) {
-        (Some(set_point), Some(kind)) => {
-            kind == SeriesKind::Protocol && is_one_of(set_point, &options.calibration_set_points)
-        }
-        _ => true,
-    })
+    Ok(set_point.zip(kind).map(|(set_point, kind)| {
+        kind == SeriesKind::Protocol && is_one_of(set_point, &options.calibration_set_points)
+    }))
 }
 
-fn calibration_segment(segment: &Segment, options: &Options) -> bool {
+/// Whether an activation is calibration data: a protocol activation at a calibration set point.
+pub fn calibration_segment(segment: &Segment, options: &Options) -> bool {
     segment.labels.series_kind == SeriesKind::Protocol
         && is_one_of(
             segment.labels.set_point_celsius,
@@ -166,7 +165,7 @@ pub fn run(
             files.len() as u64,
         );
         let started = Instant::now();
-        if !may_hold_calibration(path, options)? {
+        if calibration_file(path, options)? == Some(false) {
             // Validation and field recordings are never decoded for the fit.
             continue;
         }

@@ -89,8 +89,10 @@ where
                     Ok(_) => assert!(raw.iter().all(|r| r.is_finite()), "accepted {raw:?}"),
                     Err(_) => {
                         assert!(raw.iter().any(|r| !r.is_finite()), "refused {raw:?}");
+                        // Compared as text: the state's bracket cache may hold NaN knots (no
+                        // curve above the top one), and NaN != NaN under `==`.
                         assert!(
-                            *corrector.state() == before,
+                            format!("{:?}", corrector.state()) == format!("{before:?}"),
                             "a refused power_on changed the state"
                         );
                     }

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes};
 
@@ -85,4 +86,37 @@ pub fn count_u16(name: &str, value: &Bound<'_, PyAny>) -> Result<u16, Error> {
             "`{name}` must be an integer in 0..=65535, got {got}"
         ))
     })
+}
+
+/// An argument as an error message shows it: its repr for plain values, dtype and shape for arrays.
+pub fn shown(value: &Bound<'_, PyAny>) -> String {
+    if value.cast::<numpy::PyUntypedArray>().is_ok() {
+        return describe(value);
+    }
+    value
+        .repr()
+        .map_or_else(|_| describe(value), |repr| repr.to_string())
+}
+
+/// Any argument pyo3 can convert to `T`; `expected` says what is accepted ("an integer ≥ 1").
+pub fn value<'py, T: FromPyObjectOwned<'py>>(
+    name: &str,
+    expected: &str,
+    value: &Bound<'py, PyAny>,
+) -> Result<T, Error> {
+    value
+        .extract::<T>()
+        .map_err(|_| Error::Input(format!("`{name}` must be {expected}, got {}", shown(value))))
+}
+
+/// An optional argument (`None` or left out: `None`).
+pub fn optional<'py, T: FromPyObjectOwned<'py>>(
+    name: &str,
+    expected: &str,
+    argument: Option<&Bound<'py, PyAny>>,
+) -> Result<Option<T>, Error> {
+    match argument {
+        Some(v) if !v.is_none() => value(name, expected, v).map(Some),
+        _ => Ok(None),
+    }
 }

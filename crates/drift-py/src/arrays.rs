@@ -284,3 +284,73 @@ impl<'py> OutArrays<'py> {
         })
     }
 }
+
+impl RowsView<'_> {
+    /// The first (row, column) holding NaN or ±inf, if any.
+    pub fn first_non_finite(&self) -> Option<(usize, usize)> {
+        fn find<T: AsF32>(view: &ArrayView2<'_, T>) -> Option<(usize, usize)> {
+            view.indexed_iter()
+                .find(|(_, v)| !v.as_f32().is_finite())
+                .map(|(index, _)| index)
+        }
+        match self {
+            Self::F32(view) => find(view),
+            Self::F64(view) => find(view),
+        }
+    }
+
+    /// Column `axis` as f32 values (rounded per value, as `astype(np.float32)` does).
+    pub fn column(&self, axis: usize) -> Vec<f32> {
+        match self {
+            Self::F32(view) => view.column(axis).to_vec(),
+            Self::F64(view) => view.column(axis).iter().map(|v| v.as_f32()).collect(),
+        }
+    }
+}
+
+/// A borrowed, non-empty `(n, 3)` int16 array (raw temperature readings), any strides.
+pub fn raw_rows<'py>(
+    name: &str,
+    value: &Bound<'py, PyAny>,
+) -> Result<PyReadonlyArray2<'py, i16>, Error> {
+    let wrong = || {
+        Error::Input(format!(
+            "`{name}` must be an int16 array of shape (n, 3), got {} (convert with .astype(np.int16))",
+            describe(value)
+        ))
+    };
+    let array = value.cast::<PyArray2<i16>>().map_err(|_| wrong())?;
+    if array.shape().get(1) != Some(&3) {
+        return Err(wrong());
+    }
+    not_empty(name, value, array.shape().first().copied().unwrap_or(0))?;
+    array
+        .try_readonly()
+        .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))
+}
+
+/// A 1-D float32 or float64 array of finite values, as f32 (may be empty).
+pub fn finite_values(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f32>, Error> {
+    let values: Vec<f32> = if let Ok(array) = value.cast::<PyArray1<f32>>() {
+        array.to_vec().map_err(|e| borrow_error(name, e))?
+    } else if let Ok(array) = value.cast::<PyArray1<f64>>() {
+        let values = array.to_vec().map_err(|e| borrow_error(name, e))?;
+        values.into_iter().map(AsF32::as_f32).collect()
+    } else {
+        return Err(Error::Input(format!(
+            "`{name}` must be a float32 or float64 array of shape (n,), got {}",
+            describe(value)
+        )));
+    };
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Input(format!(
+            "`{name}` must be finite, got {} at index {i}",
+            values.get(i).copied().unwrap_or(f32::NAN)
+        )));
+    }
+    Ok(values)
+}
+
+fn borrow_error(name: &str, error: impl std::fmt::Display) -> Error {
+    Error::Input(format!("`{name}` cannot be read: {error}"))
+}

@@ -5,7 +5,10 @@
 //! ├── InputError(GyrodriftError, ValueError)   a bad argument: type, dtype, shape, length, value
 //! ├── TableError(GyrodriftError)               table JSON or settings that do not form a valid model
 //! ├── ImageError(GyrodriftError)               a firmware table image that does not decode
-//! └── FileError(GyrodriftError, OSError)       a file that cannot be read or written
+//! ├── FileError(GyrodriftError, OSError)       a file that cannot be read or written
+//! ├── RecordingError(GyrodriftError)           a recording that does not read, validate or write
+//! ├── CampaignError(GyrodriftError, ValueError) a simulation campaign that is not valid
+//! └── FitError(GyrodriftError)                 data the tables cannot be fitted or evaluated from
 //! ```
 //!
 //! `InputError` and `FileError` also derive from the built-in exception a Python user would catch
@@ -14,6 +17,10 @@
 use std::path::PathBuf;
 
 use drift_core::blob::BlobError;
+use drift_fit::pipeline::PipelineError;
+use drift_fit::FitError as RustFitError;
+use drift_recording::{ReadError, WriteError};
+use drift_sim::SimError;
 use pyo3::exceptions::{PyException, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
@@ -38,6 +45,21 @@ pyo3::create_exception!(
     "A firmware table image that cannot be decoded (bad magic, version, kind, length, CRC, payload or contents)."
 );
 
+pyo3::create_exception!(
+    gyrodrift,
+    RecordingError,
+    GyrodriftError,
+    "A recording that cannot be read, fails validation or cannot be written; the message names the file, and the topic and message index where it applies."
+);
+pyo3::create_exception!(
+    gyrodrift,
+    FitError,
+    GyrodriftError,
+    "Recordings the tables cannot be fitted or evaluated from; the message names the unit and activation, or the setting."
+);
+
+const CAMPAIGN_ERROR_DOC: &str =
+    "A simulation campaign that is not valid (unknown field, value out of range, unparsable text). Also a ValueError.";
 const INPUT_ERROR_DOC: &str =
     "A bad argument: wrong type, dtype, shape or length, or a value the corrector rejects. Also a ValueError.";
 const FILE_ERROR_DOC: &str =
@@ -45,6 +67,7 @@ const FILE_ERROR_DOC: &str =
 
 static INPUT_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static FILE_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static CAMPAIGN_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 /// A class of the hierarchy with two bases, made once per interpreter by calling `type(...)`
 /// (`create_exception!` takes a single base).
@@ -88,6 +111,17 @@ pub fn file_error(py: Python<'_>) -> PyResult<Bound<'_, PyType>> {
     )
 }
 
+/// `gyrodrift.CampaignError`.
+pub fn campaign_error(py: Python<'_>) -> PyResult<Bound<'_, PyType>> {
+    two_base_class(
+        py,
+        &CAMPAIGN_ERROR,
+        "CampaignError",
+        py.get_type::<PyValueError>(),
+        CAMPAIGN_ERROR_DOC,
+    )
+}
+
 /// Everything the binding can fail with. Converted to a Python exception in one place
 /// (`From<Error> for PyErr`), so every message and class is decided here.
 #[derive(Debug)]
@@ -114,15 +148,93 @@ pub enum Error {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// A recording that does not read or validate (the text names file, topic, message index).
+    Read(ReadError),
+    /// A recording that cannot be written.
+    Write(WriteError),
+    /// A campaign that is not valid, or a simulation that failed.
+    Simulate(SimError),
+    /// A campaign given as text or a dict that does not parse.
+    Campaign(String),
+    /// Fitting or evaluation failed.
+    Fit(RustFitError),
+    /// The fit/evaluate pipeline stopped.
+    Pipeline(PipelineError),
+}
+
+impl From<ReadError> for Error {
+    fn from(error: ReadError) -> Self {
+        match error {
+            ReadError::Io { path, source } => Self::File {
+                action: "read",
+                path,
+                source,
+            },
+            other => Self::Read(other),
+        }
+    }
+}
+
+impl From<WriteError> for Error {
+    fn from(error: WriteError) -> Self {
+        match error {
+            WriteError::Io { path, source } => Self::File {
+                action: "write",
+                path,
+                source,
+            },
+            other => Self::Write(other),
+        }
+    }
+}
+
+impl From<SimError> for Error {
+    fn from(error: SimError) -> Self {
+        match error {
+            SimError::Io { path, source } => Self::File {
+                action: "write",
+                path,
+                source,
+            },
+            SimError::Write(error) => error.into(),
+            other => Self::Simulate(other),
+        }
+    }
+}
+
+impl From<RustFitError> for Error {
+    fn from(error: RustFitError) -> Self {
+        Self::Fit(error)
+    }
+}
+
+impl From<PipelineError> for Error {
+    fn from(error: PipelineError) -> Self {
+        match error {
+            PipelineError::List { path, source } => Self::File {
+                action: "read",
+                path,
+                source,
+            },
+            PipelineError::Read(error) => error.into(),
+            PipelineError::Fit(error) => Self::Fit(error),
+            other => Self::Pipeline(other),
+        }
+    }
+}
+
+/// An instance of a two-base class, or the error of making the class.
+fn two_base_error(class: PyResult<Bound<'_, PyType>>, message: String) -> PyErr {
+    match class {
+        Ok(class) => PyErr::from_type(class, message),
+        Err(err) => err,
+    }
 }
 
 impl From<Error> for PyErr {
     fn from(error: Error) -> Self {
         Python::attach(|py| match error {
-            Error::Input(message) => match input_error(py) {
-                Ok(class) => PyErr::from_type(class, message),
-                Err(err) => err,
-            },
+            Error::Input(message) => two_base_error(input_error(py), message),
             Error::Table(source) => TableError::new_err(format!("invalid tables: {source}")),
             Error::Json { model, source } => {
                 TableError::new_err(format!("not a valid {model} JSON: {source}"))
@@ -143,6 +255,22 @@ impl From<Error> for PyErr {
                     (Err(err), _) => err,
                 }
             }
+            Error::Read(source) => RecordingError::new_err(source.to_string()),
+            Error::Write(source) => {
+                RecordingError::new_err(format!("cannot write recording: {source}"))
+            }
+            Error::Simulate(source @ (SimError::Campaign { .. } | SimError::Parse { .. })) => {
+                two_base_error(campaign_error(py), source.to_string())
+            }
+            Error::Simulate(source) => {
+                two_base_error(campaign_error(py), format!("simulation failed: {source}"))
+            }
+            Error::Campaign(message) => two_base_error(campaign_error(py), message),
+            Error::Fit(source) => FitError::new_err(source.to_string()),
+            Error::Pipeline(source @ PipelineError::NoRecordings { .. }) => {
+                RecordingError::new_err(source.to_string())
+            }
+            Error::Pipeline(source) => FitError::new_err(source.to_string()),
         })
     }
 }
@@ -155,5 +283,8 @@ pub fn register(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add("TableError", py.get_type::<TableError>())?;
     module.add("ImageError", py.get_type::<ImageError>())?;
     module.add("FileError", file_error(py)?)?;
+    module.add("RecordingError", py.get_type::<RecordingError>())?;
+    module.add("CampaignError", campaign_error(py)?)?;
+    module.add("FitError", py.get_type::<FitError>())?;
     Ok(())
 }

@@ -1,16 +1,27 @@
 //! Python bindings for gyrodrift: the extension module `gyrodrift._gyrodrift`.
 //!
-//! A thin layer: argument conversion and delegation to drift-core; the numeric work stays there.
-//! One file per Python-facing area (`tables`, `settings`, `corrector`, `flags`); shared argument
-//! checks in `args` and `arrays`; every error goes through `errors`. See `README.md`.
+//! A thin layer: argument conversion and delegation to drift-core, drift-recording, drift-sim and
+//! drift-fit; the numeric work stays there. One file per Python-facing area; shared argument
+//! checks in `args` and `arrays`, numpy outputs in `outputs`; every error goes through `errors`.
+//! See `README.md`.
 
+mod analysed;
 mod args;
 mod arrays;
 mod corrector;
 mod errors;
+mod evaluation;
+mod fit;
+mod fit_settings;
 mod flags;
+mod labels;
 mod model_io;
+mod outputs;
+mod recording;
+mod segment;
 mod settings;
+mod simulate;
+mod sources;
 mod tables;
 
 use pyo3::prelude::*;
@@ -26,5 +37,21 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<tables::PyPolynomialTables>()?;
     module.add_class::<corrector::PyCorrector>()?;
     module.add_class::<corrector::PyOutput>()?;
+    module.add_class::<labels::PyLabels>()?;
+    module.add_class::<segment::PyAuxChannel>()?;
+    module.add_class::<segment::PySegment>()?;
+    module.add_class::<recording::PyRecording>()?;
+    module.add_function(wrap_pyfunction!(recording::load_campaign, module)?)?;
+    module.add_function(wrap_pyfunction!(simulate::simulate, module)?)?;
+    module.add_function(wrap_pyfunction!(simulate::resolve_campaign, module)?)?;
+    module.add_class::<fit_settings::PyFitSettings>()?;
+    module.add_class::<fit::PyFittedUnit>()?;
+    module.add_function(wrap_pyfunction!(fit::fit, module)?)?;
+    module.add_class::<analysed::PyAnalysed>()?;
+    module.add_function(wrap_pyfunction!(analysed::analyse, module)?)?;
+    module.add_class::<evaluation::PyActivationResult>()?;
+    module.add_class::<evaluation::PyEvaluation>()?;
+    module.add_function(wrap_pyfunction!(evaluation::evaluate, module)?)?;
+    module.add_function(wrap_pyfunction!(evaluation::summarise, module)?)?;
     Ok(())
 }

@@ -108,3 +108,62 @@ def powered_corrector(model: Model, case: Case) -> gyrodrift.Corrector:
         else:
             corrector.power_on(case.switch_on_raw)
     return corrector
+
+
+# --- a small simulated campaign, shared by the recording, fit and evaluation tests -------------
+
+SMALL_CAMPAIGN: dict[str, Any] = {
+    "name": "pytest",
+    "seed": 7,
+    "units": 1,
+    "set_points_celsius": [30.0, 40.0, 33.0],
+    # 20-s activations: long enough for the analysis (4-s initial-bias window, 2-s first reference
+    # time), short enough that the whole suite stays fast.
+    "protocol": {"intervals_min": [1.0, 20.0], "activations": 3, "activation_s": 20.0, "repeats": 2},
+}
+
+
+@pytest.fixture(scope="session")
+def campaign_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A simulated campaign folder: 1 unit, +30/+40/+33 °C, 2 intervals × 3 activations × 2 repeats."""
+    out = tmp_path_factory.mktemp("campaign")
+    gyrodrift.simulate(out, SMALL_CAMPAIGN)
+    return out
+
+
+@pytest.fixture(scope="session")
+def evaluation(campaign_dir: Path) -> gyrodrift.Evaluation:
+    return gyrodrift.evaluate(campaign_dir)
+
+
+def recording_path(campaign_dir: Path, set_point: str = "+30.0") -> Path:
+    return campaign_dir / "recordings" / f"GIU-01_sp{set_point}C_protocol.mcap"
+
+
+def format_aux(n: int, rate_hz: int = 1000) -> dict[str, tuple[np.ndarray, str, int]]:
+    """The auxiliary channels the recording format stores, for an activation of `n` samples."""
+    m = -(-n // (rate_hz // 100))
+    ones = np.ones(m, dtype=np.float32)
+    return {
+        "accel_x": (0 * ones, "g", 100),
+        "accel_y": (0 * ones, "g", 100),
+        "accel_z": (ones, "g", 100),
+        "supply_voltage": (5 * ones, "V", 100),
+        "chamber_set_point": (30 * ones, "degC", 100),
+    }
+
+
+def make_segment(
+    n: int = 2500, *, power_on_ns: int = 0, activation: int = 1, unit_id: str = "PY-1", aux: bool = True
+) -> gyrodrift.Segment:
+    """A synthetic activation: a slow warm-up with a drift that follows it."""
+    t = np.arange(n) / 1000.0
+    rise = 2.0 * (1 - np.exp(-t / 30.0))
+    temperature = (6000 + 200 * rise[:, None] + np.zeros((1, 3))).round().astype(np.int16)
+    rate = (0.01 * rise[:, None] * np.array([1.0, -0.5, 0.25])).astype(np.float32)
+    labels = gyrodrift.Labels(
+        unit_id=unit_id, set_point_celsius=30.0, activation=activation, interval_min=1.0, off_before_s=60.0
+    )
+    return gyrodrift.Segment(
+        labels, rate, temperature, power_on_ns=power_on_ns, aux=format_aux(n) if aux else None
+    )

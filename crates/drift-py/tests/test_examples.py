@@ -36,3 +36,33 @@ def test_correct_activation_reports_each_model() -> None:
         assert name in rows, out
     # The drift-aware model leaves less error than no correction at the end of the warm-up.
     assert float(rows["modified"][1]) < float(rows["uncorrected"][1]), out
+
+
+def test_report_table_prints_the_papers_table() -> None:
+    script = next(p for p in EXAMPLES if p.name == "report_table.py")
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    out = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, check=True, env=env, timeout=120
+    ).stdout
+    rows = {
+        tuple(cell.strip() for cell in line.strip("|").split("|")[:3]): line.strip("|").split("|")[3:]
+        for line in out.splitlines()
+        if line.startswith("| ")
+    }
+    assert ("calibration", "set point", "data") in rows, out
+    for model in ("standard", "modified"):
+        for set_point, data in (
+            ("+30 °C", "held-out repeat"),
+            ("+33 °C", "validation"),
+            ("+40 °C", "held-out repeat"),
+        ):
+            assert len(rows[(model, set_point, data)]) == 3, out  # one column per axis of the one unit
+    standard = [float(v) for v in rows[("standard", "+33 °C", "validation")]]
+    modified = [float(v) for v in rows[("modified", "+33 °C", "validation")]]
+    assert all(m < s for m, s in zip(modified, standard)), out
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        assert "figures skipped" in out
+    else:
+        assert "saved 5 figures" in out

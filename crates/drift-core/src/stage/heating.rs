@@ -41,67 +41,99 @@ impl<'a, const R: usize> BlendedCurves<'a, R> {
         }
     }
 
-    /// Curve `c` at the current time and ambient (rise scaled before the first reference time);
-    /// NaN if missing (only for tables that skipped validation).
+    /// Curve `c` blended between the two ambients (stage 2) at reference-time index `j`; NaN if
+    /// missing (only for tables that skipped validation).
+    #[inline(always)]
+    fn knot(&self, c: usize, j: usize) -> CurvePoint {
+        let at = |curves: &[Curve<R>]| curves.get(c).and_then(|curve| curve.points.get(j)).copied();
+        match at(self.lower) {
+            Some(lower) if self.weight > 0.0 => match at(self.upper) {
+                Some(upper) => CurvePoint {
+                    rise_celsius: lerp(lower.rise_celsius, upper.rise_celsius, self.weight),
+                    k_dps_per_celsius: lerp(
+                        lower.k_dps_per_celsius,
+                        upper.k_dps_per_celsius,
+                        self.weight,
+                    ),
+                },
+                None => MISSING,
+            },
+            Some(lower) => lower,
+            None => MISSING,
+        }
+    }
+
+    /// Curve `c`'s two blended knots around the current time.
+    #[inline(always)]
+    fn knots(&self, c: usize) -> [CurvePoint; 2] {
+        [self.knot(c, self.time.lo), self.knot(c, self.time.hi)]
+    }
+
+    /// A curve's point at the current time from its two knots (stage 1), the rise scaled before the
+    /// first reference time. The only place a point is made, so cached and fresh knots give the
+    /// same bits.
+    #[inline(always)]
+    fn at_time(&self, [lo, hi]: [CurvePoint; 2]) -> CurvePoint {
+        let fraction = self.time.fraction;
+        CurvePoint {
+            rise_celsius: self.time.rise_scale * lerp(lo.rise_celsius, hi.rise_celsius, fraction),
+            k_dps_per_celsius: lerp(lo.k_dps_per_celsius, hi.k_dps_per_celsius, fraction),
+        }
+    }
+
+    /// Curve `c` at the current time and ambient.
     #[inline(always)]
     fn point(&self, c: usize) -> CurvePoint {
-        let at_time = |curves: &[Curve<R>]| {
-            curves
-                .get(c)
-                .and_then(|curve| self.time.point(&curve.points))
-        };
-        let missing = CurvePoint {
-            rise_celsius: f32::NAN,
-            k_dps_per_celsius: f32::NAN,
-        };
-        let Some(lower) = at_time(self.lower) else {
-            return missing;
-        };
-        let blended = if self.weight > 0.0 {
-            let Some(upper) = at_time(self.upper) else {
-                return missing;
-            };
-            CurvePoint {
-                rise_celsius: lerp(lower.rise_celsius, upper.rise_celsius, self.weight),
-                k_dps_per_celsius: lerp(
-                    lower.k_dps_per_celsius,
-                    upper.k_dps_per_celsius,
-                    self.weight,
-                ),
-            }
-        } else {
-            lower
-        };
-        CurvePoint {
-            rise_celsius: self.time.rise_scale * blended.rise_celsius,
-            ..blended
-        }
+        self.at_time(self.knots(c))
     }
 
     /// The correlation `k` at the current rise, and whether the rise lies beyond the curves' span by
     /// more than `margin_celsius` (then the nearest curve's `k` is used: clamp).
     ///
     /// The bracket is the last curve whose rise does not exceed the current one. The search starts
-    /// from `hint` (the previous sample's bracket, updated here): the rise changes slowly, so it
-    /// usually costs only the two curve evaluations the interpolation needs anyway. Any hint gives
-    /// the same result.
+    /// from the previous sample's bracket, kept in `cache` with the blended knots of its two curves
+    /// for the current reference-time segment: while time stays in the segment and the rise in the
+    /// bracket (almost every sample), a sample costs two time interpolations and no table lookup.
+    /// Otherwise the search walks the table and refills the cache. The cache only saves work: a
+    /// fresh or any valid cache gives the same bits.
     #[inline(always)]
-    pub fn k_at(&self, rise_celsius: f32, margin_celsius: f32, hint: &mut u8) -> (f32, bool) {
-        let last = self.lower.len().saturating_sub(1);
-        let mut lo = usize::from(*hint).min(last);
-        let mut lower = self.point(lo);
-        while lower.rise_celsius > rise_celsius && lo > 0 {
-            lo = lo.saturating_sub(1);
-            lower = self.point(lo);
+    pub fn k_at(
+        &self,
+        rise_celsius: f32,
+        margin_celsius: f32,
+        cache: &mut BracketCache,
+    ) -> (f32, bool) {
+        let count = self.lower.len();
+        let last = count.saturating_sub(1);
+        let key = [saturating_u8(self.time.lo), saturating_u8(self.time.hi)];
+        let mut lo = usize::from(cache.curve).min(last);
+        if !(cache.valid && cache.segment == key && usize::from(cache.curve) == lo) {
+            cache.knots = [self.knots(lo), self.knots(lo.saturating_add(1))];
         }
-        let mut upper = self.point(lo.saturating_add(1));
-        while lo < last && upper.rise_celsius <= rise_celsius {
-            lo = lo.saturating_add(1);
-            lower = upper;
+        let mut lower = self.at_time(cache.knots[0]);
+        let mut upper = self.at_time(cache.knots[1]);
+        let inside = (lower.rise_celsius <= rise_celsius || lo == 0)
+            && (lo >= last || rise_celsius < upper.rise_celsius);
+        if !inside {
+            while lower.rise_celsius > rise_celsius && lo > 0 {
+                lo = lo.saturating_sub(1);
+                lower = self.point(lo);
+            }
             upper = self.point(lo.saturating_add(1));
+            while lo < last && upper.rise_celsius <= rise_celsius {
+                lo = lo.saturating_add(1);
+                lower = upper;
+                upper = self.point(lo.saturating_add(1));
+            }
+            cache.knots = [self.knots(lo), self.knots(lo.saturating_add(1))];
         }
-        *hint = saturating_u8(lo);
-        if rise_celsius < lower.rise_celsius || self.lower.is_empty() {
+        *cache = BracketCache {
+            valid: true,
+            segment: key,
+            curve: saturating_u8(lo),
+            knots: cache.knots,
+        };
+        if rise_celsius < lower.rise_celsius || count == 0 {
             let beyond = rise_celsius < lower.rise_celsius - margin_celsius;
             (lower.k_dps_per_celsius, beyond)
         } else if lo < last {
@@ -114,4 +146,25 @@ impl<'a, const R: usize> BlendedCurves<'a, R> {
             (lower.k_dps_per_celsius, beyond)
         }
     }
+}
+
+const MISSING: CurvePoint = CurvePoint {
+    rise_celsius: f32::NAN,
+    k_dps_per_celsius: f32::NAN,
+};
+
+/// Stage 3's search state, kept per axis between samples: the bracketing curve and its blended
+/// knots for the current reference-time segment.
+///
+/// Belongs to the tables and ambient it was filled with; `power_on` resets it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BracketCache {
+    /// Whether the knots below were filled.
+    pub valid: bool,
+    /// Reference-time indices (low, high) the knots were read at.
+    pub segment: [u8; 2],
+    /// Lower curve of the bracket.
+    pub curve: u8,
+    /// Blended knots: `[curve, curve + 1]` × `[segment low, segment high]`.
+    pub knots: [[CurvePoint; 2]; 2],
 }

@@ -4,6 +4,11 @@ The corrector is drift-core's, the code the firmware runs, bound with pyo3: a `C
 model (`ModifiedTables`, the paper's method, or `PolynomialTables`, a baseline) and one unit's
 run-time state, and corrects one sample (`correct`) or numpy arrays (`correct_batch`) with the same
 f32 results as the firmware.
+
+Around it, what the command line does: `simulate` a campaign, `Recording`/`Segment`/`load_campaign`
+for MCAP recordings (read, build from arrays, write), `fit` the tables, `evaluate` them on data the
+fit did not see (the report's table as records or a pandas DataFrame), `paper_table` to print it,
+and `gyrodrift.plot` (matplotlib, the `[plot]` extra) for the report's figures.
 """
 
 from __future__ import annotations
@@ -12,32 +17,72 @@ import enum
 
 from . import _gyrodrift
 from ._gyrodrift import (
+    ActivationResult,
+    AnalysedActivation,
+    AuxChannel,
+    CampaignError,
     Corrector,
+    Evaluation,
     FileError,
+    FitError,
+    FitSettings,
+    FittedUnit,
     GyrodriftError,
     ImageError,
     InputError,
+    Labels,
     ModifiedTables,
     Output,
     PolynomialTables,
+    Recording,
+    RecordingError,
+    Segment,
     Settings,
     TableError,
     __version__,
+    analyse,
+    evaluate,
+    fit,
+    load_campaign,
+    resolve_campaign,
+    simulate,
+    summarise,
 )
+from .tables import paper_table
 
 __all__ = [
+    "ActivationResult",
+    "AnalysedActivation",
+    "AuxChannel",
+    "CampaignError",
     "Corrector",
+    "Evaluation",
     "FileError",
+    "FitError",
+    "FitSettings",
+    "FittedUnit",
     "Flags",
     "GyrodriftError",
     "ImageError",
     "InputError",
+    "Labels",
     "ModifiedTables",
     "Output",
     "PolynomialTables",
+    "Recording",
+    "RecordingError",
+    "Segment",
     "Settings",
     "TableError",
     "__version__",
+    "analyse",
+    "evaluate",
+    "fit",
+    "load_campaign",
+    "paper_table",
+    "resolve_campaign",
+    "simulate",
+    "summarise",
 ]
 
 

@@ -7,8 +7,9 @@ temperature-sensor units (see `Settings`), `_celsius` °C. All arithmetic is f32
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
-from typing import Final, final
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, Final, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,22 +27,44 @@ __all__ = [
     "TEMPERATURE_INVALID",
     "TEMPERATURE_OUT_OF_RANGE",
     "TEMPERATURE_STUCK",
+    "ActivationResult",
+    "AnalysedActivation",
+    "AuxChannel",
+    "CampaignError",
     "Corrector",
+    "Evaluation",
     "FileError",
+    "FitError",
+    "FitSettings",
+    "FittedUnit",
     "GyrodriftError",
     "ImageError",
     "InputError",
+    "Labels",
     "ModifiedTables",
     "Output",
     "PolynomialTables",
+    "Recording",
+    "RecordingError",
+    "Segment",
     "Settings",
     "TableError",
     "__version__",
+    "analyse",
+    "evaluate",
+    "fit",
+    "load_campaign",
+    "resolve_campaign",
+    "simulate",
+    "summarise",
 ]
 
 _Path: TypeAlias = str | os.PathLike[str]
 _Floats3: TypeAlias = Sequence[float] | NDArray[np.floating]
 _Model: TypeAlias = ModifiedTables | PolynomialTables
+_Floats: TypeAlias = NDArray[np.float32] | NDArray[np.float64]
+_Source: TypeAlias = _Path | Recording | Segment | Sequence[_Path | Recording | Segment]
+_Record: TypeAlias = dict[str, Any]
 
 # Status flags (bits of each `flags` output value); `gyrodrift.Flags` is the IntFlag of these.
 AMBIENT_OUT_OF_RANGE: Final[int]
@@ -78,6 +101,23 @@ class ImageError(GyrodriftError):
 
 class FileError(GyrodriftError, OSError):
     """A file that cannot be read or written (`errno`, `strerror` and `filename` are set)."""
+
+class RecordingError(GyrodriftError):
+    """A recording that cannot be read, fails validation or cannot be written.
+
+    The message is drift-recording's, naming the file and, where it applies, the topic and the
+    message's index within it, e.g. "run.mcap: topic /gyro/rate, message #12: gap: first_sample
+    1300, expected 1200".
+    """
+
+class CampaignError(GyrodriftError, ValueError):
+    """A simulation campaign that is not valid: unknown field, value out of range, text that does
+    not parse. The message names the field, e.g. "invalid campaign: units: must be ≥ 1"."""
+
+class FitError(GyrodriftError):
+    """Recordings the tables cannot be fitted or evaluated from (too-short activation, no
+    calibration activations, an axis that never warms up, a setting out of range). The message
+    names the unit and activation, or the setting."""
 
 @final
 class Settings:
@@ -242,3 +282,415 @@ class Corrector:
         released while correcting. Raises `InputError` for a wrong dtype or shape, an empty
         array, or lengths that differ.
         """
+
+# --- recordings -------------------------------------------------------------------------------
+
+@final
+class Labels:
+    """The labels of one activation (drift_recording::SegmentLabels). Validated: counts from 1,
+    finite set point, durations ≥ 0; raises `InputError`."""
+
+    def __new__(
+        cls,
+        *,
+        unit_id: str,
+        set_point_celsius: float,
+        series_kind: str | None = None,
+        series: int | None = None,
+        repeat: int | None = None,
+        activation: int | None = None,
+        interval_min: float | None = None,
+        off_before_s: float | None = None,
+    ) -> Labels:
+        """`series_kind` is "protocol" (default) or "field"; `series`, `repeat`, `activation`
+        default to 1; `interval_min` is the protocol off-time (None for field sessions)."""
+    @property
+    def unit_id(self) -> str:
+        """Unit id."""
+    @property
+    def set_point_celsius(self) -> float:
+        """Chamber set point at switch-on, °C."""
+    @property
+    def series_kind(self) -> str:
+        """ "protocol" or "field"."""
+    @property
+    def series(self) -> int:
+        """Series number within the recording, from 1."""
+    @property
+    def repeat(self) -> int:
+        """Repeat of the interval, from 1."""
+    @property
+    def activation(self) -> int:
+        """Activation number within the series, from 1."""
+    @property
+    def interval_min(self) -> float | None:
+        """Protocol off-time between activations, min (None for field sessions)."""
+    @property
+    def off_before_s(self) -> float | None:
+        """Off-time before this switch-on, s (None if unknown)."""
+    def __eq__(self, other: object, /) -> bool: ...
+
+@final
+class AuxChannel:
+    """An auxiliary channel of one activation (accelerometer, supply voltage, ...) at its own rate."""
+
+    def __new__(cls, values: _Floats, unit: str, sample_rate_hz: int) -> AuxChannel:
+        """Finite float32/float64 values of shape (n,), a unit ("g", "V", "degC") and a rate in Hz."""
+    @property
+    def values(self) -> NDArray[np.float32]:
+        """Samples (read-only); sample k is at k / sample_rate_hz s after switch-on."""
+    @property
+    def unit(self) -> str:
+        """Physical unit."""
+    @property
+    def sample_rate_hz(self) -> int:
+        """Sample rate, Hz."""
+    def __len__(self) -> int: ...
+
+@final
+class Segment:
+    """One activation (switch-on to switch-off) of one unit: what the fitter consumes.
+
+    Read from a recording, or built from arrays. Its arrays are made on first access and kept;
+    they are read-only (copy them to modify).
+    """
+
+    def __new__(
+        cls,
+        labels: Labels,
+        rate_dps: _Floats,
+        temperature_raw: NDArray[np.int16],
+        *,
+        sample_rate_hz: int | None = None,
+        power_on_ns: int | None = None,
+        aux: Mapping[str, AuxChannel | tuple[_Floats, str, int]] | None = None,
+    ) -> Segment:
+        """An activation from arrays: `rate_dps` float32/float64 (n, 3) in °/s (finite; float64 is
+        rounded to f32), `temperature_raw` int16 (n, 3), consecutive samples from switch-on at
+        `sample_rate_hz` (default 1000; a multiple of 100 dividing 10**9); `power_on_ns` the
+        switch-on time on the recording clock (default 0); `aux` named auxiliary channels.
+        Raises `InputError` for a wrong dtype or shape, an empty or non-finite array, or lengths
+        that differ."""
+    @property
+    def labels(self) -> Labels:
+        """The activation's labels."""
+    @property
+    def sample_rate_hz(self) -> int:
+        """Gyro and temperature sample rate, Hz."""
+    @property
+    def power_on_ns(self) -> int:
+        """Switch-on time on the recording clock, ns."""
+    def __len__(self) -> int: ...
+    @property
+    def since_power_on(self) -> NDArray[np.uint32]:
+        """Sample index since switch-on, (n,) (0 = switch-on)."""
+    @property
+    def since_power_on_ms(self) -> NDArray[np.uint32]:
+        """Milliseconds since switch-on, (n,): what `Corrector.correct_batch` takes (index × 1000 /
+        rate, rounded down, as the evaluation computes it)."""
+    @property
+    def rate_dps(self) -> NDArray[np.float32]:
+        """Angular rate X, Y, Z, °/s, (n, 3)."""
+    @property
+    def temperature_raw(self) -> NDArray[np.int16]:
+        """Raw temperature X, Y, Z, (n, 3) (200 raw units per °C)."""
+    @property
+    def aux(self) -> dict[str, AuxChannel]:
+        """Auxiliary channels by name (a new dict on each access)."""
+    def aux_channel(self, name: str) -> AuxChannel:
+        """One auxiliary channel. Raises `InputError` naming the channels there are if `name` is
+        not one of them."""
+
+@final
+class Recording:
+    """One unit's recording (the MCAP format of docs/recording-format.md): metadata and its
+    activations in recording order."""
+
+    def __new__(
+        cls,
+        segments: Sequence[Segment],
+        *,
+        unit_id: str | None = None,
+        metadata: Mapping[str, str] | None = None,
+    ) -> Recording:
+        """A recording from segments of one unit at one sample rate, each switching on after the
+        previous one switched off (`Segment(power_on_ns=...)`). `unit_id` defaults to the
+        segments'; `metadata` adds to (and overrides) the default metadata record, except
+        `unit_id` and `sample_rate_hz`. Raises `InputError`."""
+    @staticmethod
+    def load(path: _Path) -> Recording:
+        """Reads and validates an MCAP recording (the GIL is released). Raises `FileError`
+        (missing or unreadable file) or `RecordingError` (naming file, topic and message index)."""
+    @staticmethod
+    def read_metadata(path: _Path) -> dict[str, str]:
+        """A recording's metadata record without decoding its messages."""
+    def save(self, path: _Path) -> int:
+        """Writes the recording as MCAP (temporary file, fsync, rename) and returns the bytes
+        written. Every segment needs the format's auxiliary channels — accel_x, accel_y, accel_z,
+        supply_voltage, chamber_set_point, at 100 Hz, one value per 10 ms — and no other (an
+        unknown channel raises `InputError`). Raises `FileError` or `RecordingError`."""
+    @property
+    def path(self) -> Path | None:
+        """The file it was read from (None if built in Python)."""
+    @property
+    def unit_id(self) -> str:
+        """Unit id."""
+    @property
+    def sample_rate_hz(self) -> int:
+        """Gyro and temperature sample rate, Hz."""
+    @property
+    def metadata(self) -> dict[str, str]:
+        """The `gyrodrift.recording` metadata record (a new dict on each access)."""
+    @property
+    def segments(self) -> list[Segment]:
+        """The activations, in recording order."""
+    def __len__(self) -> int: ...
+
+def load_campaign(folder: _Path) -> list[Recording]:
+    """Every recording of a campaign folder (its `recordings/`) or of a folder of .mcap files,
+    sorted by name. Ground truth is never opened. Raises `FileError` or `RecordingError`."""
+
+# --- simulation -------------------------------------------------------------------------------
+
+def simulate(
+    out: _Path,
+    campaign: Mapping[str, Any] | str | os.PathLike[str] | None = None,
+    *,
+    seed: int | None = None,
+    units: int | None = None,
+    set_points: Sequence[float] | str | None = None,
+    intervals: Sequence[float] | None = None,
+    repeats: int | None = None,
+    field: bool = False,
+    field_only: bool = False,
+    zero_drift: bool = False,
+    effects: Sequence[str] | None = None,
+    noise_scale: float | None = None,
+    truth_at_aux_rate: bool = False,
+) -> dict[str, Any]:
+    """Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
+    does: the same campaign and seed give the same bytes. `campaign` is None (the paper's), a dict
+    or TOML/JSON text (drift_sim::Campaign's fields), or a file path (os.PathLike; JSON if it ends in
+    .json, else TOML). The keywords are the command line's flags (`set_points` also takes its text,
+    "30,40,33" or "-40:60:10"). Returns the run's summary. The GIL is released while simulating.
+    Raises `CampaignError`, `InputError` or `FileError`."""
+
+def resolve_campaign(
+    campaign: Mapping[str, Any] | str | os.PathLike[str] | None = None,
+    *,
+    seed: int | None = None,
+    units: int | None = None,
+    set_points: Sequence[float] | str | None = None,
+    intervals: Sequence[float] | None = None,
+    repeats: int | None = None,
+    field: bool = False,
+    field_only: bool = False,
+    zero_drift: bool = False,
+    effects: Sequence[str] | None = None,
+    noise_scale: float | None = None,
+    truth_at_aux_rate: bool = False,
+) -> dict[str, Any]:
+    """The validated campaign `simulate` would run with the same arguments, as a dict; nothing is
+    simulated."""
+
+# --- fitting and evaluation -------------------------------------------------------------------
+
+@final
+class FitSettings:
+    """How the tables are fitted (drift_fit::FitSettings): the command line's `--settings`, with
+    the same defaults. Ranges are checked when fitting (`FitError` naming the setting)."""
+
+    def __new__(
+        cls,
+        *,
+        lowpass_window_samples: int | None = None,
+        grid_ms: int | None = None,
+        initial_bias_window_s: float | None = None,
+        switch_on_window_ms: int | None = None,
+        first_reference_s: float | None = None,
+        reference_count: int | None = None,
+        reference_window_points: int | None = None,
+        independent_after_min: float | None = None,
+        polynomial_degree: int | None = None,
+    ) -> FitSettings: ...
+    @staticmethod
+    def from_json(text: str) -> FitSettings:
+        """Settings from the JSON `gyrodrift fit --settings` reads (missing fields: defaults)."""
+    def to_json(self) -> str:
+        """The JSON form."""
+    @property
+    def lowpass_window_samples(self) -> int:
+        """Low-pass: centred moving average of this many samples (default 1000: 1 s at 1 kHz)."""
+    @property
+    def grid_ms(self) -> int:
+        """Analysis grid: curves kept every this many ms (default 10)."""
+    @property
+    def initial_bias_window_s(self) -> float:
+        """Initial bias: intercept of the rate against the rise over this first part, s (default 4)."""
+    @property
+    def switch_on_window_ms(self) -> int:
+        """Switch-on temperature: mean over this first part of the activation, ms (default 20)."""
+    @property
+    def first_reference_s(self) -> float:
+        """First reference time, s (default 2)."""
+    @property
+    def reference_count(self) -> int:
+        """Reference times per axis, the first included (default 8; 2 to 16)."""
+    @property
+    def reference_window_points(self) -> int:
+        """Correlation samples averaged around each reference time, on the grid (default 10)."""
+    @property
+    def independent_after_min(self) -> float:
+        """Series with at least this interval (min) are independent, like a first activation (default 15)."""
+    @property
+    def polynomial_degree(self) -> int:
+        """Degree of the least-squares polynomial baseline (default 3)."""
+    def __eq__(self, other: object, /) -> bool: ...
+
+@final
+class AnalysedActivation:
+    """One activation analysed as the fit does: per axis, every `grid_ms` from switch-on."""
+
+    @property
+    def labels(self) -> Labels:
+        """The activation's labels."""
+    @property
+    def grid_ms(self) -> int:
+        """Spacing of the curves, ms."""
+    def __len__(self) -> int: ...
+    @property
+    def time_s(self) -> NDArray[np.float64]:
+        """Time of each grid point since switch-on, s, (m,)."""
+    @property
+    def drift_dps(self) -> NDArray[np.float32]:
+        """Low-frequency drift g(t) = low-passed rate − initial bias, °/s, (m, 3)."""
+    @property
+    def rise_celsius(self) -> NDArray[np.float32]:
+        """Temperature rise since switch-on (low-passed), °C, (m, 3)."""
+    @property
+    def switch_on_raw(self) -> tuple[float, float, float]:
+        """Raw temperature at switch-on per axis, as firmware passes it to `power_on`."""
+    @property
+    def switch_on_celsius(self) -> tuple[float, float, float]:
+        """Switch-on temperature per axis, °C."""
+    @property
+    def initial_bias_dps(self) -> tuple[float, float, float]:
+        """Initial (switch-on) bias per axis, °/s."""
+
+def analyse(segment: Segment, *, settings: FitSettings | None = None) -> AnalysedActivation:
+    """Analyses one activation as the fit does. Raises `FitError` (e.g. too short)."""
+
+@final
+class ActivationResult:
+    """One activation corrected with every model (drift-core's f32 corrector) and measured."""
+
+    @property
+    def split(self) -> str:
+        """Which data: "validation", "held_out_repeat", "field" or "noise_floor"."""
+    @property
+    def labels(self) -> Labels:
+        """The activation's labels."""
+    @property
+    def drift_dps(self) -> dict[str, tuple[float, float, float]]:
+        """Per model ("uncorrected", "standard", "3rd-order", "modified"): drift per axis, °/s —
+        max − min of the 1-s low-frequency rate over the activation (the paper's metric)."""
+    @property
+    def residual_rms_dps(self) -> dict[str, tuple[float, float, float]]:
+        """Per model: RMS of the low-frequency rate per axis, °/s (includes the initial-bias error)."""
+    @property
+    def flags(self) -> dict[str, tuple[int, int, int]]:
+        """Per model: union of the corrector's flags over the activation, per axis."""
+
+@final
+class FittedUnit:
+    """Everything fitted for one unit: the paper's tables and both baselines."""
+
+    @property
+    def unit_id(self) -> str:
+        """Unit id."""
+    @property
+    def modified(self) -> ModifiedTables:
+        """The paper's ("modified") tables."""
+    @property
+    def standard(self) -> PolynomialTables:
+        """The paper's standard calibration (Lagrange polynomial through the set points)."""
+    @property
+    def third_order(self) -> PolynomialTables:
+        """The least-squares polynomial baseline (3rd order by default)."""
+    @property
+    def settings(self) -> FitSettings:
+        """The settings the unit was fitted with (used again by `evaluate`)."""
+    @property
+    def set_points_celsius(self) -> list[float]:
+        """Calibration set points, °C, in table order."""
+    @property
+    def curve_names(self) -> list[str]:
+        """The curves kept, in table order: "independent" or "<interval>min#<activation>"."""
+    @property
+    def notes(self) -> list[str]:
+        """Things the fit decided that a reader should know (dropped curves, nudged ties)."""
+    def evaluate(self, segment: Segment, *, split: str | None = None) -> ActivationResult:
+        """Corrects one activation with every model and measures the paper's metric; `split`
+        ("validation" by default) labels the result for `summarise`. The GIL is released."""
+    def save(self, folder: _Path) -> Path:
+        """Writes <folder>/<unit_id>/{modified,standard,third_order}.{json,bin} as `gyrodrift fit`
+        does; returns the unit's folder. Raises `FileError`."""
+
+def fit(
+    source: _Source,
+    *,
+    calibration: Sequence[float] | None = None,
+    settings: FitSettings | None = None,
+) -> list[FittedUnit]:
+    """Fits the tables and both baselines for every unit in `source`, on the protocol activations
+    at the `calibration` set points (default 30, 40 °C), as `gyrodrift fit` does. `source` is a
+    campaign folder, a folder of .mcap files, one file, a list of files, or recordings/segments in
+    memory. One `FittedUnit` per unit, sorted by unit id. The GIL is released. Raises `FitError`,
+    `RecordingError`, `FileError` or `InputError`."""
+
+@final
+class Evaluation:
+    """What `evaluate` found: fitted units, analysed calibration activations, evaluated activations."""
+
+    @property
+    def fitted(self) -> list[FittedUnit]:
+        """Tables fitted on all calibration activations, one per unit."""
+    @property
+    def calibration(self) -> list[AnalysedActivation]:
+        """The calibration activations, analysed (for the paper's figures)."""
+    @property
+    def results(self) -> list[ActivationResult]:
+        """Every evaluated activation with its split."""
+    @property
+    def records(self) -> list[_Record]:
+        """The report's table as data, the records of `report.json`: one dict per unit × set point ×
+        split × model × axis with keys unit, set_point_celsius, split, model, axis, drift_dps,
+        residual_rms_dps, activations."""
+    def to_dataframe(self) -> Any:
+        """The records as a pandas DataFrame. Raises ImportError without pandas."""
+    @property
+    def noise_floor_units(self) -> list[str]:
+        """Unit ids of the noise-floor units ("noise:<id>"), if `noise_floor` was given."""
+    @property
+    def timings(self) -> list[tuple[str, float]]:
+        """Measured durations of the pipeline's steps: (step, seconds)."""
+
+def evaluate(
+    source: _Path | Sequence[_Path],
+    *,
+    calibration: Sequence[float] | None = None,
+    validation: Sequence[float] | None = None,
+    settings: FitSettings | None = None,
+    held_out_repeats: bool = True,
+    noise_floor: _Path | Sequence[_Path] | None = None,
+) -> Evaluation:
+    """Fits at the `calibration` set points (default 30, 40 °C) and evaluates every activation no
+    fit saw, as `gyrodrift report` does: the `validation` set points (default 33 °C), field
+    sessions, and (with `held_out_repeats`) each repeat at the calibration set points against
+    tables refitted without it. `source` is recording files (a campaign folder, a folder of .mcap
+    files, a list of files); `noise_floor` a campaign of zero-drift units, measured at the
+    validation set points. The GIL is released. Raises `FitError`, `RecordingError`, `FileError`
+    or `InputError`."""
+
+def summarise(results: Sequence[ActivationResult]) -> list[_Record]:
+    """Averages activation results into the report's records (as `Evaluation.records`)."""

@@ -73,9 +73,11 @@ fn two_nodes_match_the_closed_form_through_switching() {
             if powered { ss_on } else { ss_off },
             f64::from(seconds),
         );
+        // 300 000 exact steps accumulate rounding of ~1e-9 °C: five orders of magnitude below the
+        // sensor's 0.005 °C step.
         for i in 0..2 {
             assert!(
-                (x[i] - expected[i]).abs() < 1e-9,
+                (x[i] - expected[i]).abs() < 1e-8,
                 "node {i}: {} vs {}",
                 x[i],
                 expected[i]

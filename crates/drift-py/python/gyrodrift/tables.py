@@ -1,0 +1,59 @@
+"""The report's tables as text, from the records of `evaluate` (or `summarise`): formatting only."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+AXES = ("X", "Y", "Z")
+MODELS = ("standard", "modified")
+"""The paper's rows; add "3rd-order" and "uncorrected" for the other baselines."""
+SPLIT_NAMES = {
+    "validation": "validation",
+    "held_out_repeat": "held-out repeat",
+    "field": "field",
+    "noise_floor": "noise floor",
+}
+
+
+def _rows(records: Sequence[Mapping[str, Any]]) -> list[tuple[float, str]]:
+    """(set point, split) rows of the paper's table: held-out repeats and validation, by set point."""
+    rows = {
+        (float(r["set_point_celsius"]), str(r["split"]))
+        for r in records
+        if r["split"] in ("held_out_repeat", "validation")
+    }
+    return sorted(rows)
+
+
+def paper_table(records: Iterable[Mapping[str, Any]], *, models: Sequence[str] = MODELS) -> str:
+    """The paper's Table as Markdown: rows model × set point, columns unit × axis, mean drift in °/s,
+    then the standard / modified ratio per set point (as `report.md`'s "Drift per unit and axis").
+    Noise-floor units and field sessions are left out."""
+    records = [r for r in records if not str(r["unit"]).startswith("noise:")]
+    units = sorted({str(r["unit"]) for r in records})
+    index = {
+        (r["unit"], round(float(r["set_point_celsius"]) * 1000), r["split"], r["model"], r["axis"]): float(
+            r["drift_dps"]
+        )
+        for r in records
+    }
+
+    def drift(unit: str, set_point: float, split: str, model: str, axis: str) -> float | None:
+        return index.get((unit, round(set_point * 1000), split, model, axis))
+
+    header = "| calibration | set point | data |" + "".join(f" {u} {a} |" for u in units for a in AXES)
+    lines = [header, "|---|---|---|" + "---:|" * (len(units) * len(AXES))]
+    for model in models:
+        for set_point, split in _rows(records):
+            cells = [drift(u, set_point, split, model, a) for u in units for a in AXES]
+            text = "".join(" – |" if v is None else f" {v:.4f} |" for v in cells)
+            lines.append(f"| {model} | {set_point:+g} °C | {SPLIT_NAMES[split]} |{text}")
+    for set_point, split in _rows(records):
+        ratios: list[str] = []
+        for u in units:
+            for a in AXES:
+                s, d = drift(u, set_point, split, "standard", a), drift(u, set_point, split, "modified", a)
+                ratios.append(" – |" if s is None or d is None or d <= 0 else f" {s / d:.2f}× |")
+        lines.append(f"| standard / modified | {set_point:+g} °C | {SPLIT_NAMES[split]} |{''.join(ratios)}")
+    return "\n".join(lines) + "\n"

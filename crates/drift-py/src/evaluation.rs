@@ -1,0 +1,341 @@
+//! `gyrodrift.evaluate` (the command line's `gyrodrift report` without the files: fit, then
+//! correct everything the fit did not see), `gyrodrift.Evaluation`, `gyrodrift.ActivationResult`
+//! and `gyrodrift.summarise` (the report's table as data, the records of `report.json`).
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use drift_fit::evaluate::ActivationResult;
+use drift_fit::pipeline::{self, Options};
+use drift_fit::summary::{summarise as summarise_results, Split};
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+use crate::analysed::PyAnalysed;
+use crate::args;
+use crate::arrays::describe;
+use crate::errors::Error;
+use crate::fit::PyFittedUnit;
+use crate::fit_settings;
+use crate::labels::PyLabels;
+use crate::sources::{self, Source};
+
+const SPLITS: [(Split, &str); 4] = [
+    (Split::Validation, "validation"),
+    (Split::HeldOutRepeat, "held_out_repeat"),
+    (Split::Field, "field"),
+    (Split::NoiseFloor, "noise_floor"),
+];
+
+/// A split's name as in `report.json`.
+fn split_name(split: Split) -> &'static str {
+    SPLITS
+        .iter()
+        .find(|(s, _)| *s == split)
+        .map_or("validation", |(_, name)| name)
+}
+
+/// A split from its `report.json` name.
+pub fn split_from(value: &Bound<'_, PyAny>) -> Result<Split, Error> {
+    let names: Vec<&str> = SPLITS.iter().map(|(_, n)| *n).collect();
+    let text: Option<String> = value.extract().ok();
+    SPLITS
+        .iter()
+        .find(|(_, name)| text.as_deref() == Some(*name))
+        .map(|(split, _)| *split)
+        .ok_or_else(|| {
+            Error::Input(format!(
+                "`split` must be one of {}, got {}",
+                names.join(", "),
+                args::shown(value)
+            ))
+        })
+}
+
+/// Per model name, one value per axis.
+type PerModel<T> = BTreeMap<&'static str, (T, T, T)>;
+
+/// One activation corrected with every model, and the data it was measured on.
+#[pyclass(module = "gyrodrift", name = "ActivationResult", frozen)]
+#[derive(Debug, Clone)]
+pub struct PyActivationResult {
+    pub split: Split,
+    pub result: ActivationResult,
+}
+
+impl PyActivationResult {
+    fn per_model<T: Copy>(
+        &self,
+        value: impl Fn(&drift_fit::evaluate::ModelResult) -> [T; 3],
+    ) -> PerModel<T> {
+        self.result
+            .models
+            .iter()
+            .map(|m| {
+                let [x, y, z] = value(m);
+                (m.model.name(), (x, y, z))
+            })
+            .collect()
+    }
+}
+
+#[pymethods]
+impl PyActivationResult {
+    /// Which data: "validation", "held_out_repeat", "field" or "noise_floor".
+    #[getter]
+    fn split(&self) -> &'static str {
+        split_name(self.split)
+    }
+
+    /// The activation's labels.
+    #[getter]
+    fn labels(&self) -> PyLabels {
+        PyLabels(self.result.labels.clone())
+    }
+
+    /// Per model ("uncorrected", "standard", "3rd-order", "modified"): drift per axis, °/s (max −
+    /// min of the 1-s low-frequency rate over the activation).
+    #[getter]
+    fn drift_dps(&self) -> PerModel<f64> {
+        self.per_model(|m| m.drift_dps)
+    }
+
+    /// Per model: RMS of the low-frequency rate per axis, °/s (includes the initial-bias error).
+    #[getter]
+    fn residual_rms_dps(&self) -> PerModel<f64> {
+        self.per_model(|m| m.residual_rms_dps)
+    }
+
+    /// Per model: union of the corrector's flags over the activation, per axis.
+    #[getter]
+    fn flags(&self) -> PerModel<u16> {
+        self.per_model(|m| m.flags)
+    }
+
+    fn __repr__(&self) -> String {
+        let l = &self.result.labels;
+        format!(
+            "<ActivationResult {} {} {:+} °C series {} repeat {} activation {}>",
+            split_name(self.split),
+            l.unit_id,
+            l.set_point_celsius,
+            l.series,
+            l.repeat,
+            l.activation
+        )
+    }
+}
+
+/// The records of `report.json` as Python dicts (same keys and values).
+fn records_of<'py>(
+    py: Python<'py>,
+    results: &[(Split, ActivationResult)],
+) -> PyResult<Bound<'py, PyAny>> {
+    let records = summarise_results(results);
+    let text = serde_json::to_string(&records)
+        .map_err(|e| Error::Input(format!("internal: records JSON: {e}")))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// Averages activation results into the report's records: one dict per unit × set point ×
+/// split × model × axis with `drift_dps`, `residual_rms_dps` and `activations`.
+#[pyfunction]
+pub fn summarise<'py>(py: Python<'py>, results: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let items: Vec<Bound<'py, PyAny>> = args::value(
+        "results",
+        "a sequence of gyrodrift.ActivationResult",
+        results,
+    )?;
+    let mut all = Vec::with_capacity(items.len());
+    for (i, item) in items.iter().enumerate() {
+        let result = item.cast::<PyActivationResult>().map_err(|_| {
+            Error::Input(format!(
+                "`results[{i}]` must be a gyrodrift.ActivationResult, got {}",
+                describe(item)
+            ))
+        })?;
+        let r = result.get();
+        all.push((r.split, r.result.clone()));
+    }
+    records_of(py, &all)
+}
+
+/// What `evaluate` found: the fitted units, the analysed calibration activations and every
+/// evaluated activation, with the report's table as records.
+#[pyclass(module = "gyrodrift", name = "Evaluation", frozen)]
+pub struct PyEvaluation {
+    fitted: Vec<Py<PyFittedUnit>>,
+    calibration: Vec<Py<PyAnalysed>>,
+    results: Vec<(Split, ActivationResult)>,
+    noise_floor_units: Vec<String>,
+    timings: Vec<(String, f64)>,
+}
+
+#[pymethods]
+impl PyEvaluation {
+    /// Tables fitted on all calibration activations, one per unit (sorted by unit id).
+    #[getter]
+    fn fitted<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, self.fitted.iter().map(|f| f.clone_ref(py)))
+    }
+
+    /// The calibration activations, analysed (what the fit and the paper's figures use).
+    #[getter]
+    fn calibration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        PyList::new(py, self.calibration.iter().map(|a| a.clone_ref(py)))
+    }
+
+    /// Every evaluated activation with its split.
+    #[getter]
+    fn results(&self) -> Vec<PyActivationResult> {
+        self.results
+            .iter()
+            .map(|(split, result)| PyActivationResult {
+                split: *split,
+                result: result.clone(),
+            })
+            .collect()
+    }
+
+    /// The report's table as data (the records of `report.json`): a new list of dicts.
+    #[getter]
+    fn records<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        records_of(py, &self.results)
+    }
+
+    /// The records as a pandas DataFrame (needs pandas; raises ImportError without it).
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pandas = py.import("pandas").map_err(|error| {
+            pyo3::exceptions::PyImportError::new_err(format!(
+                "Evaluation.to_dataframe needs pandas (pip install pandas): {error}"
+            ))
+        })?;
+        pandas.call_method1("DataFrame", (records_of(py, &self.results)?,))
+    }
+
+    /// Unit ids of the noise-floor units ("noise:<id>"), if `noise_floor` was given.
+    #[getter]
+    fn noise_floor_units(&self) -> Vec<String> {
+        self.noise_floor_units.clone()
+    }
+
+    /// Measured durations of the pipeline's steps: (step, seconds).
+    #[getter]
+    fn timings(&self) -> Vec<(String, f64)> {
+        self.timings.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<Evaluation: {} units fitted, {} calibration activations, {} evaluated>",
+            self.fitted.len(),
+            self.calibration.len(),
+            self.results.len()
+        )
+    }
+}
+
+/// Fits on the calibration set points and evaluates every activation no fit saw, as
+/// `gyrodrift report` does: validation set points, field sessions, and (with `held_out_repeats`)
+/// each repeat at the calibration set points against tables refitted without it. `source` is a
+/// campaign folder, a folder of `.mcap` files or a list of files; `noise_floor` a campaign of
+/// zero-drift units measured at the validation set points. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (source, *, calibration = None, validation = None, settings = None, held_out_repeats = true, noise_floor = None))]
+pub fn evaluate(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    calibration: Option<&Bound<'_, PyAny>>,
+    validation: Option<&Bound<'_, PyAny>>,
+    settings: Option<&Bound<'_, PyAny>>,
+    held_out_repeats: bool,
+    noise_floor: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyEvaluation> {
+    let Source::Files(files) = sources::source(py, "source", source)? else {
+        return Err(Error::Input(
+            "`source` must be recording files (a campaign folder, a folder of .mcap files or a \
+             list of files): evaluate reads them twice, as `gyrodrift report` does; for \
+             recordings in memory use FittedUnit.evaluate and summarise"
+                .into(),
+        )
+        .into());
+    };
+    let noise_files = match noise_floor.filter(|n| !n.is_none()) {
+        None => None,
+        Some(value) => match sources::source(py, "noise_floor", value)? {
+            Source::Files(files) => Some(files),
+            Source::Segments(_) => {
+                return Err(Error::Input(format!(
+                    "`noise_floor` must be a path to recording files, got {}",
+                    describe(value)
+                ))
+                .into())
+            }
+        },
+    };
+    let options = Options {
+        calibration_set_points: match calibration {
+            Some(v) => sources::set_points("calibration", v, false)?,
+            None => vec![30.0, 40.0],
+        },
+        validation_set_points: match validation {
+            Some(v) => sources::set_points("validation", v, true)?,
+            None => vec![33.0],
+        },
+        fit: fit_settings::or_default(settings)?,
+        held_out_repeats,
+        evaluate: true,
+    };
+    let (mut outcome, noise) = py
+        .detach(|| {
+            let outcome = pipeline::run(&files, &options, false, &|_, _, _| {})?;
+            let noise = match &noise_files {
+                Some(files) => Some(pipeline::run(files, &options, true, &|_, _, _| {})?),
+                None => None,
+            };
+            Ok::<_, pipeline::PipelineError>((outcome, noise))
+        })
+        .map_err(Error::from)?;
+    let mut noise_floor_units = Vec::new();
+    if let Some(noise) = noise {
+        // As `gyrodrift report`: noise-floor units are told apart by a "noise:" prefix.
+        for (split, mut result) in noise.results {
+            result.labels.unit_id = format!("noise:{}", result.labels.unit_id);
+            if !noise_floor_units.contains(&result.labels.unit_id) {
+                noise_floor_units.push(result.labels.unit_id.clone());
+            }
+            outcome.results.push((split, result));
+        }
+        outcome.timings.extend(
+            noise
+                .timings
+                .into_iter()
+                .map(|(step, s)| (format!("noise floor: {step}"), s)),
+        );
+    }
+    let fitted = outcome
+        .fitted
+        .into_iter()
+        .map(|unit| {
+            Py::new(
+                py,
+                PyFittedUnit {
+                    unit: Arc::new(unit),
+                    settings: options.fit.clone(),
+                },
+            )
+        })
+        .collect::<PyResult<_>>()?;
+    let calibration = outcome
+        .calibration
+        .into_iter()
+        .map(|a| Py::new(py, PyAnalysed::wrap(a)))
+        .collect::<PyResult<_>>()?;
+    Ok(PyEvaluation {
+        fitted,
+        calibration,
+        results: outcome.results,
+        noise_floor_units,
+        timings: outcome.timings,
+    })
+}

@@ -1,0 +1,242 @@
+//! `gyrodrift.fit` and `gyrodrift.FittedUnit`: recordings → the paper's tables and the two
+//! baselines, through drift-fit (the command line's `gyrodrift fit`, same settings and selection).
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use drift_fit::analyse::{analyse, Analysed};
+use drift_fit::evaluate::evaluate as evaluate_segment;
+use drift_fit::pipeline::{self, Options};
+use drift_fit::summary::Split;
+use drift_fit::{fit_unit, FitSettings, FittedUnit};
+use drift_recording::{Segment, SeriesKind};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+
+use crate::args;
+use crate::arrays::describe;
+use crate::errors::{Error, FitError};
+use crate::evaluation::{split_from, PyActivationResult};
+use crate::fit_settings::{self, PyFitSettings};
+use crate::model_io;
+use crate::segment::PySegment;
+use crate::sources::{self, Source};
+use crate::tables::{PyModifiedTables, PyPolynomialTables};
+
+/// Everything fitted for one unit, with the settings it was fitted with.
+#[pyclass(module = "gyrodrift", name = "FittedUnit", frozen)]
+#[derive(Debug)]
+pub struct PyFittedUnit {
+    pub unit: Arc<FittedUnit>,
+    pub settings: FitSettings,
+}
+
+/// Whether a segment is a calibration activation: protocol, at a calibration set point (as the
+/// pipeline decides).
+fn is_calibration(segment: &Segment, set_points: &[f64]) -> bool {
+    segment.labels.series_kind == SeriesKind::Protocol
+        && set_points
+            .iter()
+            .any(|s| (s - segment.labels.set_point_celsius).abs() < 1e-6)
+}
+
+/// Fits every unit among in-memory segments, as the pipeline's first pass does for files.
+fn fit_segments(
+    segments: &[Arc<Segment>],
+    set_points: &[f64],
+    settings: &FitSettings,
+) -> Result<Vec<FittedUnit>, Error> {
+    let analysed: Vec<Analysed> = segments
+        .par_iter()
+        .filter(|s| is_calibration(s, set_points))
+        .map(|s| analyse(s, settings))
+        .collect::<Result<_, _>>()?;
+    let mut by_unit: BTreeMap<String, Vec<Analysed>> = BTreeMap::new();
+    for a in analysed {
+        by_unit.entry(a.labels.unit_id.clone()).or_default().push(a);
+    }
+    by_unit
+        .values()
+        .map(|activations| fit_unit(activations, settings).map_err(Error::from))
+        .collect()
+}
+
+/// Fits `source` at the calibration set points.
+pub fn fit_source(
+    py: Python<'_>,
+    source: Source,
+    set_points: Vec<f64>,
+    settings: FitSettings,
+) -> PyResult<Vec<PyFittedUnit>> {
+    let fitted = match source {
+        Source::Files(files) => {
+            let options = Options {
+                calibration_set_points: set_points.clone(),
+                validation_set_points: Vec::new(),
+                fit: settings.clone(),
+                held_out_repeats: false,
+                evaluate: false,
+            };
+            py.detach(|| pipeline::run(&files, &options, false, &|_, _, _| {}))
+                .map_err(Error::from)?
+                .fitted
+        }
+        Source::Segments(segments) => {
+            let fitted = py.detach(|| fit_segments(&segments, &set_points, &settings))?;
+            if fitted.is_empty() {
+                return Err(FitError::new_err(format!(
+                    "no protocol activations at the calibration set points {set_points:?} °C in {} segments",
+                    segments.len()
+                )));
+            }
+            fitted
+        }
+    };
+    Ok(fitted
+        .into_iter()
+        .map(|unit| PyFittedUnit {
+            unit: Arc::new(unit),
+            settings: settings.clone(),
+        })
+        .collect())
+}
+
+/// Fits the paper's tables and both baselines for every unit in `source`, on the protocol
+/// activations at the `calibration` set points (the command line's `gyrodrift fit`). Returns one
+/// `FittedUnit` per unit, sorted by unit id. The GIL is released while fitting.
+#[pyfunction]
+#[pyo3(signature = (source, *, calibration = None, settings = None))]
+pub fn fit(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    calibration: Option<&Bound<'_, PyAny>>,
+    settings: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<PyFittedUnit>> {
+    let source = sources::source(py, "source", source)?;
+    let set_points = match calibration {
+        Some(v) => sources::set_points("calibration", v, false)?,
+        None => vec![30.0, 40.0],
+    };
+    let settings = fit_settings::or_default(settings)?;
+    fit_source(py, source, set_points, settings)
+}
+
+#[pymethods]
+impl PyFittedUnit {
+    /// Unit id.
+    #[getter]
+    fn unit_id(&self) -> &str {
+        &self.unit.unit_id
+    }
+
+    /// The paper's ("modified") tables.
+    #[getter]
+    fn modified(&self) -> PyModifiedTables {
+        PyModifiedTables(Arc::new(self.unit.modified.clone()))
+    }
+
+    /// The paper's standard calibration (Lagrange polynomial through the set points).
+    #[getter]
+    fn standard(&self) -> PyPolynomialTables {
+        PyPolynomialTables(Arc::new(self.unit.standard.clone()))
+    }
+
+    /// The least-squares polynomial baseline (3rd order by default).
+    #[getter]
+    fn third_order(&self) -> PyPolynomialTables {
+        PyPolynomialTables(Arc::new(self.unit.third_order.clone()))
+    }
+
+    /// The settings the unit was fitted with (used again by `evaluate`).
+    #[getter]
+    fn settings(&self) -> PyFitSettings {
+        PyFitSettings(self.settings.clone())
+    }
+
+    /// Calibration set points, °C, in table order.
+    #[getter]
+    fn set_points_celsius(&self) -> Vec<f64> {
+        self.unit
+            .set_points
+            .iter()
+            .map(|s| s.set_point_celsius)
+            .collect()
+    }
+
+    /// The curves kept, in table order: "independent" or "<interval>min#<activation>".
+    #[getter]
+    fn curve_names(&self) -> Vec<String> {
+        self.unit.curve_keys.iter().map(|k| k.name()).collect()
+    }
+
+    /// Things the fit decided that a reader should know (dropped curves, nudged ties).
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.unit.notes.clone()
+    }
+
+    /// Corrects one activation with every model (drift-core's f32 corrector) and measures the
+    /// paper's drift metric; `split` labels the result for `summarise`.
+    #[pyo3(signature = (segment, *, split = None))]
+    fn evaluate(
+        &self,
+        py: Python<'_>,
+        segment: &Bound<'_, PyAny>,
+        split: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyActivationResult> {
+        let segment = segment.cast::<PySegment>().map_err(|_| {
+            Error::Input(format!(
+                "`segment` must be a gyrodrift.Segment, got {}",
+                describe(segment)
+            ))
+        })?;
+        let split = match split {
+            Some(v) if !v.is_none() => split_from(v)?,
+            _ => Split::Validation,
+        };
+        let segment = Arc::clone(&segment.get().segment);
+        let result = py.detach(|| evaluate_segment(&self.unit, &segment, &self.settings));
+        Ok(PyActivationResult { split, result })
+    }
+
+    /// Writes `<folder>/<unit_id>/{modified,standard,third_order}.{json,bin}` as `gyrodrift fit`
+    /// does; returns the unit's folder.
+    fn save(&self, folder: &Bound<'_, PyAny>) -> Result<PathBuf, Error> {
+        let dir = args::path("folder", folder)?.join(&self.unit.unit_id);
+        std::fs::create_dir_all(&dir).map_err(|source| Error::File {
+            action: "write",
+            path: dir.clone(),
+            source,
+        })?;
+        let modified = &self.unit.modified;
+        model_io::write(
+            &dir.join("modified.json"),
+            model_io::to_json("ModifiedTables", modified)?.as_bytes(),
+        )?;
+        model_io::write(&dir.join("modified.bin"), &model_io::to_image(modified)?)?;
+        for (name, model) in [
+            ("standard", &self.unit.standard),
+            ("third_order", &self.unit.third_order),
+        ] {
+            model_io::write(
+                &dir.join(format!("{name}.json")),
+                model_io::to_json("PolynomialTables", model)?.as_bytes(),
+            )?;
+            model_io::write(
+                &dir.join(format!("{name}.bin")),
+                &model_io::to_image(model)?,
+            )?;
+        }
+        Ok(dir)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<FittedUnit {}: {} curves × {} ambients>",
+            self.unit.unit_id,
+            self.unit.curve_keys.len(),
+            self.unit.set_points.len()
+        )
+    }
+}

@@ -1,0 +1,81 @@
+"""Evaluation from Python: the report's table as data (records, DataFrame) and per activation."""
+
+from __future__ import annotations
+
+import sys
+
+import pytest
+
+import gyrodrift
+from conftest import recording_path
+
+KEYS = {"unit", "set_point_celsius", "split", "model", "axis", "drift_dps", "residual_rms_dps", "activations"}
+
+
+def test_records_cover_every_split_model_and_axis(evaluation: gyrodrift.Evaluation) -> None:
+    records = evaluation.records
+    assert records and all(set(r) == KEYS for r in records)
+    assert {(r["split"], r["set_point_celsius"]) for r in records} == {
+        ("held_out_repeat", 30.0),
+        ("held_out_repeat", 40.0),
+        ("validation", 33.0),
+    }
+    assert {r["model"] for r in records} == {"uncorrected", "standard", "3rd-order", "modified"}
+    assert {r["axis"] for r in records} == {"X", "Y", "Z"}
+    assert len(evaluation.fitted) == 1 and len(evaluation.calibration) == 24
+    assert len(evaluation.results) == 36  # 12 activations per set point
+
+
+def test_the_papers_method_beats_no_correction(evaluation: gyrodrift.Evaluation) -> None:
+    def mean(model: str) -> float:
+        values = [
+            r["drift_dps"] for r in evaluation.records if r["split"] == "validation" and r["model"] == model
+        ]
+        return sum(values) / len(values)
+
+    assert mean("modified") < mean("uncorrected")
+
+
+def test_per_activation_evaluation_and_summarise_agree(
+    campaign_dir, evaluation: gyrodrift.Evaluation
+) -> None:  # type: ignore[no-untyped-def]
+    unit = evaluation.fitted[0]
+    validation = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0"))
+    results = [unit.evaluate(segment) for segment in validation.segments]
+    assert {r.split for r in results} == {"validation"}
+    assert set(results[0].drift_dps) == {"uncorrected", "standard", "3rd-order", "modified"}
+    expected = [r for r in evaluation.records if r["split"] == "validation"]
+    assert gyrodrift.summarise(results) == expected
+
+
+def test_results_carry_labels_and_flags(evaluation: gyrodrift.Evaluation) -> None:
+    held_out = [r for r in evaluation.results if r.split == "held_out_repeat"]
+    assert {r.labels.repeat for r in held_out} == {1, 2}
+    assert all(r.flags["uncorrected"] == (0, 0, 0) for r in held_out)
+
+
+def test_dataframe_with_pandas(evaluation: gyrodrift.Evaluation) -> None:
+    pd = pytest.importorskip("pandas")
+    frame = evaluation.to_dataframe()
+    assert isinstance(frame, pd.DataFrame)
+    assert set(frame.columns) == KEYS and len(frame) == len(evaluation.records)
+    table = frame[frame.split == "validation"].pivot_table(index="model", columns="axis", values="drift_dps")
+    assert table.loc["modified", "X"] < table.loc["uncorrected", "X"]
+
+
+def test_dataframe_without_pandas(evaluation: gyrodrift.Evaluation, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "pandas", None)  # `import pandas` now fails
+    with pytest.raises(ImportError, match="needs pandas"):
+        evaluation.to_dataframe()
+    assert evaluation.records  # the records need nothing
+
+
+def test_paper_table(evaluation: gyrodrift.Evaluation) -> None:
+    table = gyrodrift.paper_table(evaluation.records)
+    lines = table.splitlines()
+    assert lines[0] == "| calibration | set point | data | GIU-01 X | GIU-01 Y | GIU-01 Z |"
+    rows = [line.split(" | ")[:3] for line in lines[2:]]
+    assert rows[:3] == [["| standard", "+30 °C", "held-out repeat"], ["| standard", "+33 °C", "validation"],
+                        ["| standard", "+40 °C", "held-out repeat"]]  # fmt: skip
+    assert [r[0] for r in rows] == ["| standard"] * 3 + ["| modified"] * 3 + ["| standard / modified"] * 3
+    assert lines[-1].endswith("× |")

@@ -1,0 +1,98 @@
+"""Recordings from Python: load what the simulator wrote, build from arrays, write, read back."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gyrodrift
+from conftest import SMALL_CAMPAIGN, make_segment, recording_path
+
+
+def test_load_a_simulated_recording(campaign_dir: Path) -> None:
+    recording = gyrodrift.Recording.load(recording_path(campaign_dir))
+    protocol = SMALL_CAMPAIGN["protocol"]
+    assert recording.unit_id == "GIU-01"
+    assert recording.sample_rate_hz == 1000
+    assert recording.path == recording_path(campaign_dir)
+    assert recording.metadata["set_point_celsius"] == "30"
+    assert len(recording) == len(protocol["intervals_min"]) * protocol["activations"] * protocol["repeats"]
+    segment = recording.segments[0]
+    n = int(protocol["activation_s"] * 1000)
+    assert len(segment) == n
+    assert segment.labels.series_kind == "protocol" and segment.labels.activation == 1
+    assert segment.rate_dps.shape == (n, 3) and segment.rate_dps.dtype == np.float32
+    assert segment.temperature_raw.shape == (n, 3) and segment.temperature_raw.dtype == np.int16
+    assert np.array_equal(segment.since_power_on, np.arange(n, dtype=np.uint32))
+    assert segment.since_power_on_ms[-1] == n - 1
+    assert sorted(segment.aux) == ["accel_x", "accel_y", "accel_z", "chamber_set_point", "supply_voltage"]
+    accel = segment.aux_channel("accel_z")
+    assert accel.unit == "g" and accel.sample_rate_hz == 100 and len(accel) == n // 10
+
+
+def test_segment_arrays_are_kept_and_read_only(campaign_dir: Path) -> None:
+    segment = gyrodrift.Recording.load(recording_path(campaign_dir)).segments[0]
+    assert segment.rate_dps is segment.rate_dps  # made once
+    with pytest.raises(ValueError, match="read-only"):
+        segment.rate_dps[0, 0] = 1.0
+
+
+def test_load_campaign_reads_every_recording(campaign_dir: Path) -> None:
+    recordings = gyrodrift.load_campaign(campaign_dir)
+    names = [r.path.name for r in recordings if r.path is not None]
+    assert names == sorted(p.name for p in (campaign_dir / "recordings").glob("*.mcap"))
+    assert {r.metadata["set_point_celsius"] for r in recordings} == {"30", "33", "40"}
+
+
+def test_read_metadata_without_decoding(campaign_dir: Path) -> None:
+    metadata = gyrodrift.Recording.read_metadata(recording_path(campaign_dir, "+40.0"))
+    assert metadata["unit_id"] == "GIU-01" and metadata["series_kind"] == "protocol"
+
+
+def test_build_write_and_read_back(tmp_path: Path) -> None:
+    first, second = make_segment(), make_segment(2345, power_on_ns=10**10, activation=2)
+    recording = gyrodrift.Recording([first, second], metadata={"campaign": "bench 7"})
+    assert recording.unit_id == "PY-1" and recording.path is None
+    written = recording.save(tmp_path / "bench.mcap")
+    assert written == (tmp_path / "bench.mcap").stat().st_size
+    assert [p.name for p in tmp_path.iterdir()] == ["bench.mcap"]  # no temporary left behind
+
+    back = gyrodrift.Recording.load(tmp_path / "bench.mcap")
+    assert back.metadata["campaign"] == "bench 7" and back.metadata["series_kind"] == "protocol"
+    for built, read in zip([first, second], back.segments):
+        assert read.labels == built.labels
+        assert read.power_on_ns == built.power_on_ns
+        assert np.array_equal(read.rate_dps, built.rate_dps)
+        assert np.array_equal(read.temperature_raw, built.temperature_raw)
+        assert np.array_equal(read.aux["supply_voltage"].values, built.aux["supply_voltage"].values)
+
+
+def test_a_loaded_recording_writes_back_unchanged(campaign_dir: Path, tmp_path: Path) -> None:
+    original = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0"))
+    original.save(tmp_path / "copy.mcap")
+    copy = gyrodrift.Recording.load(tmp_path / "copy.mcap")
+    assert copy.metadata == original.metadata
+    for a, b in zip(original.segments, copy.segments):
+        assert a.labels == b.labels and a.power_on_ns == b.power_on_ns
+        assert np.array_equal(a.rate_dps, b.rate_dps) and np.array_equal(a.temperature_raw, b.temperature_raw)
+
+
+def test_float64_rates_are_rounded_to_float32() -> None:
+    rate = np.full((1000, 3), 0.1, dtype=np.float64)
+    labels = gyrodrift.Labels(unit_id="U", set_point_celsius=30.0)
+    segment = gyrodrift.Segment(labels, rate, np.zeros((1000, 3), dtype=np.int16))
+    assert np.array_equal(segment.rate_dps, rate.astype(np.float32))
+
+
+def test_in_memory_segments_feed_the_corrector(campaign_dir: Path) -> None:
+    segment = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0")).segments[0]
+    model = gyrodrift.fit(campaign_dir)[0].modified
+    corrector = gyrodrift.Corrector(model)
+    corrector.power_on(segment.temperature_raw[:20].mean(axis=0))
+    corrected, _, flags = corrector.correct_batch(
+        segment.since_power_on_ms, segment.rate_dps, segment.temperature_raw.astype(np.float32)
+    )
+    assert corrected.shape == segment.rate_dps.shape
+    assert not (flags & gyrodrift.Flags.faults().value).any()

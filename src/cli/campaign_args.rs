@@ -1,0 +1,42 @@
+//! The arguments every fitting command shares: which recordings, which set points to fit, which
+//! fit settings, and whether to show progress.
+
+use std::path::PathBuf;
+
+use drift_fit::pipeline::Options;
+
+use super::fit::load_settings;
+
+/// Recordings and fit settings.
+#[derive(Debug, clap::Args)]
+pub struct CampaignArgs {
+    /// Campaign folder (with `recordings/`) or a folder of `.mcap` recordings.
+    pub campaign: PathBuf,
+    /// Chamber set points to fit, °C (protocol activations only).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "30,40",
+        allow_hyphen_values = true
+    )]
+    pub calibration: Vec<f64>,
+    /// Fit settings as JSON (fields of `drift_fit::FitSettings`; missing fields keep defaults).
+    #[arg(long)]
+    pub settings: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+impl CampaignArgs {
+    /// Pipeline options: fit on the calibration set points, validate on `validation`.
+    pub fn options(&self, validation: &[f64], evaluate: bool) -> anyhow::Result<Options> {
+        Ok(Options {
+            calibration_set_points: self.calibration.clone(),
+            validation_set_points: validation.to_vec(),
+            fit: load_settings(self.settings.as_deref())?,
+            held_out_repeats: evaluate,
+            evaluate,
+        })
+    }
+}
