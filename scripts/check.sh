@@ -38,6 +38,12 @@ step "tests: workspace (all features) and drift-core without default features"
 cargo test --workspace --all-features --locked
 cargo test -p drift-core --no-default-features --locked --lib
 
+step "fuzz targets: format and compile on stable (the corpora are replayed by the tests above)"
+# Fuzzing itself (nightly, minutes per target) is scripts/fuzz.sh; Miri over drift-core takes
+# far longer than this script's budget: both are run by hand (docs/reliability.md).
+(cd fuzz && cargo fmt --check)
+cargo check --manifest-path fuzz/Cargo.toml --locked
+
 step "benches: every criterion bench once, quickly (they must not rot)"
 cargo bench --workspace --locked -- --test
 

@@ -68,3 +68,88 @@ pub(crate) fn for_each_message<E>(
     }
     Ok(())
 }
+
+fn le_u64(bytes: &[u8], at: usize) -> Option<u64> {
+    let b = bytes.get(at..at.checked_add(8)?)?;
+    Some(u64::from_le_bytes(b.try_into().ok()?))
+}
+
+fn le_u32(bytes: &[u8], at: usize) -> Option<u32> {
+    let b = bytes.get(at..at.checked_add(4)?)?;
+    Some(u32::from_le_bytes(b.try_into().ok()?))
+}
+
+/// mcap 0.26's sans-io reader subtracts an inner record's length from an uncompressed chunk's
+/// remaining bytes without checking that it fits (found by fuzzing, F11: an overflow panic in
+/// debug builds, a misread past the chunk in release). Walks the top-level records and refuses an
+/// uncompressed chunk whose inner records do not tile it exactly. Stops quietly where the
+/// top-level structure itself is broken: mcap reports that with its own error. Also refuses an
+/// attachment record too short for its own header (F12: mcap slices it unchecked). Runs before any
+/// mcap reader sees the bytes (its summary reader can scan the file too).
+pub(crate) fn check_uncompressed_chunks(buf: &[u8]) -> Result<(), McapError> {
+    // mcap reads records linearly from the start (messages) and from the footer's summary start
+    // (summary): walk both ways in. The footer is the last record before the closing magic:
+    // opcode, length 20, summary start, summary offset start, CRC.
+    let footer = buf.len().checked_sub(mcap::MAGIC.len() + 9 + 20);
+    let summary_start = footer
+        .and_then(|at| le_u64(buf, at + 9))
+        .and_then(|s| usize::try_from(s).ok())
+        .filter(|&s| s > 0 && s < buf.len());
+    check_from(buf, mcap::MAGIC.len())?;
+    match summary_start {
+        Some(at) => check_from(buf, at),
+        None => Ok(()),
+    }
+}
+
+fn check_from(buf: &[u8], mut at: usize) -> Result<(), McapError> {
+    const CHUNK: u8 = 0x06;
+    const ATTACHMENT: u8 = 0x09;
+    while let (Some(&opcode), Some(len)) = (buf.get(at), le_u64(buf, at + 1)) {
+        let body_at = at + 9;
+        let Some(body) = usize::try_from(len)
+            .ok()
+            .and_then(|len| buf.get(body_at..body_at.checked_add(len)?))
+        else {
+            return Ok(());
+        };
+        if opcode == ATTACHMENT {
+            // log time u64, create time u64, name, media type, data length u64, data, CRC u32:
+            // mcap slices `body[header ..len − 4]` without checking (F12).
+            let name = le_u32(body, 16).and_then(|n| usize::try_from(n).ok());
+            let media_at = name.and_then(|n| 20usize.checked_add(n));
+            let media = media_at
+                .and_then(|at| le_u32(body, at))
+                .and_then(|n| usize::try_from(n).ok());
+            let header = media_at
+                .zip(media)
+                .and_then(|(at, m)| at.checked_add(4)?.checked_add(m)?.checked_add(8));
+            if header.is_some_and(|h| h.saturating_add(4) > body.len()) {
+                return Err(McapError::UnexpectedEof);
+            }
+        }
+        if opcode == CHUNK {
+            // start u64, end u64, uncompressed size u64, crc u32, compression string, size u64.
+            let Some(name_len) = le_u32(body, 28).and_then(|n| usize::try_from(n).ok()) else {
+                return Ok(());
+            };
+            let records_at = 32usize.saturating_add(name_len).saturating_add(8);
+            let size = le_u64(body, 32usize.saturating_add(name_len));
+            let records = size
+                .and_then(|n| usize::try_from(n).ok())
+                .and_then(|n| body.get(records_at..records_at.checked_add(n)?));
+            if let (Some(0), Some(records)) = (le_u32(body, 28), records) {
+                let mut inner = 0usize;
+                while inner < records.len() {
+                    let end = le_u64(records, inner + 1)
+                        .and_then(|n| usize::try_from(n).ok())
+                        .and_then(|n| (inner + 9).checked_add(n))
+                        .filter(|&end| end <= records.len());
+                    inner = end.ok_or(McapError::UnexpectedEoc)?;
+                }
+            }
+        }
+        at = body_at + body.len();
+    }
+    Ok(())
+}

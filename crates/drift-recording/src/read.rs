@@ -125,6 +125,10 @@ fn refuse_truth_name(path: &Path) -> Result<(), ReadError> {
 }
 
 fn open_bytes(path: &Path, buf: Vec<u8>) -> Result<Opened, ReadError> {
+    crate::messages::check_uncompressed_chunks(&buf).map_err(|e| ReadError::Mcap {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
     let mcap_err = |e| ReadError::Mcap {
         path: path.to_path_buf(),
         source: e,

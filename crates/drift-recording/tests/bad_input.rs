@@ -430,3 +430,28 @@ fn oversized_record_lengths_are_refused_without_allocating_them() {
         .to_string();
     assert!(text.starts_with("huge.mcap: MCAP: "), "{text}");
 }
+
+#[test]
+fn a_metadata_index_pointing_past_the_file_is_named() {
+    // Found by fuzzing (F9): mcap adds the index's offset and length unchecked and slices.
+    let mut bytes = good_bytes();
+    // The metadata index record (opcode 0x0D): length u64, then offset u64, length u64, name.
+    let name = schema::METADATA_RECORDING.as_bytes();
+    let at = bytes
+        .windows(name.len())
+        .enumerate()
+        .filter(|(_, w)| *w == name)
+        .map(|(i, _)| i)
+        .find(|&i| bytes[i - 4 - 8 - 8 - 8 - 1] == 0x0D)
+        .unwrap();
+    let offset = at - 4 - 8 - 8;
+    bytes[offset..offset + 8].copy_from_slice(&(u64::MAX - 16).to_le_bytes());
+    let text = read_recording_bytes(Path::new("index.mcap"), &bytes)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        text.starts_with("index.mcap: metadata `gyrodrift.recording`")
+            && text.contains("metadata index points outside the file"),
+        "{text}"
+    );
+}
