@@ -42,12 +42,13 @@ fn main() {
             "modified" => "ModelName::Modified",
             "standard" => "ModelName::Standard",
             "third_order" => "ModelName::ThirdOrder",
+            "extended" => "ModelName::Extended",
             other => panic!("unknown model {other}"),
         };
         writeln!(
             code,
-            "Case {{ name: {:?}, model: {model}, switch_on_raw: {:?}, power_on_fails: {}, samples: &{:?}, expected: &{:?} }},",
-            case.name, case.switch_on_raw, case.power_on_fails, case.samples, case.expected
+            "Case {{ name: {:?}, model: {model}, switch_on_raw: {:?}, power_on_fails: {}, samples: &{:?}, expected: &{:?}, aux: &{:?} }},",
+            case.name, case.switch_on_raw, case.power_on_fails, case.samples, case.expected, case.aux
         )
         .unwrap();
     }

@@ -19,6 +19,8 @@ pub enum ModelName {
     Standard,
     /// The 3rd-order polynomial baseline.
     ThirdOrder,
+    /// The paper's tables plus the extended model's extra terms.
+    Extended,
 }
 
 /// One test-vector case (see `testdata/vectors.json`).
@@ -35,6 +37,8 @@ pub struct Case {
     pub samples: &'static [[u32; 7]],
     /// `[corrected x y z, bias x y z, flags x y z]`, floats as bits.
     pub expected: &'static [[u32; 9]],
+    /// Auxiliary inputs per sample (floats as bits); empty: corrected without.
+    pub aux: &'static [[u32; 4]],
 }
 
 include!(concat!(env!("OUT_DIR"), "/vectors.rs"));

@@ -5,7 +5,7 @@
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 4 | magic `GYDT` |
-//! | 4 | 2 | format version ([`FORMAT_VERSION`]) |
+//! | 4 | 2 | format version ([`FORMAT_VERSION`]; version 1, without extra terms, still reads) |
 //! | 6 | 1 | model kind ([`Kind`]) |
 //! | 7 | 1 | reserved, 0 |
 //! | 8 | 4 | payload length `n`, bytes |
@@ -21,14 +21,21 @@ use core::fmt;
 use serde::{de::DeserializeOwned, Serialize};
 
 use crate::error::Error;
+use crate::extension::Extension;
 use crate::model::Model;
 use crate::polynomial::PolynomialTables;
+use crate::settings::Settings;
+use crate::table::AxisTable;
 use crate::table::ModifiedTables;
+use crate::AXES;
 
 /// First four bytes of every image.
 pub const MAGIC: [u8; 4] = *b"GYDT";
-/// The image format version this build writes and reads.
-pub const FORMAT_VERSION: u16 = 1;
+/// The image format version this build writes. Version 2 added the extended model's extra terms
+/// to [`ModifiedTables`]; this build still reads version-1 images (they load with no extra terms).
+pub const FORMAT_VERSION: u16 = 2;
+/// The oldest image format version this build reads.
+pub const OLDEST_READABLE_VERSION: u16 = 1;
 /// Bytes before the payload.
 pub const HEADER_LEN: usize = 12;
 /// Bytes after the payload (the CRC).
@@ -50,10 +57,39 @@ pub enum Kind {
 pub trait Image: Model + Serialize + DeserializeOwned {
     /// The kind byte written in the header.
     const KIND: Kind;
+
+    /// Decodes a payload written by format `version` (already checked to be readable); returns
+    /// the model and the bytes left over. Models whose payload changed between versions override
+    /// this to read the older form.
+    fn from_payload(version: u16, payload: &[u8]) -> postcard::Result<(Self, &[u8])> {
+        let _ = version;
+        postcard::take_from_bytes(payload)
+    }
+}
+
+/// A version-1 modified-model payload: the tables before the extended model existed.
+#[derive(serde::Deserialize)]
+struct ModifiedTablesV1<const R: usize, const A: usize, const C: usize> {
+    settings: Settings,
+    axes: [AxisTable<R, A, C>; AXES],
 }
 
 impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R, A, C> {
     const KIND: Kind = Kind::Modified;
+
+    fn from_payload(version: u16, payload: &[u8]) -> postcard::Result<(Self, &[u8])> {
+        if version == 1 {
+            let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)?;
+            let tables = Self {
+                settings: v1.settings,
+                axes: v1.axes,
+                extension: Extension::NONE,
+            };
+            Ok((tables, rest))
+        } else {
+            postcard::take_from_bytes(payload)
+        }
+    }
 }
 
 impl Image for PolynomialTables {
@@ -75,7 +111,7 @@ pub enum BlobError {
         /// The bytes found.
         found: [u8; 4],
     },
-    /// The format version is not [`FORMAT_VERSION`].
+    /// The format version is outside [`OLDEST_READABLE_VERSION`] ..= [`FORMAT_VERSION`].
     UnsupportedVersion {
         /// The version found.
         found: u16,
@@ -120,7 +156,7 @@ impl fmt::Display for BlobError {
             ),
             Self::UnsupportedVersion { found } => write!(
                 f,
-                "table image format version {found} is not supported (this build reads {FORMAT_VERSION})"
+                "table image format version {found} is not supported (this build reads {OLDEST_READABLE_VERSION} to {FORMAT_VERSION})"
             ),
             Self::WrongKind { expected, found } => {
                 write!(f, "table image holds model kind {found}, expected {expected}")
@@ -232,7 +268,7 @@ pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
         return Err(BlobError::BadMagic { found: magic });
     }
     let version = le_u16(bytes, 4);
-    if version != FORMAT_VERSION {
+    if !(OLDEST_READABLE_VERSION..=FORMAT_VERSION).contains(&version) {
         return Err(BlobError::UnsupportedVersion { found: version });
     }
     let kind = bytes.get(6).copied().unwrap_or(0);
@@ -263,7 +299,7 @@ pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
         return Err(BlobError::CrcMismatch { stored, computed });
     }
     let payload = body.get(HEADER_LEN..).unwrap_or_default();
-    let (model, rest) = postcard::take_from_bytes::<M>(payload).map_err(BlobError::Malformed)?;
+    let (model, rest) = M::from_payload(version, payload).map_err(BlobError::Malformed)?;
     if !rest.is_empty() {
         return Err(BlobError::Malformed(
             postcard::Error::DeserializeBadEncoding,

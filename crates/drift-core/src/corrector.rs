@@ -1,6 +1,7 @@
 //! The run-time corrector: immutable model (tables) + small per-unit state, one call per sample.
 
 use crate::error::{Error, Location, Problem};
+use crate::extension::{ExtensionState, TermInputs, AUX_INPUTS};
 use crate::flags::Flags;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
@@ -43,6 +44,8 @@ pub struct AxisState<S> {
     repeats: u16,
     /// Flags that hold for the whole activation (from switch-on).
     activation_flags: Flags,
+    /// Last good contribution of the extended model's extra terms, held through input faults.
+    extension_dps: f32,
     model: S,
 }
 
@@ -68,6 +71,7 @@ impl<S> AxisState<S> {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CorrectorState<S> {
     axes: [AxisState<S>; AXES],
+    extension: ExtensionState,
     powered_on: bool,
 }
 
@@ -131,6 +135,7 @@ impl<S: Copy + Default> CorrectorState<S> {
             state.activation_flags = activation;
             *flags = activation;
         }
+        self.extension = ExtensionState::power_on(switch_on_raw.map(|raw| settings.celsius(raw)));
         self.powered_on = true;
         Ok(flags)
     }
@@ -140,9 +145,25 @@ impl<S: Copy + Default> CorrectorState<S> {
         self.powered_on = false;
     }
 
-    /// Corrects one sample. Total: never panics, never allocates; every clamp, hold and fault is in
-    /// the returned flags.
+    /// Corrects one sample without auxiliary inputs. Total: never panics, never allocates; every
+    /// clamp, hold and fault is in the returned flags. A model whose extra terms read auxiliary
+    /// inputs needs [`Self::correct_with_aux`]: here those terms hold, flagged.
     pub fn correct<M>(&mut self, model: &M, sample: &Sample) -> Output
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        self.correct_with_aux(model, sample, &[f32::NAN; AUX_INPUTS])
+    }
+
+    /// Corrects one sample, with the auxiliary inputs the extended model's extra terms may read
+    /// (e.g. supply voltage, accelerometer axes, in the order the fit named them).
+    pub fn correct_with_aux<M>(
+        &mut self,
+        model: &M,
+        sample: &Sample,
+        aux: &[f32; AUX_INPUTS],
+    ) -> Output
     where
         M: Model,
         M::Axis: AxisModel<State = S>,
@@ -164,6 +185,44 @@ impl<S: Copy + Default> CorrectorState<S> {
             } else {
                 (rate, 0.0, Flags::NOT_POWERED_ON | rate_flag(rate))
             };
+        }
+        let extension = model.extension();
+        if self.powered_on && !extension.is_empty() {
+            // The extra terms read the last good temperature of every axis (a faulty reading is
+            // held there, like the paper's drift).
+            let mut inputs = TermInputs {
+                since_power_on_ms: sample.since_power_on_ms,
+                aux: *aux,
+                ..TermInputs::default()
+            };
+            for ((state, celsius), rise) in self
+                .axes
+                .iter()
+                .zip(&mut inputs.celsius)
+                .zip(&mut inputs.rise_celsius)
+            {
+                *celsius = settings.celsius(state.last_raw);
+                *rise = (state.last_raw - state.switch_on_raw) / settings.raw_per_celsius;
+            }
+            let values = self.extension.values(extension, &inputs);
+            let extra = extension.bias(&values);
+            for ((((state, extra), values), corrected), (bias, flags)) in self
+                .axes
+                .iter_mut()
+                .zip(extra)
+                .zip(&values)
+                .zip(&mut output.corrected_dps)
+                .zip(output.bias_dps.iter_mut().zip(&mut output.flags))
+            {
+                let used = values.iter().take(extension.terms.len());
+                if extra.is_finite() && used.clone().all(|v| v.is_finite()) {
+                    state.extension_dps = extra;
+                } else {
+                    *flags |= Flags::EXTENSION_INPUT_INVALID;
+                }
+                *corrected -= state.extension_dps;
+                *bias += state.extension_dps;
+            }
         }
         output
     }
@@ -280,6 +339,11 @@ impl<'a, M: Model> Corrector<'a, M> {
     /// See [`CorrectorState::correct`].
     pub fn correct(&mut self, sample: &Sample) -> Output {
         self.state.correct(self.model, sample)
+    }
+
+    /// See [`CorrectorState::correct_with_aux`].
+    pub fn correct_with_aux(&mut self, sample: &Sample, aux: &[f32; AUX_INPUTS]) -> Output {
+        self.state.correct_with_aux(self.model, sample, aux)
     }
 
     /// Corrects a block of samples into `outputs`; returns how many were corrected (the shorter of

@@ -90,6 +90,13 @@ pub enum Problem {
         /// Length it has.
         found: u16,
     },
+    /// An index that must be below a limit is not.
+    OutOfRange {
+        /// The first value that is too large.
+        limit: u16,
+    },
+    /// Differs from an earlier entry it must equal.
+    Mismatch,
 }
 
 /// A table or settings value failed validation.
@@ -139,6 +146,8 @@ impl fmt::Display for Error {
             Problem::LengthMismatch { expected, found } => {
                 write!(f, ": has {found} entries, expected {expected}")
             }
+            Problem::OutOfRange { limit } => write!(f, ": must be less than {limit}"),
+            Problem::Mismatch => f.write_str(": differs from the earlier entry it must equal"),
         }
     }
 }

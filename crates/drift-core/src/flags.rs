@@ -38,10 +38,14 @@ impl Flags {
     /// The model produced a non-finite drift (for example from an extreme but finite input); the last
     /// good drift estimate is held.
     pub const MODEL_INVALID: Self = Self(1 << 8);
+    /// Extended model: an auxiliary input an extra term reads is NaN, infinite or was not passed:
+    /// the extra terms' last good contribution is held. (Temperature faults hold the temperature
+    /// the terms read, under the flags above.)
+    pub const EXTENSION_INPUT_INVALID: Self = Self(1 << 9);
 
     /// Every flag with its name, in bit order (for bindings, logs and reports: a flag added here is
     /// listed everywhere).
-    pub const ALL: [(Self, &'static str); 9] = [
+    pub const ALL: [(Self, &'static str); 10] = [
         (Self::AMBIENT_OUT_OF_RANGE, "AMBIENT_OUT_OF_RANGE"),
         (Self::RISE_OUT_OF_SPAN, "RISE_OUT_OF_SPAN"),
         (Self::PAST_LAST_REFERENCE, "PAST_LAST_REFERENCE"),
@@ -51,6 +55,7 @@ impl Flags {
         (Self::RATE_INVALID, "RATE_INVALID"),
         (Self::NOT_POWERED_ON, "NOT_POWERED_ON"),
         (Self::MODEL_INVALID, "MODEL_INVALID"),
+        (Self::EXTENSION_INPUT_INVALID, "EXTENSION_INPUT_INVALID"),
     ];
 
     /// Flags that mean the correction of this sample is degraded (a hold or pass-through), as opposed
@@ -60,7 +65,8 @@ impl Flags {
             | Self::TEMPERATURE_STUCK.0
             | Self::RATE_INVALID.0
             | Self::NOT_POWERED_ON.0
-            | Self::MODEL_INVALID.0,
+            | Self::MODEL_INVALID.0
+            | Self::EXTENSION_INPUT_INVALID.0,
     );
 
     /// Whether every bit of `other` is set in `self`.

@@ -21,6 +21,7 @@ extern crate std;
 pub mod blob;
 mod corrector;
 mod error;
+mod extension;
 mod flags;
 mod interp;
 mod model;
@@ -31,6 +32,9 @@ mod table;
 
 pub use corrector::{AxisState, Corrector, CorrectorState, Output, Sample};
 pub use error::{Error, Location, Problem};
+pub use extension::{
+    Extension, ExtensionState, ExtraTerm, Term, TermInputs, TermValues, AUX_INPUTS, MAX_TERMS,
+};
 pub use flags::Flags;
 pub use model::{AxisModel, Model};
 pub use polynomial::{

@@ -2,6 +2,7 @@
 //! flagged and compared the same way, in firmware and in analysis.
 
 use crate::error::Error;
+use crate::extension::Extension;
 use crate::flags::Flags;
 use crate::settings::Settings;
 use crate::AXES;
@@ -50,4 +51,11 @@ pub trait Model {
 
     /// Checks every value; the error names the field and where it sits.
     fn validate(&self) -> Result<(), Error>;
+
+    /// Extra linear terms on top of the per-axis model (none unless the model carries them).
+    fn extension(&self) -> &Extension {
+        &NO_EXTENSION
+    }
 }
+
+static NO_EXTENSION: Extension = Extension::NONE;

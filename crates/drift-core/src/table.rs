@@ -3,6 +3,7 @@
 use heapless::Vec;
 
 use crate::error::{check_increasing, check_len, Error, Location, Problem};
+use crate::extension::Extension;
 use crate::flags::Flags;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
@@ -71,12 +72,27 @@ pub struct ModifiedTables<const R: usize = 16, const A: usize = 12, const C: usi
     pub settings: Settings,
     /// One table per axis (X, Y, Z).
     pub axes: [AxisTable<R, A, C>; AXES],
+    /// Extra linear terms (the extended model); empty for the paper's model as published. Tables
+    /// written before the extended model existed read as empty.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub extension: Extension,
 }
 
 impl<const R: usize, const A: usize, const C: usize> ModifiedTables<R, A, C> {
     /// The validating constructor: returns the tables only if [`Model::validate`] accepts them.
     pub fn try_new(settings: Settings, axes: [AxisTable<R, A, C>; AXES]) -> Result<Self, Error> {
-        let tables = Self { settings, axes };
+        let tables = Self {
+            settings,
+            axes,
+            extension: Extension::NONE,
+        };
+        tables.validate()?;
+        Ok(tables)
+    }
+
+    /// The same tables with extra terms; validates the whole.
+    pub fn with_extension(self, extension: Extension) -> Result<Self, Error> {
+        let tables = Self { extension, ..self };
         tables.validate()?;
         Ok(tables)
     }
@@ -276,6 +292,10 @@ impl<const R: usize, const A: usize, const C: usize> Model for ModifiedTables<R,
         for (axis, table) in self.axes.iter().enumerate() {
             table.validate(Location::axis(axis))?;
         }
-        Ok(())
+        self.extension.validate()
+    }
+
+    fn extension(&self) -> &Extension {
+        &self.extension
     }
 }

@@ -240,3 +240,78 @@ fn encoded_len_is_exact() {
     let mut short = vec![0; buffer.len() - 1];
     assert_eq!(encode(&model, &mut short), Err(BlobError::BufferTooSmall));
 }
+
+/// An image written by the version-1 build (before the extended model), committed as it was:
+/// it still loads, with no extra terms, into exactly the tables it held.
+#[test]
+fn version_1_images_still_load() {
+    let v1 = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../testdata/image-v1-modified.bin"
+    ))
+    .unwrap();
+    assert_eq!(u16::from_le_bytes([v1[4], v1[5]]), 1);
+    let tables: FixtureTables = decode(&v1).unwrap();
+    assert!(tables.extension.is_empty());
+    assert_eq!(tables, fixture::modified());
+    // Re-encoding writes the current version, which a version-1 reader would refuse by number.
+    let mut buffer = vec![0; 64 * 1024];
+    let len = encode(&tables, &mut buffer).unwrap();
+    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
+    assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), tables);
+}
+
+#[test]
+fn extended_images_round_trip_and_bad_terms_are_named() {
+    use drift_core::{ExtraTerm, Term};
+    let extended = fixture::extended();
+    let mut buffer = vec![0; 64 * 1024];
+    let len = encode(&extended, &mut buffer).unwrap();
+    assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), extended);
+
+    let bad_term = |term: Term| {
+        let mut extension = extended.extension.clone();
+        extension.terms[0] = ExtraTerm {
+            term,
+            ..extension.terms[0]
+        };
+        fixture::modified()
+            .with_extension(extension)
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        bad_term(Term::Aux { input: 4 }),
+        "term_input[0]: must be less than 4"
+    );
+    assert_eq!(
+        bad_term(Term::AxisRise { axis: 3 }),
+        "term_axis[0]: must be less than 3"
+    );
+    assert_eq!(
+        bad_term(Term::TemperatureRate {
+            time_constant_ms: 0
+        }),
+        "term_time_constant_ms[0]: must be greater than zero"
+    );
+    let mut two_filters = extended.extension.clone();
+    two_filters.terms[1].term = Term::TemperatureRate {
+        time_constant_ms: 1000,
+    };
+    assert_eq!(
+        fixture::modified()
+            .with_extension(two_filters)
+            .unwrap_err()
+            .to_string(),
+        "term_time_constant_ms[1]: differs from the earlier entry it must equal"
+    );
+    let mut nan = extended.extension.clone();
+    nan.terms[2].coefficient[1] = f32::NAN;
+    assert_eq!(
+        fixture::modified()
+            .with_extension(nan)
+            .unwrap_err()
+            .to_string(),
+        "axes[1].term_coefficient[2]: value is NaN or infinite"
+    );
+}

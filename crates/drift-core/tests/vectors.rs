@@ -71,7 +71,10 @@ fn check_case<M: Model>(model: &M, case: &Case) -> usize {
             rate_dps: [input[1], input[2], input[3]].map(f32::from_bits),
             temperature_raw: [input[4], input[5], input[6]].map(f32::from_bits),
         };
-        let out = corrector.correct(&sample);
+        let out = match case.aux.get(i) {
+            Some(aux) => corrector.correct_with_aux(&sample, &aux.map(f32::from_bits)),
+            None => corrector.correct(&sample),
+        };
         let got: Vec<u32> = out
             .corrected_dps
             .iter()
@@ -103,6 +106,7 @@ fn corrector_reproduces_vectors_bit_for_bit() {
     let modified: ModifiedTables = model(&file, "modified");
     let standard: PolynomialTables = model(&file, "standard");
     let third_order: PolynomialTables = model(&file, "third_order");
+    let extended: ModifiedTables = model(&file, "extended");
     let mut total = 0;
     let mut samples = 0;
     for case in &file.cases {
@@ -111,6 +115,7 @@ fn corrector_reproduces_vectors_bit_for_bit() {
             "modified" => check_case(&modified, case),
             "standard" => check_case(&standard, case),
             "third_order" => check_case(&third_order, case),
+            "extended" => check_case(&extended, case),
             other => panic!("unknown model {other}"),
         };
     }
@@ -170,6 +175,7 @@ fn every_case_name_and_flag_kind_is_covered() {
         Flags::TEMPERATURE_STUCK,
         Flags::RATE_INVALID,
         Flags::NOT_POWERED_ON,
+        Flags::EXTENSION_INPUT_INVALID,
     ] {
         assert!(seen.contains(flag), "no vector exercises flag {flag:?}");
     }

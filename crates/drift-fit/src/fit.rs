@@ -244,6 +244,7 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
     let modified = ModifiedTables {
         settings: core_settings,
         axes,
+        extension: drift_core::Extension::NONE,
     };
     modified.validate().map_err(|source| FitError::Table {
         unit: unit_id.clone(),

@@ -11,7 +11,7 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use drift_core::blob::decode;
 use drift_core::{AxisModel, Corrector, Model, PolynomialTables, Sample};
-use gyrodrift_embedded::{FirmwareTables, MODIFIED, STANDARD};
+use gyrodrift_embedded::{FirmwareTables, EXTENDED, MODIFIED, STANDARD};
 use panic_semihosting as _;
 
 /// Samples corrected between two markers.
@@ -77,14 +77,32 @@ where
     gyrodrift_marker(id + 1);
 }
 
+/// As `measure`, with auxiliary inputs (supply voltage, gravity) for the extended model.
+fn measure_with_aux<M: Model>(model: &M, samples: &[Sample], id: u32)
+where
+    M::Axis: AxisModel,
+{
+    let Ok(mut corrector) = Corrector::new(model) else {
+        return;
+    };
+    let _ = corrector.power_on([6600.0, 6640.0, 6580.0]);
+    let aux = [5.0, 0.0, 0.0, 1.0];
+    gyrodrift_marker(id);
+    for sample in samples {
+        black_box(corrector.correct_with_aux(black_box(sample), black_box(&aux)));
+    }
+    gyrodrift_marker(id + 1);
+}
+
 #[entry]
 fn main() -> ! {
     let samples = activation(1000);
     let at_1khz = activation(1);
     let modified: Result<FirmwareTables, _> = decode(black_box(MODIFIED));
     let standard: Result<PolynomialTables, _> = decode(black_box(STANDARD));
-    match (modified, standard) {
-        (Ok(modified), Ok(standard)) => {
+    let extended: Result<FirmwareTables, _> = decode(black_box(EXTENDED));
+    match (modified, standard, extended) {
+        (Ok(modified), Ok(standard), Ok(extended)) => {
             hprintln!("samples per interval: {}", SAMPLES);
             hprintln!("interval 1: modified model, samples 1 s apart (worst case)");
             measure(&modified, &samples, 1);
@@ -99,6 +117,10 @@ fn main() -> ! {
                 black_box(drift_core::Output::default());
             }
             gyrodrift_marker(8);
+            hprintln!("interval 9: modified model + 4 extra terms (extended), samples 1 s apart");
+            measure_with_aux(&extended, &samples, 9);
+            hprintln!("interval 11: modified model + 4 extra terms (extended), 1000 Hz windows");
+            measure_with_aux(&extended, &at_1khz, 11);
             debug::exit(debug::EXIT_SUCCESS);
         }
         _ => {

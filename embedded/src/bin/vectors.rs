@@ -13,7 +13,7 @@ use drift_core::{
     AxisModel, Corrector, CorrectorState, Model, ModifiedAxisState, PolynomialTables, Sample,
 };
 use gyrodrift_embedded::{
-    stack, Case, FirmwareTables, ModelName, CASES, MODIFIED, STANDARD, THIRD_ORDER,
+    stack, Case, FirmwareTables, ModelName, CASES, EXTENDED, MODIFIED, STANDARD, THIRD_ORDER,
 };
 use panic_semihosting as _;
 
@@ -49,7 +49,10 @@ where
             rate_dps: [input[1], input[2], input[3]].map(f32::from_bits),
             temperature_raw: [input[4], input[5], input[6]].map(f32::from_bits),
         };
-        let out = corrector.correct(&sample);
+        let out = match case.aux.get(i) {
+            Some(aux) => corrector.correct_with_aux(&sample, &aux.map(f32::from_bits)),
+            None => corrector.correct(&sample),
+        };
         let got = [
             out.corrected_dps[0].to_bits(),
             out.corrected_dps[1].to_bits(),
@@ -92,6 +95,9 @@ fn main() -> ! {
     let Ok(third_order) = decode::<PolynomialTables>(THIRD_ORDER) else {
         fail("third-order image")
     };
+    let Ok(extended) = decode::<FirmwareTables>(EXTENDED) else {
+        fail("extended image")
+    };
 
     let mut samples = 0;
     let mut mismatches = 0;
@@ -101,11 +107,12 @@ fn main() -> ! {
             ModelName::Modified => run(&modified, case),
             ModelName::Standard => run(&standard, case),
             ModelName::ThirdOrder => run(&third_order, case),
+            ModelName::Extended => run(&extended, case),
         };
     }
 
     // Stack of one power-on plus one corrected sample, measured on a fresh painting.
-    let Ok(mut corrector) = Corrector::new(&modified) else {
+    let Ok(mut corrector) = Corrector::new(&extended) else {
         fail("model rejected")
     };
     let painted = stack::paint();
@@ -115,7 +122,7 @@ fn main() -> ! {
         rate_dps: [0.1; 3],
         temperature_raw: [6900.0, 6950.0, 6800.0],
     };
-    black_box(corrector.correct(black_box(&sample)));
+    black_box(corrector.correct_with_aux(black_box(&sample), black_box(&[5.0, 0.0, 0.0, 1.0])));
     let correct_stack = painted.used();
 
     hprintln!("cases: {}", CASES.len());
@@ -132,7 +139,10 @@ fn main() -> ! {
         core::mem::size_of::<CorrectorState<ModifiedAxisState>>()
     );
     hprintln!("stack bytes, decode image: {}", decode_stack);
-    hprintln!("stack bytes, power_on + correct: {}", correct_stack);
+    hprintln!(
+        "stack bytes, power_on + correct_with_aux (extended model): {}",
+        correct_stack
+    );
     if mismatches == 0 {
         hprintln!("PASS: Cortex-M4F outputs are bit-identical to the host's");
         debug::exit(debug::EXIT_SUCCESS);

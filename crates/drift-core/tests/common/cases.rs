@@ -36,6 +36,21 @@ struct Scenario {
     times: Vec<u32>,
     /// Per-sample input override (sample index, ms) → optional (rates, raw temperatures).
     tamper: fn(usize, u32, &mut [f32; 3], &mut [f32; 3]),
+    /// Auxiliary inputs per (sample index, ms), for the extended model; None: `correct` without.
+    aux: Option<fn(usize, u32) -> [f32; 4]>,
+}
+
+/// Supply voltage sagging and recovering, an accelerometer turned over half-way, and one NaN
+/// supply reading (sample 40) the extension must hold through.
+fn supply_and_gravity(i: usize, ms: u32) -> [f32; 4] {
+    let t = ms as f32 / 1000.0;
+    let supply = if i == 40 {
+        f32::NAN
+    } else {
+        5.0 - 0.3 * (t / 30.0).sin()
+    };
+    let gravity = if ms < 60_000 { 1.0 } else { -1.0 };
+    [supply, 0.0, 0.02, gravity]
 }
 
 fn untouched(_: usize, _: u32, _: &mut [f32; 3], _: &mut [f32; 3]) {}
@@ -63,6 +78,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [4.1, 3.3, 5.2],
             times: every(500, 120_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "modified-on-calibration-ambient",
@@ -72,6 +88,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [2.4, 4.6, 6.0],
             times: every(1000, 120_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "modified-ambient-below-range",
@@ -81,6 +98,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [4.0, 4.0, 4.0],
             times: every(4000, 120_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "modified-ambient-above-range",
@@ -90,6 +108,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [4.0, 4.0, 4.0],
             times: every(4000, 120_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "modified-rise-out-of-span",
@@ -99,6 +118,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [9.0, -1.5, 3.0],
             times: every(2000, 120_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "modified-past-last-reference",
@@ -108,6 +128,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [3.0, 4.0, 5.0],
             times: every(3000, 300_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "modified-temperature-faults",
@@ -127,6 +148,7 @@ fn scenarios() -> Vec<Scenario> {
                     raw[1] = 6400.0;
                 }
             },
+            aux: None,
         },
         Scenario {
             name: "modified-rate-faults",
@@ -142,6 +164,7 @@ fn scenarios() -> Vec<Scenario> {
                 13 => *rate = [500.0, -500.0, 500.0],
                 _ => {}
             },
+            aux: None,
         },
         Scenario {
             name: "modified-not-powered-on",
@@ -151,6 +174,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [4.0, 4.0, 4.0],
             times: (0..10).map(|i| i * 100).collect(),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "modified-power-on-rejects-nan",
@@ -160,6 +184,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [4.0, 4.0, 4.0],
             times: (0..10).map(|i| i * 100).collect(),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "standard-nominal",
@@ -169,6 +194,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [4.0, 5.0, 3.0],
             times: every(2000, 120_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "standard-out-of-range",
@@ -178,6 +204,7 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [6.0, 6.0, 6.0],
             times: every(4000, 120_000),
             tamper: untouched,
+            aux: None,
         },
         Scenario {
             name: "third-order-nominal",
@@ -187,6 +214,44 @@ fn scenarios() -> Vec<Scenario> {
             final_rise: [4.0, 5.0, 3.0],
             times: every(2000, 120_000),
             tamper: untouched,
+            aux: None,
+        },
+        Scenario {
+            name: "extended-with-aux",
+            description: "the paper's tables plus 4 extra terms (temperature rate, supply voltage, X rise, rise²) at 33 °C with a sagging supply, a NaN supply reading (held, flagged) and 1-ms steps",
+            model: "extended",
+            switch_on_celsius: Some([33.0, 33.2, 32.8]),
+            final_rise: [4.0, 5.0, 3.0],
+            times: every(1000, 120_000),
+            tamper: untouched,
+            aux: Some(supply_and_gravity),
+        },
+        Scenario {
+            name: "extended-temperature-faults",
+            description: "the extended model through a NaN X temperature and a stuck Y sensor: the terms read the held temperature",
+            model: "extended",
+            switch_on_celsius: Some([31.0, 31.0, 31.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: (0..=120).map(|i| i * 250).collect(),
+            tamper: |i, _, _, raw| {
+                if (40..50).contains(&i) {
+                    raw[0] = f32::NAN;
+                }
+                if (60..90).contains(&i) {
+                    raw[1] = 6400.0;
+                }
+            },
+            aux: Some(supply_and_gravity),
+        },
+        Scenario {
+            name: "extended-without-aux",
+            description: "the extended model corrected without auxiliary inputs: the supply term holds 0, flagged on every sample",
+            model: "extended",
+            switch_on_celsius: Some([30.0, 30.0, 30.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(5000, 120_000),
+            tamper: untouched,
+            aux: None,
         },
     ]
 }
@@ -213,6 +278,7 @@ where
         .map(|r| if r.is_finite() { r } else { 6000.0 });
     let mut samples = Vec::new();
     let mut expected = Vec::new();
+    let mut aux_inputs = Vec::new();
     for (i, &ms) in scenario.times.iter().enumerate() {
         let t = f64::from(ms) / 1000.0;
         let shape = (1.0 - (-t / 60.0).exp()) / (1.0 - (-2.0_f64).exp());
@@ -231,7 +297,14 @@ where
             rate_dps: rate,
             temperature_raw: raw,
         };
-        let out = corrector.correct(&sample);
+        let out = match scenario.aux {
+            Some(aux) => {
+                let aux = aux(i, ms);
+                aux_inputs.push(aux.map(f32::to_bits));
+                corrector.correct_with_aux(&sample, &aux)
+            }
+            None => corrector.correct(&sample),
+        };
         let [rx, ry, rz] = bits3(rate);
         let [tx, ty, tz] = bits3(raw);
         samples.push([ms, rx, ry, rz, tx, ty, tz]);
@@ -248,6 +321,7 @@ where
         power_on_fails,
         samples,
         expected,
+        aux: aux_inputs,
     }
 }
 
@@ -268,12 +342,14 @@ pub fn build() -> VectorFile {
     let modified = fixture::modified();
     let standard = fixture::standard();
     let third_order = fixture::third_order();
+    let extended = fixture::extended();
     let cases = scenarios()
         .iter()
         .enumerate()
         .map(|(i, scenario)| match scenario.model {
             "modified" => run(&modified, scenario, i as u64 + 1),
             "standard" => run(&standard, scenario, i as u64 + 1),
+            "extended" => run(&extended, scenario, i as u64 + 1),
             _ => run(&third_order, scenario, i as u64 + 1),
         })
         .collect();
@@ -283,7 +359,7 @@ pub fn build() -> VectorFile {
         description: vec![
             "Shared test vectors for every implementation of the gyrodrift corrector (Rust host, Cortex-M4 firmware, Python).".into(),
             "Each model is given as its firmware image (canonical, bit-exact) and as JSON (readable).".into(),
-            "Each case: optional power_on(switch_on_raw), then correct() per sample, in order, on one fresh state.".into(),
+            "Each case: optional power_on(switch_on_raw), then correct() per sample (correct_with_aux(aux[i]) when the case has aux), in order, on one fresh state.".into(),
             "samples: [since_power_on_ms, rate x,y,z (°/s), temperature_raw x,y,z]; expected: [corrected x,y,z, bias x,y,z, flags x,y,z].".into(),
             "Floats are IEEE-754 binary32 bit patterns. Expected outputs must match bit for bit; a NaN matches any NaN.".into(),
             "Regenerate with: GYRODRIFT_BLESS=1 cargo test -p drift-core --test vectors".into(),
@@ -292,6 +368,7 @@ pub fn build() -> VectorFile {
             named("modified", "modified", &modified),
             named("standard", "polynomial", &standard),
             named("third_order", "polynomial", &third_order),
+            named("extended", "modified", &extended),
         ],
         cases,
     }

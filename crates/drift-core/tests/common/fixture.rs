@@ -126,3 +126,37 @@ pub fn third_order() -> PolynomialTables {
     });
     PolynomialTables::try_new(settings(), axes).unwrap()
 }
+
+/// The extended-model fixture: the modified tables plus one extra term of each kind, with
+/// coefficients of the size the closed loop fits (°/s per unit of the term).
+pub fn extended() -> FixtureTables {
+    use drift_core::{Extension, ExtraTerm, Term};
+    let terms = [
+        ExtraTerm {
+            term: Term::TemperatureRate {
+                time_constant_ms: 5000,
+            },
+            centre: [0.01, 0.012, 0.008],
+            coefficient: [0.1, -0.08, 0.05],
+        },
+        ExtraTerm {
+            term: Term::Aux { input: 0 },
+            centre: [5.0; 3],
+            coefficient: [0.01, -0.012, 0.008],
+        },
+        ExtraTerm {
+            term: Term::AxisRise { axis: 0 },
+            centre: [2.0; 3],
+            coefficient: [0.0, 0.002, -0.0015],
+        },
+        ExtraTerm {
+            term: Term::RiseSquared,
+            centre: [6.0, 7.0, 5.0],
+            coefficient: [0.0003, -0.0002, 0.0001],
+        },
+    ];
+    let extension = Extension {
+        terms: heapless::Vec::from_slice(&terms).unwrap(),
+    };
+    modified().with_extension(extension).unwrap()
+}

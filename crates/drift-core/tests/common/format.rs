@@ -52,4 +52,8 @@ pub struct Case {
     pub samples: Vec<[u32; 7]>,
     /// Expected outputs: `[corrected x, y, z, bias x, y, z, flags x, y, z]` (floats as bits).
     pub expected: Vec<[u32; 9]>,
+    /// Auxiliary inputs per sample (floats as bits), for the extended model: when present, each
+    /// sample is corrected with `correct_with_aux`; when absent, with `correct`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub aux: Vec<[u32; 4]>,
 }
