@@ -6,13 +6,21 @@ use std::path::PathBuf;
 
 use drift_fit::diagnose::{diagnose, series, ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_fit::pipeline;
-use drift_recording::read_recording;
+use drift_recording::{read_recording, Segment, SeriesKind};
 use rayon::prelude::*;
 
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use crate::output::write_atomic;
 use crate::report::plots;
+
+/// One unit's activations, split for `--extend`.
+#[derive(Default)]
+struct UnitSegments {
+    calibration: Vec<Segment>,
+    training: Vec<Segment>,
+    validation: Vec<Segment>,
+}
 
 /// Options of `gyrodrift diagnose`.
 #[derive(Debug, clap::Args)]
@@ -26,6 +34,11 @@ pub struct Args {
     /// How many candidates to print per axis.
     #[arg(long, default_value_t = 5)]
     pub top: usize,
+    /// Close the loop: add the significant winners as the extended model's terms, fit their
+    /// coefficients on the field-like activations at the calibration set points (which the
+    /// diagnosis then leaves out), refit the tables, and report the error before and after.
+    #[arg(long)]
+    pub extend: bool,
 }
 
 /// The ranking as Markdown.
@@ -118,15 +131,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let files = pipeline::recording_files(&input.campaign)?;
     let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;
-    // Every activation the fit did not see: field sessions and non-calibration set points.
+    // Every activation the fit did not see: field sessions and non-calibration set points. With
+    // --extend, the field sessions at the calibration set points train the terms instead.
     let mut by_unit: BTreeMap<String, Vec<ActivationSeries>> = BTreeMap::new();
+    let mut kept: BTreeMap<String, UnitSegments> = BTreeMap::new();
     for (i, path) in files.iter().enumerate() {
         steps.update(
             "putting unseen activations on the diagnosis grid",
             i as u64,
             files.len() as u64,
         );
-        if pipeline::calibration_file(path, &options)? == Some(true) {
+        if !args.extend && pipeline::calibration_file(path, &options)? == Some(true) {
             continue;
         }
         let recording = read_recording(path)?;
@@ -137,12 +152,32 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         else {
             continue;
         };
+        let training = |s: &Segment| {
+            args.extend
+                && s.labels.series_kind == SeriesKind::Field
+                && options
+                    .calibration_set_points
+                    .iter()
+                    .any(|c| (c - s.labels.set_point_celsius).abs() < 1e-6)
+        };
         let prepared: Vec<ActivationSeries> = recording
             .segments
             .par_iter()
-            .filter(|s| !pipeline::calibration_segment(s, &options))
+            .filter(|s| !pipeline::calibration_segment(s, &options) && !training(s))
             .map(|s| series(fitted, s, &options.fit))
             .collect();
+        if args.extend {
+            let unit = kept.entry(recording.unit_id.clone()).or_default();
+            for segment in recording.segments {
+                if pipeline::calibration_segment(&segment, &options) {
+                    unit.calibration.push(segment);
+                } else if training(&segment) {
+                    unit.training.push(segment);
+                } else {
+                    unit.validation.push(segment);
+                }
+            }
+        }
         by_unit
             .entry(recording.unit_id.clone())
             .or_default()
@@ -197,6 +232,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     axis.axis, top.name
                 );
             }
+        }
+        if let (true, Some(segments), Some(fitted)) = (
+            args.extend,
+            kept.get(unit),
+            outcome.fitted.iter().find(|f| &f.unit_id == unit),
+        ) {
+            md.push_str(&super::extend::run(
+                unit,
+                &axes,
+                fitted,
+                &super::extend::Roles {
+                    calibration: segments.calibration.iter().collect(),
+                    training: segments.training.iter().collect(),
+                    validation: segments.validation.iter().collect(),
+                },
+                &options.fit,
+                &args.out,
+            )?);
         }
         json.push(serde_json::json!({ "unit": unit, "axes": axes }));
     }

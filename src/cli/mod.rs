@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 mod campaign_args;
 pub mod demo;
 pub mod diagnose;
+mod extend;
 pub mod fit;
 mod progress;
 pub mod report;

@@ -220,7 +220,7 @@ fn absorbed_share(activations: &[ActivationSeries], axis: usize, name: &str) -> 
 }
 
 /// Least squares `y ≈ X b` via normal equations (columns ≤ 6).
-fn least_squares(rows: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
+pub(crate) fn least_squares(rows: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
     let k = rows.first().map_or(0, Vec::len);
     let mut normal = nalgebra::DMatrix::<f64>::zeros(k, k);
     let mut rhs = nalgebra::DVector::<f64>::zeros(k);

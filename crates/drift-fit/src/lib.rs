@@ -13,6 +13,7 @@ pub mod curves;
 pub mod diagnose;
 pub mod error;
 pub mod evaluate;
+pub mod extend;
 pub mod fit;
 pub mod knots;
 pub mod lowpass;

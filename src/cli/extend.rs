@@ -1,0 +1,157 @@
+//! `gyrodrift diagnose --extend`: the diagnosis's significant winners become the extended model's
+//! extra terms; their coefficients are fitted on field-like activations at the calibration set
+//! points, the tables refitted, and the error before and after is reported on the activations the
+//! diagnosis saw (set points and sessions the fit never used).
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use drift_core::blob;
+use drift_fit::diagnose::AxisDiagnosis;
+use drift_fit::evaluate::switch_on_raw;
+use drift_fit::extend::{correct_with_terms, extend, Extended, TermPlan};
+use drift_fit::lowpass::centred_moving_average;
+use drift_fit::{FitSettings, FittedUnit};
+use drift_recording::Segment;
+
+use crate::output::write_atomic;
+
+/// Alternations of coefficient fit and table refit.
+const ROUNDS: usize = 2;
+
+/// Per axis, (max − min, RMS) of the 1-s mean of the corrected rate.
+type Metrics = [(f64, f64); 3];
+
+/// One activation's metrics with the paper's model and with the extended one.
+type BeforeAfter = (Metrics, Metrics);
+
+/// One unit's activations by role.
+pub struct Roles<'a> {
+    /// Protocol activations at the calibration set points (the tables are fitted on these).
+    pub calibration: Vec<&'a Segment>,
+    /// Field-like activations at the calibration set points (the terms' coefficients).
+    pub training: Vec<&'a Segment>,
+    /// Everything else: what the diagnosis saw and the before/after is measured on.
+    pub validation: Vec<&'a Segment>,
+}
+
+/// (max − min, RMS) of the 1-s mean of each axis.
+fn metric(rates: &[Vec<f32>; 3], window: usize) -> Metrics {
+    std::array::from_fn(|a| {
+        let low = centred_moving_average(&rates[a], window);
+        let (lo, hi) = low
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
+        let rms = (low.iter().map(|v| v * v).sum::<f64>() / low.len().max(1) as f64).sqrt();
+        (hi - lo, rms)
+    })
+}
+
+/// Fits the extended model of one unit and writes its tables and the before/after table.
+/// Returns the Markdown section.
+pub fn run(
+    unit: &str,
+    axes: &[AxisDiagnosis; 3],
+    base: &FittedUnit,
+    roles: &Roles<'_>,
+    settings: &FitSettings,
+    out: &Path,
+) -> anyhow::Result<String> {
+    let Roles {
+        calibration,
+        training,
+        validation,
+    } = roles;
+    let mut md = format!("## Extended model of unit {unit}\n\n");
+    let plan = TermPlan::choose(axes);
+    if plan.terms.is_empty() {
+        md.push_str("Nothing significant maps to a term the firmware can compute: the paper's model is kept unchanged.\n\n");
+        return Ok(md);
+    }
+    anyhow::ensure!(
+        !training.is_empty(),
+        "unit {unit}: --extend needs field-like activations at the calibration set points to fit the terms' coefficients on (none found)"
+    );
+    let Extended { tables, .. } = extend(base, &plan, calibration, training, settings, ROUNDS)?;
+    let _ = writeln!(
+        md,
+        "Terms (coefficients fitted on {} field-like activations at the calibration set points, tables refitted on {} calibration activations, {ROUNDS} rounds):\n",
+        training.len(),
+        calibration.len()
+    );
+    md.push_str("| term | from candidate | centre X, Y, Z | coefficient X, Y, Z (°/s per unit) |\n|---|---|---|---|\n");
+    for (term, chosen) in tables.extension.terms.iter().zip(&plan.terms) {
+        let _ = writeln!(
+            md,
+            "| {:?} | {} | {:.4}, {:.4}, {:.4} | {:.3e}, {:.3e}, {:.3e} |",
+            term.term,
+            chosen.candidate,
+            term.centre[0],
+            term.centre[1],
+            term.centre[2],
+            term.coefficient[0],
+            term.coefficient[1],
+            term.coefficient[2]
+        );
+    }
+    if !plan.aux_inputs.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nThe firmware passes these recorded channels as auxiliary inputs 0.., in order: {}.",
+            plan.aux_inputs.join(", ")
+        );
+    }
+
+    // Before/after on the activations the diagnosis saw, per set point and axis.
+    let window = settings.lowpass_window_samples;
+    let mut by_set_point: BTreeMap<String, Vec<BeforeAfter>> = BTreeMap::new();
+    for segment in validation {
+        let on = switch_on_raw(segment, settings);
+        let before = metric(
+            &correct_with_terms(&base.modified, &plan, segment, on),
+            window,
+        );
+        let after = metric(&correct_with_terms(&tables, &plan, segment, on), window);
+        let key = format!(
+            "{:+.1} °C {}",
+            segment.labels.set_point_celsius,
+            segment.labels.series_kind.as_str()
+        );
+        by_set_point.entry(key).or_default().push((before, after));
+    }
+    md.push_str("\n| set point | axis | activations | RMS before | RMS after | drift before | drift after |\n|---|---|---:|---:|---:|---:|---:|\n");
+    for (key, results) in &by_set_point {
+        for (a, axis) in ["X", "Y", "Z"].iter().enumerate() {
+            let n = results.len() as f64;
+            let mean = |f: &dyn Fn(&BeforeAfter) -> f64| results.iter().map(f).sum::<f64>() / n;
+            let _ = writeln!(
+                md,
+                "| {key} | {axis} | {} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                results.len(),
+                mean(&|r| r.0[a].1),
+                mean(&|r| r.1[a].1),
+                mean(&|r| r.0[a].0),
+                mean(&|r| r.1[a].0),
+            );
+        }
+    }
+    md.push_str("\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). Compare with the noise floor of `gyrodrift report --noise-floor`.\n\n");
+
+    let mut image = vec![0; blob::encoded_len(&tables)?];
+    blob::encode(&tables, &mut image)?;
+    write_atomic(&out.join(format!("extended-{unit}.bin")), &image)?;
+    write_atomic(
+        &out.join(format!("extended-{unit}.json")),
+        serde_json::to_string_pretty(&tables)?.as_bytes(),
+    )?;
+    let _ = writeln!(
+        md,
+        "Firmware image: `extended-{unit}.bin` ({} bytes, format version {}); tables as JSON: `extended-{unit}.json`.\n",
+        image.len(),
+        blob::FORMAT_VERSION
+    );
+    Ok(md)
+}
