@@ -6,6 +6,8 @@ mod campaign_args;
 pub mod demo;
 pub mod diagnose;
 pub mod fit;
+pub mod import;
+mod measured;
 mod progress;
 pub mod report;
 pub mod simulate;
@@ -32,6 +34,8 @@ pub enum Command {
     Report(report::Args),
     /// Rank what explains the residual the paper's model leaves.
     Diagnose(diagnose::Args),
+    /// Convert measured data (CSV) into a recording the other commands read.
+    Import(import::Args),
 }
 
 /// Runs one parsed command line.
@@ -42,5 +46,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fit(args) => fit::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
+        Command::Import(args) => import::run(&args),
     }
 }

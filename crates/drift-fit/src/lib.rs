@@ -16,6 +16,7 @@ pub mod evaluate;
 pub mod fit;
 pub mod knots;
 pub mod lowpass;
+pub mod measured;
 pub mod pipeline;
 pub mod settings;
 pub mod summary;
