@@ -20,13 +20,13 @@ fn pm(e: Option<Estimate>, scale: f64, digits: usize) -> String {
     })
 }
 
-/// The Allan deviation at the τ closest to `tau` (within a factor of √2).
-fn adev_at(curve: &[(f64, f64)], tau: f64) -> Option<f64> {
+/// The Allan deviation at the τ closest to `tau` (within a factor of √2): (τ, σ).
+fn adev_at(curve: &[(f64, f64)], tau: f64) -> Option<(f64, f64)> {
     curve
         .iter()
         .filter(|(t, _)| (t / tau).ln().abs() <= std::f64::consts::LN_2 / 2.0 + 1e-9)
         .min_by(|a, b| (a.0 / tau).ln().abs().total_cmp(&(b.0 / tau).ln().abs()))
-        .map(|p| p.1)
+        .copied()
 }
 
 fn unit_section(md: &mut String, c: &Characterisation) -> std::fmt::Result {
@@ -79,19 +79,19 @@ fn unit_section(md: &mut String, c: &Characterisation) -> std::fmt::Result {
     }
 
     writeln!(md, "\n## Noise floor\n")?;
-    writeln!(md, "Overlapping Allan deviation of the rate on the recording's grid, from the longest activation; the minimum is over every activation's curve (bias instability ≈ minimum / 0.664). Sample σ and the 1-s mean spread are means over activations. The grid's linear interpolation (resampled data) lowers the deviation at τ of a few samples.\n")?;
+    writeln!(md, "Overlapping Allan deviation of the rate on the recording's grid at octave τ (the τ used in brackets), from the longest activation; the minimum is over every activation's curve at τ up to a tenth of the activation, i.e. at least ten independent averages (bias instability ≈ minimum / 0.664). Sample σ and the 1-s mean spread are means over activations. The grid's linear interpolation (resampled data) lowers the deviation at τ of a few samples.\n")?;
     let longest = c
         .activations
         .iter()
         .max_by(|a, b| a.duration_s.total_cmp(&b.duration_s));
-    writeln!(md, "| axis | sample σ, °/s | 1-s mean spread, °/s | σ(0.1 s), °/s | σ(1 s), °/s | σ(10 s), °/s | σ(100 s), °/s | minimum σ, °/s (at τ, s) |")?;
+    writeln!(md, "| axis | sample σ, °/s | 1-s mean spread, °/s | σ at τ ≈ 0.1 s, °/s | τ ≈ 1 s | τ ≈ 10 s | τ ≈ 100 s | minimum σ, °/s (at τ, s) |")?;
     writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|")?;
     let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
     for (k, axis) in c.axes.iter().enumerate() {
         let at = |tau: f64| {
             longest
                 .and_then(|a| adev_at(&a.axes[k].allan, tau))
-                .map_or("–".into(), |v| format!("{v:.5}"))
+                .map_or("–".into(), |(t, v)| format!("{v:.5} ({t:.2} s)"))
         };
         writeln!(
             md,

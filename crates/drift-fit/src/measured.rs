@@ -391,7 +391,8 @@ pub struct AxisSummary {
     pub between_slope: Option<Estimate>,
     /// Linear temperature correction, leave one activation out.
     pub correction: Option<Correction>,
-    /// Lowest Allan deviation over every activation's curve, and its τ: (τ in s, σ in °/s).
+    /// Lowest Allan deviation over every activation's curve at τ up to a tenth of the
+    /// activation (at least ten independent averages), and its τ: (τ in s, σ in °/s).
     pub allan_minimum: Option<(f64, f64)>,
 }
 
@@ -556,7 +557,14 @@ fn axis_summary(axis: usize, all: &[Means], activations: &[Activation]) -> AxisS
     });
     let allan_minimum = activations
         .iter()
-        .flat_map(|a| a.axes[axis].allan.iter().copied())
+        .flat_map(|a| {
+            let longest_tau = a.duration_s / 10.0;
+            a.axes[axis]
+                .allan
+                .iter()
+                .copied()
+                .filter(move |(t, _)| *t <= longest_tau)
+        })
         .filter(|(_, s)| s.is_finite())
         .min_by(|a, b| a.1.total_cmp(&b.1));
     AxisSummary {
