@@ -145,8 +145,8 @@ fn a_csv_with_irregular_ms_times_and_rad_per_s_becomes_a_campaign_the_tools_read
         for i in [0, n / 2, n - 1] {
             let celsius = segment.temperature_celsius(0, i).unwrap();
             let c0 = [24.0, 24.5][k];
-            for axis in 0..3 {
-                let expected = (RAD_PER_S[axis] + 0.001 * (celsius - c0)) * to_dps;
+            for (axis, rad_per_s) in RAD_PER_S.iter().enumerate() {
+                let expected = (rad_per_s + 0.001 * (celsius - c0)) * to_dps;
                 let got = f64::from(segment.rate_dps[axis][i]);
                 // The temperature is stored in 1/200 °C: its rounding bounds the comparison.
                 let tolerance = 0.001 * to_dps * 0.5 / RAW_PER_CELSIUS + 1e-5;
