@@ -130,7 +130,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let options = input.options(&[], false)?;
     let files = pipeline::recording_files(&input.campaign)?;
     let steps = Steps::new(input.quiet);
-    let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;
+    let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
+        .map_err(|e| super::measured::explain(e, &files))?;
     // Every activation the fit did not see: field sessions and non-calibration set points. With
     // --extend, the field sessions at the calibration set points train the terms instead.
     let mut by_unit: BTreeMap<String, Vec<ActivationSeries>> = BTreeMap::new();

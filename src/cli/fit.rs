@@ -77,7 +77,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let files = pipeline::recording_files(&args.input.campaign)?;
     let options = args.input.options(&[], false)?;
     let steps = Steps::new(args.input.quiet);
-    let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))?;
+    let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
+        .map_err(|e| super::measured::explain(e, &files))?;
     steps.finish();
     write_tables(&args.out, &outcome.fitted)?;
     let seconds = |step: &str| {

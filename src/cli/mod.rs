@@ -7,6 +7,8 @@ pub mod demo;
 pub mod diagnose;
 mod extend;
 pub mod fit;
+pub mod import;
+mod measured;
 mod progress;
 pub mod report;
 pub mod simulate;
@@ -33,6 +35,8 @@ pub enum Command {
     Report(report::Args),
     /// Rank what explains the residual the paper's model leaves.
     Diagnose(diagnose::Args),
+    /// Convert measured data (CSV) into a recording the other commands read.
+    Import(import::Args),
 }
 
 /// Runs one parsed command line.
@@ -43,5 +47,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fit(args) => fit::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
+        Command::Import(args) => import::run(&args),
     }
 }

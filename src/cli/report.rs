@@ -6,8 +6,11 @@ use drift_fit::summary::Split;
 
 use super::campaign_args::CampaignArgs;
 use super::fit::write_tables;
+use super::measured;
 use super::progress::Steps;
+use crate::report::measured::write_measured_report;
 use crate::report::{write_report, ReportInput};
+use drift_fit::pipeline::PipelineError;
 use drift_fit::pipeline::{self, Options, Outcome};
 
 /// Options of `gyrodrift report`.
@@ -113,15 +116,61 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         input.calibration,
         args.validation
     )];
-    let (path, outcome) = make(
+    let made = make(
         &input.campaign,
         args.noise_floor.as_deref(),
         &options,
         &args.out,
-        provenance,
+        provenance.clone(),
         input.quiet,
-    )?;
-    print_headline(&outcome);
-    println!("report: {}", path.display());
+    );
+    let error = match made {
+        Ok((path, outcome)) => {
+            print_headline(&outcome);
+            println!("report: {}", path.display());
+            return Ok(());
+        }
+        Err(error) => error,
+    };
+    // Data the paper's method cannot be fitted on: say why, and report what it does tell.
+    if !error
+        .downcast_ref::<PipelineError>()
+        .is_some_and(measured::may_be_unfittable)
+    {
+        return Err(error);
+    }
+    let files = pipeline::recording_files(&input.campaign)?;
+    let unfittable = measured::unfittable(&files)?;
+    if unfittable.is_empty() {
+        return Err(error);
+    }
+    for unit in &unfittable {
+        println!("{unit}");
+    }
+    let units = measured::characterise_files(&files)?;
+    let path = write_measured_report(&args.out, &units, &provenance, &error.to_string())?;
+    for c in &units {
+        for axis in &c.axes {
+            let correction = axis.correction.map_or(String::new(), |r| {
+                format!(
+                    "; residual RMS {:.5} → {:.5} °/s after a linear temperature correction (leave one activation out)",
+                    r.rms_before_dps, r.rms_after_dps
+                )
+            });
+            println!(
+                "{} {}: temperature slope {} (°/s)/°C{correction}",
+                c.unit_id,
+                axis.axis,
+                axis.within_slope.map_or("–".into(), |e| format!(
+                    "{:+.4} ± {:.4}",
+                    e.value, e.standard_error
+                ))
+            );
+        }
+    }
+    println!(
+        "report (measured data, no tables fitted): {}",
+        path.display()
+    );
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! results.
 
 mod figures;
+pub mod measured;
 pub mod plots;
 mod tables;
 

@@ -17,6 +17,7 @@ pub mod extend;
 pub mod fit;
 pub mod knots;
 pub mod lowpass;
+pub mod measured;
 pub mod pipeline;
 pub mod settings;
 pub mod summary;

@@ -6,7 +6,10 @@
 //! [`gx_dps`, `gy_dps`, `gz_dps`], temperatures in °C per axis [`temp_c` for all three: a
 //! single die sensor], and an optional activation column [`segment_id`]: consecutive rows with
 //! the same value are one activation. Temperatures become raw readings at 200 raw/°C (the
-//! recording format's scale), rounded. Any other column is ignored. The defaults read the
+//! recording format's scale), rounded. Optional auxiliary columns (accelerometer X, Y, Z in g,
+//! supply voltage in V) go to the format's auxiliary channels at its fixed 100 Hz
+//! ([`crate::AUX_RATE_HZ`]); the format has no other auxiliary channels, so any other column is
+//! ignored. Rates may be given in rad/s and times in ms ([`RateUnit`], [`TimeUnit`]). The defaults read the
 //! MPU6050 static recordings of `sunsided/sensor-fusion` (`../shared/data/measured/`).
 //!
 //! Timing ([`CsvTiming`]): `Strict` takes every row as one sample of a fixed-rate stream: times
@@ -16,9 +19,10 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+use crate::layout::AUX_RATE_HZ;
 use crate::read::Recording;
 use crate::segment::{
-    Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS, TEMPERATURE_MISSING_RAW,
+    AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS, TEMPERATURE_MISSING_RAW,
 };
 
 /// Which CSV column holds what (header names).
@@ -33,6 +37,11 @@ pub struct CsvColumns {
     /// Activation id: consecutive rows with the same value form one activation. `None`: the whole
     /// file is one activation.
     pub segment: Option<String>,
+    /// Accelerometer X, Y, Z, g → the `/aux/accel` channel (`accel_x`, `accel_y`, `accel_z`).
+    /// `None`: no accelerometer.
+    pub accel_g: Option<[String; 3]>,
+    /// Supply voltage, V → the `/aux/supply_voltage` channel. `None`: not recorded.
+    pub supply_voltage: Option<String>,
 }
 
 impl Default for CsvColumns {
@@ -43,6 +52,66 @@ impl Default for CsvColumns {
             rate_dps: [s("gx_dps"), s("gy_dps"), s("gz_dps")],
             temperature_celsius: [s("temp_c"), s("temp_c"), s("temp_c")],
             segment: Some(s("segment_id")),
+            accel_g: None,
+            supply_voltage: None,
+        }
+    }
+}
+
+/// Unit of the rate columns (segments hold °/s).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RateUnit {
+    /// Degrees per second.
+    #[default]
+    DegPerSec,
+    /// Radians per second (multiplied by 180/π).
+    RadPerSec,
+}
+
+impl RateUnit {
+    /// Parses `deg/s` (or `dps`) and `rad/s`.
+    pub fn parse(text: &str) -> Option<Self> {
+        match text {
+            "deg/s" | "dps" => Some(Self::DegPerSec),
+            "rad/s" => Some(Self::RadPerSec),
+            _ => None,
+        }
+    }
+
+    /// Factor to °/s.
+    pub fn to_dps(self) -> f64 {
+        match self {
+            Self::DegPerSec => 1.0,
+            Self::RadPerSec => 180.0 / std::f64::consts::PI,
+        }
+    }
+}
+
+/// Unit of the time column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TimeUnit {
+    /// Seconds.
+    #[default]
+    Seconds,
+    /// Milliseconds (divided by 1000).
+    Milliseconds,
+}
+
+impl TimeUnit {
+    /// Parses `s` and `ms`.
+    pub fn parse(text: &str) -> Option<Self> {
+        match text {
+            "s" => Some(Self::Seconds),
+            "ms" => Some(Self::Milliseconds),
+            _ => None,
+        }
+    }
+
+    /// Factor to seconds.
+    pub fn to_seconds(self) -> f64 {
+        match self {
+            Self::Seconds => 1.0,
+            Self::Milliseconds => 1e-3,
         }
     }
 }
@@ -80,6 +149,10 @@ pub struct CsvOptions {
     /// Accept an empty or NaN temperature cell as a sensor dropout
     /// ([`TEMPERATURE_MISSING_RAW`]); otherwise it is an error. Rates never accept one.
     pub temperature_dropouts: bool,
+    /// Unit of the rate columns.
+    pub rate_unit: RateUnit,
+    /// Unit of the time column.
+    pub time_unit: TimeUnit,
 }
 
 impl Default for CsvOptions {
@@ -92,6 +165,8 @@ impl Default for CsvOptions {
             set_point_celsius: None,
             series_kind: SeriesKind::Protocol,
             temperature_dropouts: false,
+            rate_unit: RateUnit::DegPerSec,
+            time_unit: TimeUnit::Seconds,
         }
     }
 }
@@ -199,6 +274,8 @@ struct Rows {
     time_s: Vec<f64>,
     rate: [Vec<f64>; 3],
     celsius: [Vec<f64>; 3],
+    /// Auxiliary columns, in the order of [`Columns::aux`].
+    aux: Vec<Vec<f64>>,
     /// (row, line) of every row, for errors found after reading.
     at: Vec<(u64, u64)>,
 }
@@ -208,6 +285,8 @@ struct Columns {
     rate: [usize; 3],
     temperature: [usize; 3],
     segment: Option<usize>,
+    /// Auxiliary columns: (index, column name, channel name, unit).
+    aux: Vec<(usize, String, &'static str, &'static str)>,
 }
 
 fn read_csv_from<R: Read>(
@@ -261,7 +340,28 @@ fn read_csv_from<R: Read>(
             find(&c.temperature_celsius[2])?,
         ],
         segment: c.segment.as_deref().map(find).transpose()?,
+        aux: {
+            let mut aux = Vec::new();
+            if let Some(names) = &c.accel_g {
+                for (name, channel) in names.iter().zip(["accel_x", "accel_y", "accel_z"]) {
+                    aux.push((find(name)?, name.clone(), channel, "g"));
+                }
+            }
+            if let Some(name) = &c.supply_voltage {
+                aux.push((find(name)?, name.clone(), "supply_voltage", "V"));
+            }
+            aux
+        },
     };
+    if !columns.aux.is_empty() && fs % AUX_RATE_HZ != 0 {
+        return Err(CsvError::Options {
+            path: path.to_path_buf(),
+            field: "sample_rate_hz",
+            reason: format!(
+                "auxiliary columns are recorded at {AUX_RATE_HZ} Hz, which needs a sample rate that is a multiple of it, got {fs} Hz"
+            ),
+        });
+    }
     let mut done: Vec<Rows> = Vec::new();
     let mut current: Option<Rows> = None;
     let mut record = csv::StringRecord::new();
@@ -299,6 +399,7 @@ fn read_csv_from<R: Read>(
             }
             current = Some(Rows {
                 id,
+                aux: vec![Vec::new(); columns.aux.len()],
                 ..Rows::default()
             });
         }
@@ -310,7 +411,7 @@ fn read_csv_from<R: Read>(
             text.parse::<f64>()
                 .map_err(|_| bad(name, format!("`{text}` is not a number")))
         };
-        let time = number(columns.time, &c.time_s)?;
+        let time = number(columns.time, &c.time_s)? * options.time_unit.to_seconds();
         if !time.is_finite() {
             return Err(bad(&c.time_s, format!("time is {time}")));
         }
@@ -329,7 +430,7 @@ fn read_csv_from<R: Read>(
             }
         }
         for axis in 0..3 {
-            let rate = number(columns.rate[axis], &c.rate_dps[axis])?;
+            let rate = number(columns.rate[axis], &c.rate_dps[axis])? * options.rate_unit.to_dps();
             if !rate.is_finite() {
                 return Err(bad(&c.rate_dps[axis], format!("non-finite rate {rate}")));
             }
@@ -362,6 +463,16 @@ fn read_csv_from<R: Read>(
             }
             rows.celsius[axis].push(celsius);
         }
+        for (k, (index, name, _, unit)) in columns.aux.iter().enumerate() {
+            let value = number(*index, name)?;
+            if !(value.is_finite() && (value as f32).is_finite()) {
+                return Err(bad(
+                    name,
+                    format!("auxiliary value {value} {unit} is not a finite f32"),
+                ));
+            }
+            rows.aux[k].push(value);
+        }
         rows.time_s.push(time);
         rows.at.push((row, line));
     }
@@ -374,8 +485,13 @@ fn read_csv_from<R: Read>(
     let mut segments = done
         .iter()
         .enumerate()
-        .map(|(k, rows)| to_segment(path, rows, k, options))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|(k, rows)| {
+            let mut segment = to_segment(path, rows, k, options)?;
+            add_aux(&mut segment, rows, &columns, options);
+            Ok(segment)
+        })
+        .collect::<Result<Vec<_>, CsvError>>()?;
+    let timing = TimingStats::of(&done, f64::from(fs));
     // Activations whose clock restarts (each from t = 0, as in the MPU6050 file) are laid out one
     // second apart, so the recording's log times increase and it can be written as MCAP.
     let period_ns = 1_000_000_000 / u64::from(fs);
@@ -394,6 +510,29 @@ fn read_csv_from<R: Read>(
         ("series_kind", options.series_kind.as_str().to_owned()),
         ("temperature_raw_per_celsius", format!("{RAW_PER_CELSIUS}")),
         ("source", format!("csv: {}", path.display())),
+        ("csv_rows", timing.rows.to_string()),
+        (
+            "csv_longest_step_s",
+            format!("{:.6}", timing.longest_step_s),
+        ),
+        ("csv_steps_over_two_periods", timing.long_steps.to_string()),
+        (
+            "csv_time_in_long_steps_s",
+            format!("{:.3}", timing.long_steps_s),
+        ),
+        (
+            "csv_smallest_temperature_step_celsius",
+            format!("{:.6}", timing.temperature_step_celsius),
+        ),
+        (
+            "csv_timing",
+            match options.timing {
+                CsvTiming::Strict => "strict".to_owned(),
+                CsvTiming::Resample { max_gap_s } => {
+                    format!("resampled linearly onto {fs} Hz, steps up to {max_gap_s} s")
+                }
+            },
+        ),
     ]
     .into_iter()
     .chain(
@@ -410,6 +549,100 @@ fn read_csv_from<R: Read>(
         sample_rate_hz: fs,
         segments,
     })
+}
+
+/// How regular the rows' times were (what resampling bridged), over all activations.
+struct TimingStats {
+    rows: usize,
+    longest_step_s: f64,
+    /// Steps between consecutive rows longer than two sample periods.
+    long_steps: usize,
+    /// Time covered by those steps, s.
+    long_steps_s: f64,
+    /// Smallest non-zero change of the X temperature between consecutive rows (the sensor's
+    /// step as logged), °C; infinite if it never changes.
+    temperature_step_celsius: f64,
+}
+
+impl TimingStats {
+    fn of(activations: &[Rows], fs: f64) -> Self {
+        let mut stats = Self {
+            rows: 0,
+            longest_step_s: 0.0,
+            long_steps: 0,
+            long_steps_s: 0.0,
+            temperature_step_celsius: f64::INFINITY,
+        };
+        for rows in activations {
+            stats.rows += rows.time_s.len();
+            for w in rows.time_s.windows(2) {
+                let step = w[1] - w[0];
+                stats.longest_step_s = stats.longest_step_s.max(step);
+                if step > 2.0 / fs {
+                    stats.long_steps += 1;
+                    stats.long_steps_s += step;
+                }
+            }
+            for w in rows.celsius[0].windows(2) {
+                let change = (w[1] - w[0]).abs();
+                if change > 0.0 {
+                    stats.temperature_step_celsius = stats.temperature_step_celsius.min(change);
+                }
+            }
+        }
+        stats
+    }
+}
+
+/// Linear interpolation of `values` (at `times`, strictly increasing) at `t`, held at the ends;
+/// `j` is the search position, advanced monotonically for increasing `t`.
+fn interpolate(times: &[f64], values: &[f64], t: f64, j: &mut usize) -> f64 {
+    while *j + 2 < times.len() && times[*j + 1] <= t {
+        *j += 1;
+    }
+    let a = values[*j];
+    let (Some(&tb), Some(&b)) = (times.get(*j + 1), values.get(*j + 1)) else {
+        return a;
+    };
+    let ta = times[*j];
+    let w = if tb > ta {
+        ((t - ta) / (tb - ta)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a + (b - a) * w
+}
+
+/// Puts the auxiliary columns on the format's fixed auxiliary grid (sample `j` at `j / 100` s
+/// after switch-on, as many as the activation's gyro samples cover): every `fs / 100`-th row for
+/// `Strict` timing, interpolated like the rates for `Resample`.
+fn add_aux(segment: &mut Segment, rows: &Rows, columns: &Columns, options: &CsvOptions) {
+    let every = (options.sample_rate_hz / AUX_RATE_HZ).max(1) as usize;
+    let count = segment.len().div_ceil(every);
+    let t0 = rows.time_s.first().copied().unwrap_or_default();
+    for (k, (_, _, channel, unit)) in columns.aux.iter().enumerate() {
+        let source = &rows.aux[k];
+        let values: Vec<f32> = match options.timing {
+            CsvTiming::Strict => source.iter().step_by(every).map(|&v| v as f32).collect(),
+            CsvTiming::Resample { .. } => {
+                let mut j = 0;
+                (0..count)
+                    .map(|i| {
+                        let t = t0 + i as f64 / f64::from(AUX_RATE_HZ);
+                        interpolate(&rows.time_s, source, t, &mut j) as f32
+                    })
+                    .collect()
+            }
+        };
+        segment.aux.insert(
+            (*channel).to_owned(),
+            AuxChannel {
+                unit: (*unit).to_owned(),
+                sample_rate_hz: AUX_RATE_HZ,
+                values,
+            },
+        );
+    }
 }
 
 fn row_error(path: &Path, e: &csv::Error, row: u64, line: u64) -> CsvError {

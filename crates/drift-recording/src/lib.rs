@@ -19,7 +19,9 @@ mod segment;
 mod write;
 pub mod writer;
 
-pub use csv_file::{read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming};
+pub use csv_file::{
+    read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming, RateUnit, TimeUnit,
+};
 pub use error::{ReadError, WriteError};
 pub use layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 pub use messages::RECORD_LENGTH_LIMIT;

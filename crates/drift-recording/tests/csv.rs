@@ -75,6 +75,7 @@ fn a_custom_column_mapping_with_one_sensor_per_axis() {
             rate_dps: ["wx".into(), "wy".into(), "wz".into()],
             temperature_celsius: ["tx".into(), "ty".into(), "tz".into()],
             segment: None,
+            ..CsvColumns::default()
         },
         set_point_celsius: Some(25.0),
         ..CsvOptions::default()
