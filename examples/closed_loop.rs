@@ -349,37 +349,39 @@ fn main() -> anyhow::Result<()> {
     let work = tempfile::tempdir()?;
     let settings = FitSettings::default();
     let mut rows = Vec::new();
+    println!("| effect | seed | axis | top candidate | significant | terms added | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift |");
+    println!("|---|---:|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|");
     for effect in &effects {
         for seed in first_seed..first_seed + seeds {
             eprintln!("{effect}, seed {seed} …");
-            rows.extend(run(effect, seed, work.path(), &settings, &size)?);
+            let new = run(effect, seed, work.path(), &settings, &size)?;
+            // Printed as each run ends: a long experiment keeps what it has measured.
+            for r in &new {
+                let cut = (r.before.1 - r.floor.1) / (r.after.1 - r.floor.1).max(1e-9);
+                println!(
+                    "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.1}× | {:.4} | {:.4} | {:.4} |",
+                    r.effect,
+                    r.seed,
+                    r.axis,
+                    r.top,
+                    if r.significant { "yes" } else { "no" },
+                    r.terms,
+                    r.before.1,
+                    r.after.1,
+                    r.floor.1,
+                    cut,
+                    r.before.0,
+                    r.after.0,
+                    r.floor.0,
+                );
+            }
+            rows.extend(new);
             // Recordings of finished runs are not needed again.
             for suffix in ["", "-floor"] {
                 let _ =
                     std::fs::remove_dir_all(work.path().join(format!("{effect}-{seed}{suffix}")));
             }
         }
-    }
-    println!("| effect | seed | axis | top candidate | significant | terms added | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift |");
-    println!("|---|---:|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|");
-    for r in &rows {
-        let cut = (r.before.1 - r.floor.1) / (r.after.1 - r.floor.1).max(1e-9);
-        println!(
-            "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.1}× | {:.4} | {:.4} | {:.4} |",
-            r.effect,
-            r.seed,
-            r.axis,
-            r.top,
-            if r.significant { "yes" } else { "no" },
-            r.terms,
-            r.before.1,
-            r.after.1,
-            r.floor.1,
-            cut,
-            r.before.0,
-            r.after.0,
-            r.floor.0,
-        );
     }
     let mut null: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.effect == "none") {

@@ -222,9 +222,15 @@ fn absorbed_share(activations: &[ActivationSeries], axis: usize, name: &str) -> 
 /// Least squares `y ≈ X b` via normal equations (columns ≤ 6).
 pub(crate) fn least_squares(rows: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
     let k = rows.first().map_or(0, Vec::len);
+    if k == 0 {
+        return Vec::new();
+    }
     let mut normal = nalgebra::DMatrix::<f64>::zeros(k, k);
     let mut rhs = nalgebra::DVector::<f64>::zeros(k);
-    for (row, &t) in rows.iter().zip(y) {
+    // A non-finite point (a sensor fault the corrector flagged) says nothing about the effect, and
+    // one NaN would poison the whole solve: it is left out.
+    let finite = |row: &Vec<f64>, t: f64| t.is_finite() && row.iter().all(|v| v.is_finite());
+    for (row, &t) in rows.iter().zip(y).filter(|(row, t)| finite(row, **t)) {
         for r in 0..k {
             rhs[r] += row[r] * t;
             for c in 0..k {
@@ -454,4 +460,24 @@ pub fn diagnose_axis(
 /// Diagnoses all three axes.
 pub fn diagnose(activations: &[ActivationSeries]) -> [AxisDiagnosis; 3] {
     [0, 1, 2].map(|axis| diagnose_axis(activations, axis, 5, 0.05))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::least_squares;
+
+    #[test]
+    fn least_squares_leaves_out_non_finite_points() {
+        // y = 2 + 3x, one NaN residual and one infinite candidate among them.
+        let mut rows: Vec<Vec<f64>> = (0..10).map(|i| vec![1.0, f64::from(i)]).collect();
+        let mut y: Vec<f64> = (0..10).map(|i| 2.0 + 3.0 * f64::from(i)).collect();
+        y[3] = f64::NAN;
+        rows[5][1] = f64::INFINITY;
+        let b = least_squares(&rows, &y);
+        assert!(
+            (b[0] - 2.0).abs() < 1e-6 && (b[1] - 3.0).abs() < 1e-6,
+            "{b:?}"
+        );
+        assert!(least_squares(&[], &[]).is_empty());
+    }
 }

@@ -357,3 +357,82 @@ pub fn extend(
         refitted,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::CandidateScore;
+
+    fn axis(name: &'static str, ranking: &[(&str, bool)]) -> AxisDiagnosis {
+        AxisDiagnosis {
+            axis: name,
+            activations: 10,
+            residual_rms_dps: 0.01,
+            ranking: ranking
+                .iter()
+                .map(|(candidate, significant)| CandidateScore {
+                    name: (*candidate).to_owned(),
+                    explained: 0.5,
+                    p_value: 0.001,
+                    significant: *significant,
+                    coefficient: 0.01,
+                    absorbed_by_model: 0.0,
+                    level: "within activations",
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn significant_candidates_become_terms_once_best_ranks_first() {
+        let axes = [
+            axis(
+                "X",
+                &[("temperature rate X", true), ("aux:supply_voltage", true)],
+            ),
+            axis(
+                "Y",
+                &[
+                    ("temperature rate Y", true),
+                    ("campaign time (ageing)", true),
+                ],
+            ),
+            axis("Z", &[("rise X", true), ("rise² Z", false)]),
+        ];
+        let plan = TermPlan::choose(&axes);
+        let terms: Vec<Term> = plan.terms.iter().map(|t| t.term).collect();
+        assert_eq!(
+            terms,
+            [
+                Term::TemperatureRate {
+                    time_constant_ms: RATE_TIME_CONSTANT_MS
+                },
+                Term::AxisRise { axis: 0 },
+                Term::Aux { input: 0 },
+            ]
+        );
+        assert_eq!(plan.aux_inputs, ["supply_voltage"]);
+        // Ageing and insignificant candidates never become terms.
+        assert!(plan.terms.iter().all(|t| !t.candidate.contains("ageing")));
+    }
+
+    #[test]
+    fn nothing_significant_means_no_terms_and_at_most_four() {
+        let quiet = [axis("X", &[("temperature rate X", false)])];
+        assert!(TermPlan::choose(&quiet).terms.is_empty());
+        let many = [axis(
+            "X",
+            &[
+                ("aux:a", true),
+                ("aux:b", true),
+                ("aux:c", true),
+                ("aux:d", true),
+                ("aux:e", true),
+                ("rise² X", true),
+            ],
+        )];
+        let plan = TermPlan::choose(&many);
+        assert_eq!(plan.terms.len(), MAX_TERMS);
+        assert_eq!(plan.aux_inputs, ["a", "b", "c", "d"]);
+    }
+}
