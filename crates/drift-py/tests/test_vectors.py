@@ -82,7 +82,9 @@ def test_per_sample_aux_as_python_floats(cases: list[Case], models: dict[str, Mo
 def test_aux_none_is_correct_without_aux(cases: list[Case], models: dict[str, Model]) -> None:
     """`aux=None` is drift-core's `correct`: the same as NaN auxiliary inputs, flagged."""
     case = next(c for c in cases if c.aux is not None)
-    without = powered_corrector(models[case.model], case).correct_batch(case.times, case.rate, case.temperature)
+    without = powered_corrector(models[case.model], case).correct_batch(
+        case.times, case.rate, case.temperature
+    )
     nan_aux = np.full((len(case.times), 4), np.nan, np.float32)
     with_nan = powered_corrector(models[case.model], case).correct_batch(
         case.times, case.rate, case.temperature, aux=nan_aux
@@ -155,7 +157,10 @@ def test_a_case_split_into_batches_continues_the_activation(
         corrector = powered_corrector(models[case.model], case)
         parts = [
             corrector.correct_batch(
-                case.times[s], case.rate[s], case.temperature[s], aux=None if case.aux is None else case.aux[s]
+                case.times[s],
+                case.rate[s],
+                case.temperature[s],
+                aux=None if case.aux is None else case.aux[s],
             )
             for s in (slice(0, 1), slice(1, 7), slice(7, None))
             if len(case.times[s])
