@@ -49,8 +49,8 @@ def test_extension_lists_the_terms_as_in_the_json(extended: ModifiedTables, vect
     assert [t.parameter for t in got] == [5000, 0, 0, None]
     for term, raw in zip(got, expected):
         # The JSON holds the f32 values printed shortest; the getters give the same f32s.
-        assert term.centre == tuple(np.float32(raw["centre"]).tolist())
-        assert term.coefficient == tuple(np.float32(raw["coefficient"]).tolist())
+        assert term.centre == tuple(np.asarray(raw["centre"], dtype=np.float32).tolist())
+        assert term.coefficient == tuple(np.asarray(raw["coefficient"], dtype=np.float32).tolist())
     assert got == tuple(terms())
     assert repr(extended).endswith("; 4 extra terms>")
 
@@ -237,7 +237,7 @@ def test_extension_changes_the_correction(modified: ModifiedTables, extended: Mo
     times = np.arange(1, 201, dtype=np.uint32) * 10
     rate = np.zeros((200, 3), np.float32)
     temperature = (6600.0 + np.linspace(0, 40, 200)[:, None] * np.ones(3)).astype(np.float32)
-    aux = np.tile(np.float32([5.0, 0.0, 0.0, 1.0]), (200, 1))
+    aux = np.tile(np.asarray([5.0, 0.0, 0.0, 1.0], dtype=np.float32), (200, 1))
 
     def bias(model: ModifiedTables, aux: np.ndarray | None) -> np.ndarray:
         corrector = gyrodrift.Corrector(model)
@@ -246,5 +246,5 @@ def test_extension_changes_the_correction(modified: ModifiedTables, extended: Mo
 
     plain, with_aux = bias(modified, None), bias(extended, aux)
     assert not np.array_equal(plain, with_aux)
-    assert not np.array_equal(with_aux, bias(extended, aux + np.float32([0.5, 0, 0, 0])))
+    assert not np.array_equal(with_aux, bias(extended, aux + np.asarray([0.5, 0, 0, 0], dtype=np.float32)))
     assert np.array_equal(bias(modified, aux), plain)  # the paper's model does not read aux
