@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use drift_core::AUX_INPUTS;
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyBytes};
@@ -32,6 +33,21 @@ pub fn per_axis(name: &str, value: &Bound<'_, PyAny>) -> Result<[f32; 3], Error>
         .map_err(|_| {
             Error::Input(format!(
                 "`{name}` must be a sequence of 3 floats (X, Y, Z), got {}",
+                describe(value)
+            ))
+        })
+}
+
+/// The auxiliary inputs of one sample (`drift_core::AUX_INPUTS` floats, by input index); NaN and
+/// infinity are accepted (the corrector holds the terms that read them, flagged).
+pub fn aux_inputs(name: &str, value: &Bound<'_, PyAny>) -> Result<[f32; AUX_INPUTS], Error> {
+    value
+        .extract::<[f64; AUX_INPUTS]>()
+        .map(|values| values.map(|v| v as f32))
+        .map_err(|_| {
+            Error::Input(format!(
+                "`{name}` must be a sequence of {AUX_INPUTS} floats (auxiliary inputs 0..{AUX_INPUTS}) \
+                 or a float array of shape ({AUX_INPUTS},), got {}",
                 describe(value)
             ))
         })

@@ -65,7 +65,8 @@ pub fn times<'py>(
         .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))
 }
 
-/// A borrowed `(n, 3)` float array (rates or raw temperatures), float32 or float64.
+/// A borrowed `(n, columns)` float array (rates or raw temperatures: 3 columns; auxiliary inputs:
+/// 4), float32 or float64.
 pub enum Rows<'py> {
     /// float32: read in place.
     F32(PyReadonlyArray2<'py, f32>),
@@ -74,11 +75,20 @@ pub enum Rows<'py> {
 }
 
 impl<'py> Rows<'py> {
-    /// Checks and borrows `value`, naming it `name` in errors.
+    /// Checks and borrows an `(n, 3)` `value`, naming it `name` in errors.
     pub fn borrow(name: &str, value: &Bound<'py, PyAny>) -> Result<Self, Error> {
+        Self::borrow_columns(name, value, 3)
+    }
+
+    /// Checks and borrows an `(n, columns)` `value`, naming it `name` in errors.
+    pub fn borrow_columns(
+        name: &str,
+        value: &Bound<'py, PyAny>,
+        columns: usize,
+    ) -> Result<Self, Error> {
         let wrong = || {
             Error::Input(format!(
-                "`{name}` must be a float32 or float64 array of shape (n, 3), got {}",
+                "`{name}` must be a float32 or float64 array of shape (n, {columns}), got {}",
                 describe(value)
             ))
         };
@@ -92,11 +102,11 @@ impl<'py> Rows<'py> {
         } else {
             return Err(wrong());
         };
-        let (n, columns) = {
+        let (n, found) = {
             let view = rows.view();
             (view.len(), view.shape().get(1).copied())
         };
-        if columns != Some(3) {
+        if found != Some(columns) {
             return Err(wrong());
         }
         not_empty(name, value, n)?;
@@ -112,7 +122,7 @@ impl<'py> Rows<'py> {
     }
 }
 
-/// Rows of an `(n, 3)` array of either float dtype, any strides.
+/// Rows of an `(n, columns)` array of either float dtype, any strides.
 pub enum RowsView<'a> {
     /// float32 rows.
     F32(ArrayView2<'a, f32>),
@@ -121,7 +131,7 @@ pub enum RowsView<'a> {
 }
 
 impl RowsView<'_> {
-    /// The array's shape, `[n, 3]`.
+    /// The array's shape, `[n, columns]`.
     pub fn shape(&self) -> &[usize] {
         match self {
             Self::F32(view) => view.shape(),
@@ -142,8 +152,12 @@ impl RowsView<'_> {
         }
     }
 
-    /// Copies rows `start..` as f32 into `out`, as many as `out` yields.
-    pub fn copy_rows<'o>(&self, start: usize, out: impl Iterator<Item = &'o mut [f32; 3]>) {
+    /// Copies rows `start..` as f32 into `out`, as many as `out` yields (`N`: the column count).
+    pub fn copy_rows<'o, const N: usize>(
+        &self,
+        start: usize,
+        out: impl Iterator<Item = &'o mut [f32; N]>,
+    ) {
         match self {
             Self::F32(view) => copy_rows(view, start, out),
             Self::F64(view) => copy_rows(view, start, out),
@@ -169,15 +183,15 @@ impl AsF32 for f64 {
     }
 }
 
-fn copy_rows<'o, T: AsF32>(
+fn copy_rows<'o, T: AsF32, const N: usize>(
     view: &ArrayView2<'_, T>,
     start: usize,
-    out: impl Iterator<Item = &'o mut [f32; 3]>,
+    out: impl Iterator<Item = &'o mut [f32; N]>,
 ) {
     if let Some(flat) = view.as_slice() {
         // C-contiguous: straight from the caller's buffer.
-        let rows = flat.get(start.saturating_mul(3)..).unwrap_or_default();
-        for (dst, src) in out.zip(rows.chunks_exact(3)) {
+        let rows = flat.get(start.saturating_mul(N)..).unwrap_or_default();
+        for (dst, src) in out.zip(rows.chunks_exact(N)) {
             for (d, s) in dst.iter_mut().zip(src) {
                 *d = s.as_f32();
             }

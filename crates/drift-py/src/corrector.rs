@@ -1,11 +1,13 @@
 //! `gyrodrift.Corrector`: a model plus one unit's run-time state, correcting one sample at a time
-//! or whole numpy arrays. Every sample goes through drift-core's `CorrectorState::correct`, the
-//! code the firmware runs.
+//! or whole numpy arrays. Every sample goes through drift-core's `CorrectorState::correct`, or
+//! `CorrectorState::correct_with_aux` when the caller passes auxiliary inputs: the code the firmware
+//! runs.
 
 use std::sync::Arc;
 
 use drift_core::{
     AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialTables, Sample,
+    AUX_INPUTS,
 };
 use numpy::ndarray::{Array2, ArrayView1};
 use numpy::{IntoPyArray, PyArray2};
@@ -41,6 +43,8 @@ struct Batch<'a> {
     times: ArrayView1<'a, u32>,
     rates: RowsView<'a>,
     temperatures: RowsView<'a>,
+    /// `(n, AUX_INPUTS)` auxiliary inputs, if the caller passed them.
+    aux: Option<RowsView<'a>>,
 }
 
 /// Where the batch's outputs go: `n × 3` row-major slices (new vectors or the caller's arrays).
@@ -48,6 +52,24 @@ struct Corrected<'a> {
     corrected_dps: &'a mut [f32],
     bias_dps: &'a mut [f32],
     flags: &'a mut [u16],
+}
+
+/// One sample through drift-core: `correct_with_aux` with auxiliary inputs, else `correct`.
+fn correct_one<M, S>(
+    model: &M,
+    state: &mut CorrectorState<S>,
+    sample: &Sample,
+    aux: Option<&[f32; AUX_INPUTS]>,
+) -> Output
+where
+    M: Model,
+    M::Axis: AxisModel<State = S>,
+    S: Copy + Default,
+{
+    match aux {
+        Some(aux) => state.correct_with_aux(model, sample, aux),
+        None => state.correct(model, sample),
+    }
 }
 
 fn correct_all<M, S>(
@@ -78,17 +100,24 @@ fn correct_all<M, S>(
             }
         }
     };
+    // `Some(None)`: no auxiliary inputs; `Some(Some(rows))`: float32 C-contiguous ones.
+    let aux = match &batch.aux {
+        None => Some(None),
+        Some(view) => view.as_f32_slice().map(Some),
+    };
     let contiguous = (
         batch.times.as_slice(),
         batch.rates.as_f32_slice(),
         batch.temperatures.as_f32_slice(),
+        aux,
     );
-    if let (Some(times), Some(rates), Some(temperatures)) = contiguous {
+    if let (Some(times), Some(rates), Some(temperatures), Some(aux)) = contiguous {
         // The usual case, float32 C-contiguous inputs: samples straight from the caller's buffers.
         let rows = times
             .iter()
             .zip(rates.chunks_exact(3))
             .zip(temperatures.chunks_exact(3));
+        let mut aux_rows = aux.map(|aux| aux.chunks_exact(AUX_INPUTS));
         for ((&since_power_on_ms, rate), temperature) in rows {
             let mut sample = Sample {
                 since_power_on_ms,
@@ -100,13 +129,18 @@ fn correct_all<M, S>(
             for (dst, src) in sample.temperature_raw.iter_mut().zip(temperature) {
                 *dst = *src;
             }
-            store(state.correct(model, &sample));
+            let aux = aux_rows
+                .as_mut()
+                .and_then(Iterator::next)
+                .and_then(|row| <&[f32; AUX_INPUTS]>::try_from(row).ok());
+            store(correct_one(model, state, &sample, aux));
         }
         return;
     }
-    // Any other layout or float64: staged through a small buffer, converted per value.
+    // Any other layout or float64: staged through small buffers, converted per value.
     let n = batch.times.len();
     let mut staged = [Sample::default(); BLOCK];
+    let mut staged_aux = [[0.0_f32; AUX_INPUTS]; BLOCK];
     for start in (0..n).step_by(BLOCK) {
         let count = BLOCK.min(n.saturating_sub(start));
         let block = staged.get_mut(..count).unwrap_or_default();
@@ -121,8 +155,13 @@ fn correct_all<M, S>(
         batch
             .temperatures
             .copy_rows(start, block.iter_mut().map(|s| &mut s.temperature_raw));
-        for sample in block.iter() {
-            store(state.correct(model, sample));
+        let aux_block = staged_aux.get_mut(..count).unwrap_or_default();
+        if let Some(aux) = &batch.aux {
+            aux.copy_rows(start, aux_block.iter_mut());
+        }
+        for (sample, aux) in block.iter().zip(aux_block.iter()) {
+            let aux = batch.aux.as_ref().map(|_| aux);
+            store(correct_one(model, state, sample, aux));
         }
     }
 }
@@ -142,10 +181,10 @@ impl Engine {
         }
     }
 
-    fn correct(&mut self, sample: &Sample) -> Output {
+    fn correct(&mut self, sample: &Sample, aux: Option<&[f32; AUX_INPUTS]>) -> Output {
         match self {
-            Self::Modified(model, state) => state.correct(&**model, sample),
-            Self::Polynomial(model, state) => state.correct(&**model, sample),
+            Self::Modified(model, state) => correct_one(&**model, state, sample, aux),
+            Self::Polynomial(model, state) => correct_one(&**model, state, sample, aux),
         }
     }
 
@@ -295,19 +334,26 @@ impl PyCorrector {
         self.engine.power_off();
     }
 
-    /// Corrects one sample.
+    /// Corrects one sample; `aux`: the auxiliary inputs an extended model's extra terms read
+    /// (drift-core's `correct_with_aux`), or `None` (drift-core's `correct`).
+    #[pyo3(signature = (since_power_on_ms, rate_dps, temperature_raw, *, aux = None))]
     fn correct(
         &mut self,
         since_power_on_ms: &Bound<'_, PyAny>,
         rate_dps: &Bound<'_, PyAny>,
         temperature_raw: &Bound<'_, PyAny>,
+        aux: Option<&Bound<'_, PyAny>>,
     ) -> Result<PyOutput, Error> {
         let sample = Sample {
             since_power_on_ms: args::milliseconds("since_power_on_ms", since_power_on_ms)?,
             rate_dps: args::per_axis("rate_dps", rate_dps)?,
             temperature_raw: args::per_axis("temperature_raw", temperature_raw)?,
         };
-        let output = self.engine.correct(&sample);
+        let aux = match aux {
+            Some(aux) if !aux.is_none() => Some(args::aux_inputs("aux", aux)?),
+            _ => None,
+        };
+        let output = self.engine.correct(&sample, aux.as_ref());
         Ok(PyOutput {
             corrected_dps: triple(output.corrected_dps),
             bias_dps: triple(output.bias_dps),
@@ -316,29 +362,41 @@ impl PyCorrector {
     }
 
     /// Corrects n samples in order, continuing the current activation; the GIL is released while
-    /// the samples are corrected. With `out`, writes into the caller's arrays and returns them.
-    #[pyo3(signature = (since_power_on_ms, rate_dps, temperature_raw, *, out = None))]
+    /// the samples are corrected. `aux`: `(n, AUX_INPUTS)` auxiliary inputs (`correct_with_aux`
+    /// per sample) or `None` (`correct`). With `out`, writes into the caller's arrays and returns
+    /// them.
+    #[pyo3(signature = (since_power_on_ms, rate_dps, temperature_raw, *, aux = None, out = None))]
     fn correct_batch<'py>(
         &mut self,
         py: Python<'py>,
         since_power_on_ms: &Bound<'py, PyAny>,
         rate_dps: &Bound<'py, PyAny>,
         temperature_raw: &Bound<'py, PyAny>,
+        aux: Option<&Bound<'py, PyAny>>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> Result<BatchArrays<'py>, Error> {
         let times_array = times("since_power_on_ms", since_power_on_ms)?;
         let rates = Rows::borrow("rate_dps", rate_dps)?;
         let temperatures = Rows::borrow("temperature_raw", temperature_raw)?;
+        let aux = match aux {
+            Some(aux) if !aux.is_none() => Some(Rows::borrow_columns("aux", aux, AUX_INPUTS)?),
+            _ => None,
+        };
         let batch = Batch {
             times: times_array.as_array(),
             rates: rates.view(),
             temperatures: temperatures.view(),
+            aux: aux.as_ref().map(Rows::view),
         };
         let n = batch.times.len();
+        let aux_rows = batch.aux.as_ref().map(|aux| ("aux", aux.len()));
         for (name, rows) in [
             ("rate_dps", batch.rates.len()),
             ("temperature_raw", batch.temperatures.len()),
-        ] {
+        ]
+        .into_iter()
+        .chain(aux_rows)
+        {
             if rows != n {
                 return Err(Error::Input(format!(
                     "`{name}` must have one row per time in `since_power_on_ms` ({n}), got {rows} rows"

@@ -1,27 +1,24 @@
 //! The corrector's status flags as module constants (`gyrodrift.Flags` builds an `enum.IntFlag`
 //! from them in Python).
+//!
+//! The list comes from `drift_core::Flags::ALL`, so a flag added to drift-core is a module constant
+//! here without an edit; `FLAGS` (every `(name, value)` in bit order) lets the Python tests check
+//! that `gyrodrift.Flags` names each of them.
 
 use drift_core::Flags;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
-/// Every flag drift-core defines, by name, plus the `FAULTS` mask.
-pub const FLAGS: [(&str, Flags); 10] = [
-    ("AMBIENT_OUT_OF_RANGE", Flags::AMBIENT_OUT_OF_RANGE),
-    ("RISE_OUT_OF_SPAN", Flags::RISE_OUT_OF_SPAN),
-    ("PAST_LAST_REFERENCE", Flags::PAST_LAST_REFERENCE),
-    ("TEMPERATURE_OUT_OF_RANGE", Flags::TEMPERATURE_OUT_OF_RANGE),
-    ("TEMPERATURE_INVALID", Flags::TEMPERATURE_INVALID),
-    ("TEMPERATURE_STUCK", Flags::TEMPERATURE_STUCK),
-    ("RATE_INVALID", Flags::RATE_INVALID),
-    ("NOT_POWERED_ON", Flags::NOT_POWERED_ON),
-    ("MODEL_INVALID", Flags::MODEL_INVALID),
-    ("FAULTS", Flags::FAULTS),
-];
-
-/// Adds each flag as an `int` constant of the module.
+/// Adds each flag drift-core defines as an `int` constant of the module, then `FAULTS` and `FLAGS`.
 pub fn register(module: &Bound<'_, PyModule>) -> PyResult<()> {
-    for (name, flag) in FLAGS {
+    for (flag, name) in Flags::ALL {
         module.add(name, flag.0)?;
     }
+    module.add("FAULTS", Flags::FAULTS.0)?;
+    let all = PyTuple::new(
+        module.py(),
+        Flags::ALL.iter().map(|&(flag, name)| (name, flag.0)),
+    )?;
+    module.add("FLAGS", all)?;
     Ok(())
 }

@@ -11,6 +11,7 @@ mod arrays;
 mod corrector;
 mod errors;
 mod evaluation;
+mod extension;
 mod fit;
 mod fit_settings;
 mod flags;
@@ -34,6 +35,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     flags::register(module)?;
     module.add_class::<settings::PySettings>()?;
     module.add_class::<tables::PyModifiedTables>()?;
+    extension::register(module)?;
     module.add_class::<tables::PyPolynomialTables>()?;
     module.add_class::<corrector::PyCorrector>()?;
     module.add_class::<corrector::PyOutput>()?;

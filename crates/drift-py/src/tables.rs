@@ -2,16 +2,18 @@
 //! `gyrodrift.PolynomialTables` (the standard and 3rd-order baselines).
 //!
 //! Both are immutable, validated on construction, and share one API (generated below so it cannot
-//! drift apart): JSON and firmware-image conversion, files, settings.
+//! drift apart): JSON and firmware-image conversion, files, settings. `ModifiedTables` adds the
+//! extended model's extra terms (`extension`, `with_extension`).
 
 use std::sync::Arc;
 
-use drift_core::{Model, ModifiedTables, PolynomialTables};
+use drift_core::{Extension, Model, ModifiedTables, PolynomialTables, MAX_TERMS};
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyString, PyTuple};
 
 use crate::args;
 use crate::errors::Error;
+use crate::extension::PyExtraTerm;
 use crate::model_io;
 use crate::settings::PySettings;
 
@@ -35,8 +37,13 @@ impl Summary for ModifiedTables {
                 )
             })
             .collect();
+        let terms = match self.extension.terms.len() {
+            0 => String::new(),
+            1 => "; 1 extra term".to_owned(),
+            n => format!("; {n} extra terms"),
+        };
         format!(
-            "reference times x ambients x curves per axis: {}",
+            "reference times x ambients x curves per axis: {}{terms}",
             axes.join(", ")
         )
     }
@@ -59,9 +66,10 @@ impl Summary for PolynomialTables {
     }
 }
 
-/// Defines a frozen model class wrapping `Arc<$model>` with the shared API.
+/// Defines a frozen model class wrapping `Arc<$model>` with the shared API, plus the model's own
+/// `#[pymethods]` given after the doc (pyo3 takes one `#[pymethods]` block per class).
 macro_rules! model_class {
-    ($class:ident, $model:ty, $name:literal, $doc:literal) => {
+    ($class:ident, $model:ty, $name:literal, $doc:literal, { $($methods:tt)* }) => {
         #[doc = $doc]
         #[pyclass(module = "gyrodrift", name = $name, frozen, eq)]
         #[derive(Clone, Debug, PartialEq)]
@@ -153,6 +161,8 @@ macro_rules! model_class {
             fn __repr__(&self) -> String {
                 format!("<{} {}>", $name, self.0.summary())
             }
+
+            $($methods)*
         }
     };
 }
@@ -161,12 +171,59 @@ model_class!(
     PyModifiedTables,
     ModifiedTables,
     "ModifiedTables",
-    "The paper's correlation tables (`drift_core::ModifiedTables`, host capacities 16 x 12 x 32)."
+    "The paper's correlation tables (`drift_core::ModifiedTables`, host capacities 16 x 12 x 32), \
+     with the extended model's extra terms if any.",
+    {
+        /// The extended model's extra terms (empty for the paper's model).
+        #[getter]
+        fn extension<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+            PyTuple::new(py, self.0.extension.terms.iter().map(|&t| PyExtraTerm(t)))
+        }
+
+        /// The same tables with `terms` as the extra terms (replacing any; empty: none), validated
+        /// by drift-core (`TableError` names the term).
+        fn with_extension(&self, terms: &Bound<'_, PyAny>) -> Result<Self, Error> {
+            let wrong = || {
+                Error::Input(format!(
+                    "`terms` must be a sequence of gyrodrift.ExtraTerm, got {}",
+                    crate::arrays::describe(terms)
+                ))
+            };
+            if terms.is_instance_of::<PyString>() {
+                return Err(wrong());
+            }
+            let items: Vec<Bound<'_, PyAny>> = terms.extract().map_err(|_| wrong())?;
+            if items.len() > MAX_TERMS {
+                return Err(Error::Input(format!(
+                    "`terms` must hold at most {MAX_TERMS} terms, got {}",
+                    items.len()
+                )));
+            }
+            let mut extension = Extension::NONE;
+            for (index, item) in items.iter().enumerate() {
+                let term = item.cast::<PyExtraTerm>().map_err(|_| {
+                    Error::Input(format!(
+                        "`terms[{index}]` must be a gyrodrift.ExtraTerm, got {}",
+                        crate::arrays::describe(item)
+                    ))
+                })?;
+                extension.terms.push(term.get().0).map_err(|_| {
+                    Error::Input(format!("`terms` must hold at most {MAX_TERMS} terms"))
+                })?;
+            }
+            let tables = (*self.0)
+                .clone()
+                .with_extension(extension)
+                .map_err(Error::Table)?;
+            Ok(Self(Arc::new(tables)))
+        }
+    }
 );
 
 model_class!(
     PyPolynomialTables,
     PolynomialTables,
     "PolynomialTables",
-    "A polynomial baseline, standard or 3rd order (`drift_core::PolynomialTables`)."
+    "A polynomial baseline, standard or 3rd order (`drift_core::PolynomialTables`).",
+    {}
 );

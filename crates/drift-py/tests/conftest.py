@@ -31,6 +31,7 @@ class Case:
     corrected: np.ndarray  # (n, 3) float32
     bias: np.ndarray  # (n, 3) float32
     flags: np.ndarray  # (n, 3) uint16
+    aux: np.ndarray | None = None  # (n, 4) float32: the auxiliary inputs, when the case passes them
 
 
 def f32(bits: Any) -> np.ndarray:
@@ -83,6 +84,7 @@ def parse_case(case: dict[str, Any]) -> Case:
         corrected=f32(np.ascontiguousarray(expected[:, 0:3])),
         bias=f32(np.ascontiguousarray(expected[:, 3:6])),
         flags=expected[:, 6:9].astype(np.uint16),
+        aux=f32(np.asarray(case["aux"], dtype=np.uint32).reshape(-1, 4)) if "aux" in case else None,
     )
 
 

@@ -147,6 +147,34 @@ def test_batch_rejects_mismatched_lengths(corrector: gyrodrift.Corrector, argume
         corrector.correct_batch(args["since_power_on_ms"], args["rate_dps"], args["temperature_raw"])
 
 
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        (
+            np.zeros((N, 3), dtype=np.float32),
+            "`aux` must be a float32 or float64 array of shape (n, 4), got float32 array of shape (5, 3)",
+        ),
+        (
+            np.zeros(4, dtype=np.float32),
+            "`aux` must be a float32 or float64 array of shape (n, 4), got float32 array of shape (4,)",
+        ),
+        (
+            np.zeros((N, 4), dtype=np.int32),
+            "`aux` must be a float32 or float64 array of shape (n, 4), got int32 array of shape (5, 4)",
+        ),
+        ([[0.0] * 4] * N, "`aux` must be a float32 or float64 array of shape (n, 4), got list"),
+        (np.zeros((0, 4), dtype=np.float32), "`aux` must not be empty, got float32 array of shape (0, 4)"),
+        (
+            np.zeros((N - 1, 4), dtype=np.float64),
+            "`aux` must have one row per time in `since_power_on_ms` (5), got 4 rows",
+        ),
+    ],
+)
+def test_batch_rejects_bad_aux(corrector: gyrodrift.Corrector, bad: Any, message: str) -> None:
+    with pytest.raises(InputError, match=re.escape(message)):
+        corrector.correct_batch(*inputs(), aux=bad)
+
+
 def test_a_rejected_batch_leaves_the_state_alone(modified: ModifiedTables) -> None:
     times, rate, temperature = inputs()
     reference = gyrodrift.Corrector(modified)
@@ -265,6 +293,30 @@ def test_correct_rejects_bad_arguments(corrector: gyrodrift.Corrector, args: tup
         corrector.correct(*args)
 
 
+@pytest.mark.parametrize(
+    ("aux", "got"),
+    [
+        ([0.0] * 3, "list"),
+        ("abcd", "str"),
+        (5.0, "float"),
+        (np.zeros((2, 4)), "float64 array of shape (2, 4)"),
+        (np.zeros(5, dtype=np.float32), "float32 array of shape (5,)"),
+    ],
+)
+def test_correct_rejects_bad_aux(corrector: gyrodrift.Corrector, aux: Any, got: str) -> None:
+    message = (
+        "`aux` must be a sequence of 4 floats (auxiliary inputs 0..4) or a float array of shape (4,), "
+        f"got {got}"
+    )
+    with pytest.raises(InputError, match=re.escape(message)):
+        corrector.correct(1, [0.0] * 3, [6000.0] * 3, aux=aux)
+
+
+def test_aux_is_keyword_only(corrector: gyrodrift.Corrector) -> None:
+    with pytest.raises(TypeError):
+        corrector.correct(1, [0.0] * 3, [6000.0] * 3, [5.0] * 4)  # type: ignore[misc]
+
+
 def test_power_on_rejects_non_finite_and_keeps_the_state(modified: ModifiedTables) -> None:
     corrector = gyrodrift.Corrector(modified)
     with pytest.raises(
@@ -354,8 +406,12 @@ def image(modified: ModifiedTables) -> bytes:
         (lambda b: b"JUNK" + b[4:], "not a gyrodrift table image: magic is [4a, 55, 4e, 4b]"),
         (lambda b: b'{"axes": []}', "not a gyrodrift table image: magic is [7b, 22, 61, 78]"),
         (
-            lambda b: b[:4] + b"\x02\x00" + b[6:],
-            "table image format version 2 is not supported (this build reads 1)",
+            lambda b: b[:4] + b"\x03\x00" + b[6:],
+            "table image format version 3 is not supported (this build reads 1 to 2)",
+        ),
+        (
+            lambda b: b[:4] + b"\x00\x00" + b[6:],
+            "table image format version 0 is not supported (this build reads 1 to 2)",
         ),
         (lambda b: b[:6] + b"\x02" + b[7:], "table image holds model kind 2, expected 1"),
         (lambda b: b + b"\x00\x00", "2 unexpected bytes after the table image's CRC"),
@@ -374,7 +430,8 @@ def image(modified: ModifiedTables) -> bytes:
         "truncated-body",
         "bad-magic",
         "not-an-image",
-        "version",
+        "version-3",
+        "version-0",
         "wrong-kind",
         "trailing-bytes",
         "crc-mismatch",

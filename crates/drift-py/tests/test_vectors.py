@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 
+import gyrodrift
 from conftest import Case, Model, powered_corrector, same_bits
 
 
@@ -18,27 +21,87 @@ def check_batch(case: Case, corrected: np.ndarray, bias: np.ndarray, flags: np.n
 
 
 def test_vectors_cover_every_model_and_enough_samples(cases: list[Case], models: dict[str, Model]) -> None:
-    assert {c.model for c in cases} == set(models) == {"modified", "standard", "third_order"}
+    assert {c.model for c in cases} == set(models) == {"modified", "standard", "third_order", "extended"}
     assert sum(len(c.times) for c in cases) > 1000
+    with_aux = [c for c in cases if c.aux is not None]
+    assert {c.model for c in with_aux} == {"extended"}
+    assert all(c.aux is not None and c.aux.shape == (len(c.times), 4) for c in with_aux)
+    # The extended model is also run without aux (drift-core's `correct`): its terms hold, flagged.
+    assert any(c.model == "extended" and c.aux is None for c in cases)
+
+
+def test_extended_cases_exercise_the_extension(cases: list[Case], models: dict[str, Model]) -> None:
+    """Guards the tests below against passing vacuously: the extended model has terms, and its
+    cases include the new flag."""
+    extended = models["extended"]
+    assert isinstance(extended, gyrodrift.ModifiedTables) and len(extended.extension) == 4
+    flags = np.concatenate([c.flags for c in cases if c.model == "extended"])
+    assert (flags & gyrodrift.Flags.EXTENSION_INPUT_INVALID).any()
 
 
 def test_batch_reproduces_every_case(cases: list[Case], models: dict[str, Model]) -> None:
     for case in cases:
         corrector = powered_corrector(models[case.model], case)
-        check_batch(case, *corrector.correct_batch(case.times, case.rate, case.temperature))
+        check_batch(case, *corrector.correct_batch(case.times, case.rate, case.temperature, aux=case.aux))
+
+
+def per_sample(corrector: gyrodrift.Corrector, case: Case, aux: list[Any]) -> list[gyrodrift.Output]:
+    return [
+        corrector.correct(int(t), rate, temperature, aux=a)
+        for t, rate, temperature, a in zip(case.times, case.rate, case.temperature, aux)
+    ]
 
 
 def test_per_sample_reproduces_every_case(cases: list[Case], models: dict[str, Model]) -> None:
     for case in cases:
         corrector = powered_corrector(models[case.model], case)
-        outputs = [
-            corrector.correct(int(t), rate, temperature)
-            for t, rate, temperature in zip(case.times, case.rate, case.temperature)
-        ]
+        # aux per sample as a (4,) float32 row, or None (drift-core's `correct`).
+        aux: list[Any] = [None] * len(case.times) if case.aux is None else list(case.aux)
+        outputs = per_sample(corrector, case, aux)
         corrected = np.array([o.corrected_dps for o in outputs], dtype=np.float32)
         bias = np.array([o.bias_dps for o in outputs], dtype=np.float32)
         flags = np.array([o.flags for o in outputs], dtype=np.uint16)
         check_batch(case, corrected, bias, flags)
+
+
+def test_per_sample_aux_as_python_floats(cases: list[Case], models: dict[str, Model]) -> None:
+    """A sequence of 4 Python floats (exact widenings of the f32 inputs, NaN included) works too."""
+    for case in cases:
+        if case.aux is None:
+            continue
+        corrector = powered_corrector(models[case.model], case)
+        outputs = per_sample(corrector, case, [[float(v) for v in row] for row in case.aux])
+        check_batch(
+            case,
+            np.array([o.corrected_dps for o in outputs], dtype=np.float32),
+            np.array([o.bias_dps for o in outputs], dtype=np.float32),
+            np.array([o.flags for o in outputs], dtype=np.uint16),
+        )
+
+
+def test_aux_none_is_correct_without_aux(cases: list[Case], models: dict[str, Model]) -> None:
+    """`aux=None` is drift-core's `correct`: the same as NaN auxiliary inputs, flagged."""
+    case = next(c for c in cases if c.aux is not None)
+    without = powered_corrector(models[case.model], case).correct_batch(
+        case.times, case.rate, case.temperature
+    )
+    nan_aux = np.full((len(case.times), 4), np.nan, np.float32)
+    with_nan = powered_corrector(models[case.model], case).correct_batch(
+        case.times, case.rate, case.temperature, aux=nan_aux
+    )
+    for a, b in zip(without, with_nan):
+        assert a.tobytes() == b.tobytes()
+    assert (without[2] & gyrodrift.Flags.EXTENSION_INPUT_INVALID).all()
+
+
+def test_aux_is_ignored_by_models_without_aux_terms(cases: list[Case], models: dict[str, Model]) -> None:
+    """Models without extra terms give the same bits with any aux (they have nothing to read it)."""
+    for case in cases:
+        if case.model == "extended":
+            continue
+        aux = np.full((len(case.times), 4), 3.5, np.float32)
+        corrector = powered_corrector(models[case.model], case)
+        check_batch(case, *corrector.correct_batch(case.times, case.rate, case.temperature, aux=aux))
 
 
 @pytest.mark.parametrize("layout", ["float64", "fortran", "strided", "reversed-copy"])
@@ -47,12 +110,15 @@ def test_batch_is_layout_and_dtype_independent(
 ) -> None:
     """float64 inputs (exact widenings of the vectors' f32) and non-contiguous views give the same bits."""
     for case in cases:
+        aux = case.aux
         if layout == "float64":
             rate, temperature = case.rate.astype(np.float64), case.temperature.astype(np.float64)
             times = case.times
+            aux = None if aux is None else aux.astype(np.float64)
         elif layout == "fortran":
             rate, temperature = np.asfortranarray(case.rate), np.asfortranarray(case.temperature)
             times = case.times
+            aux = None if aux is None else np.asfortranarray(aux)
         elif layout == "strided":
             # Every other row of a doubled array, and every other column of a widened one.
             rate = np.repeat(case.rate, 2, axis=0)[::2]
@@ -60,12 +126,28 @@ def test_batch_is_layout_and_dtype_independent(
             times = np.repeat(case.times, 2)[::2]
             assert not rate.flags.c_contiguous and not temperature.flags.c_contiguous
             assert not times.flags.c_contiguous
+            if aux is not None:
+                aux = np.repeat(aux, 2, axis=1)[:, ::2]
+                assert not aux.flags.c_contiguous
         else:
             rate = case.rate[::-1].copy()[::-1]
             temperature = case.temperature[::-1].copy()[::-1]
             times = case.times[::-1].copy()[::-1]
+            aux = None if aux is None else aux[::-1].copy()[::-1]
         corrector = powered_corrector(models[case.model], case)
-        check_batch(case, *corrector.correct_batch(times, rate, temperature))
+        check_batch(case, *corrector.correct_batch(times, rate, temperature, aux=aux))
+
+
+def test_only_aux_in_another_layout_still_gives_the_same_bits(
+    cases: list[Case], models: dict[str, Model]
+) -> None:
+    """float32 C-contiguous inputs with a float64 or strided `aux` (the staged path for one input)."""
+    for case in cases:
+        if case.aux is None:
+            continue
+        for aux in (case.aux.astype(np.float64), np.repeat(case.aux, 2, axis=0)[::2]):
+            corrector = powered_corrector(models[case.model], case)
+            check_batch(case, *corrector.correct_batch(case.times, case.rate, case.temperature, aux=aux))
 
 
 def test_a_case_split_into_batches_continues_the_activation(
@@ -74,7 +156,12 @@ def test_a_case_split_into_batches_continues_the_activation(
     for case in cases:
         corrector = powered_corrector(models[case.model], case)
         parts = [
-            corrector.correct_batch(case.times[s], case.rate[s], case.temperature[s])
+            corrector.correct_batch(
+                case.times[s],
+                case.rate[s],
+                case.temperature[s],
+                aux=None if case.aux is None else case.aux[s],
+            )
             for s in (slice(0, 1), slice(1, 7), slice(7, None))
             if len(case.times[s])
         ]
@@ -112,6 +199,6 @@ def test_out_arrays_receive_the_same_results(cases: list[Case], models: dict[str
         n = len(case.times)
         out = (np.full((n, 3), 7, np.float32), np.full((n, 3), 7, np.float32), np.full((n, 3), 7, np.uint16))
         corrector = powered_corrector(models[case.model], case)
-        returned = corrector.correct_batch(case.times, case.rate, case.temperature, out=out)
+        returned = corrector.correct_batch(case.times, case.rate, case.temperature, aux=case.aux, out=out)
         assert all(r is o for r, o in zip(returned, out))
         check_batch(case, *out)

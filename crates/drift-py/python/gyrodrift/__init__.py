@@ -3,7 +3,8 @@
 The corrector is drift-core's, the code the firmware runs, bound with pyo3: a `Corrector` holds a
 model (`ModifiedTables`, the paper's method, or `PolynomialTables`, a baseline) and one unit's
 run-time state, and corrects one sample (`correct`) or numpy arrays (`correct_batch`) with the same
-f32 results as the firmware.
+f32 results as the firmware. The extended model (`ModifiedTables.extension`, `ExtraTerm`) adds
+extra linear terms, some of which read auxiliary inputs passed as `aux=`.
 
 Around it, what the command line does: `simulate` a campaign, `Recording`/`Segment`/`load_campaign`
 for MCAP recordings (read, build from arrays, write), `fit` the tables, `evaluate` them on data the
@@ -17,12 +18,15 @@ import enum
 
 from . import _gyrodrift
 from ._gyrodrift import (
+    AUX_INPUTS,
+    MAX_EXTRA_TERMS,
     ActivationResult,
     AnalysedActivation,
     AuxChannel,
     CampaignError,
     Corrector,
     Evaluation,
+    ExtraTerm,
     FileError,
     FitError,
     FitSettings,
@@ -51,12 +55,15 @@ from ._gyrodrift import (
 from .tables import paper_table
 
 __all__ = [
+    "AUX_INPUTS",
+    "MAX_EXTRA_TERMS",
     "ActivationResult",
     "AnalysedActivation",
     "AuxChannel",
     "CampaignError",
     "Corrector",
     "Evaluation",
+    "ExtraTerm",
     "FileError",
     "FitError",
     "FitSettings",
@@ -110,6 +117,9 @@ class Flags(enum.IntFlag):
     """No successful power_on: rate passed through uncorrected."""
     MODEL_INVALID = _gyrodrift.MODEL_INVALID
     """The tables produced a non-finite drift (corrupt tables only): last good drift held."""
+    EXTENSION_INPUT_INVALID = _gyrodrift.EXTENSION_INPUT_INVALID
+    """Extended model: an auxiliary input an extra term reads is NaN/inf or was not passed
+    (`aux=None`): the extra terms' last good contribution held."""
 
     @classmethod
     def faults(cls) -> Flags:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Final, final
+from typing import Any, Final, Literal, final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -18,7 +18,11 @@ from typing_extensions import TypeAlias
 __version__: Final[str]
 __all__ = [
     "AMBIENT_OUT_OF_RANGE",
+    "AUX_INPUTS",
+    "EXTENSION_INPUT_INVALID",
     "FAULTS",
+    "FLAGS",
+    "MAX_EXTRA_TERMS",
     "MODEL_INVALID",
     "NOT_POWERED_ON",
     "PAST_LAST_REFERENCE",
@@ -33,6 +37,7 @@ __all__ = [
     "CampaignError",
     "Corrector",
     "Evaluation",
+    "ExtraTerm",
     "FileError",
     "FitError",
     "FitSettings",
@@ -63,6 +68,8 @@ _Path: TypeAlias = str | os.PathLike[str]
 _Floats3: TypeAlias = Sequence[float] | NDArray[np.floating]
 _Model: TypeAlias = ModifiedTables | PolynomialTables
 _Floats: TypeAlias = NDArray[np.float32] | NDArray[np.float64]
+_Floats4: TypeAlias = Sequence[float] | NDArray[np.floating]
+_TermKind: TypeAlias = Literal["temperature_rate", "aux", "axis_rise", "rise_squared"]
 _Source: TypeAlias = _Path | Recording | Segment | Sequence[_Path | Recording | Segment]
 _Record: TypeAlias = dict[str, Any]
 
@@ -76,7 +83,15 @@ TEMPERATURE_STUCK: Final[int]
 RATE_INVALID: Final[int]
 NOT_POWERED_ON: Final[int]
 MODEL_INVALID: Final[int]
+EXTENSION_INPUT_INVALID: Final[int]
 FAULTS: Final[int]
+FLAGS: Final[tuple[tuple[str, int], ...]]
+"""Every flag drift-core defines, `(name, value)` in bit order (drift_core::Flags::ALL)."""
+
+AUX_INPUTS: Final[int]
+"""Auxiliary inputs the extended model's terms can read per sample (drift_core::AUX_INPUTS, 4)."""
+MAX_EXTRA_TERMS: Final[int]
+"""Most extra terms a model carries (drift_core::MAX_TERMS, 4)."""
 
 class GyrodriftError(Exception):
     """Base class of every error gyrodrift raises."""
@@ -183,6 +198,57 @@ class ModifiedTables:
         """The settings stored with the tables."""
     def with_settings(self, settings: Settings) -> ModifiedTables:
         """The same tables with other settings (validated; `self` is unchanged)."""
+    @property
+    def extension(self) -> tuple[ExtraTerm, ...]:
+        """The extended model's extra terms, in model order; empty for the paper's model."""
+    def with_extension(self, terms: Sequence[ExtraTerm]) -> ModifiedTables:
+        """The same tables with `terms` as the extra terms (replacing any; `[]` removes them).
+
+        At most `MAX_EXTRA_TERMS` terms (`InputError` otherwise, or for anything not an
+        `ExtraTerm`). drift-core validates the whole model: an unknown input or axis index, a
+        time constant of 0, rate terms with different time constants or a NaN/inf centre or
+        coefficient raise `TableError` naming the term's index. `self` is unchanged.
+        """
+    def __eq__(self, other: object, /) -> bool: ...
+
+@final
+class ExtraTerm:
+    """One extra linear term of the extended model (drift_core::ExtraTerm): the axis's bias gains
+    `coefficient · (value − centre)`, per axis, where `value` is what `kind` measures.
+
+    Kinds and their `parameter`:
+
+    - `'temperature_rate'`: the axis's temperature rate, °C/s, from a first-order low-pass of time
+      constant `parameter` ms (every rate term of a model must use the same one);
+    - `'aux'`: auxiliary input `parameter` (0 .. AUX_INPUTS), as passed in `aux=` to
+      `Corrector.correct`/`correct_batch`, in its own unit, shared by the axes;
+    - `'axis_rise'`: the rise since switch-on of axis `parameter` (0 = X, 1 = Y, 2 = Z), °C;
+    - `'rise_squared'`: the axis's own rise squared, °C²; `parameter` is None.
+
+    Only converted on construction (`InputError` for a wrong type or a missing parameter); the
+    values are validated when the term becomes part of a model (`ModifiedTables.with_extension`).
+    """
+
+    def __new__(
+        cls,
+        kind: _TermKind,
+        parameter: int | None = None,
+        *,
+        centre: _Floats3,
+        coefficient: _Floats3,
+    ) -> ExtraTerm: ...
+    @property
+    def kind(self) -> _TermKind:
+        """What the term measures: 'temperature_rate', 'aux', 'axis_rise' or 'rise_squared'."""
+    @property
+    def parameter(self) -> int | None:
+        """The time constant (ms), auxiliary input index or axis index; None for 'rise_squared'."""
+    @property
+    def centre(self) -> tuple[float, float, float]:
+        """Per axis, the value the term is measured from (its calibration mean), in its unit."""
+    @property
+    def coefficient(self) -> tuple[float, float, float]:
+        """Per axis, °/s per unit of the term (0 leaves that axis untouched)."""
     def __eq__(self, other: object, /) -> bool: ...
 
 @final
@@ -262,25 +328,41 @@ class Corrector:
         """
     def power_off(self) -> None:
         """Ends the activation: samples pass through, flagged NOT_POWERED_ON, until `power_on`."""
-    def correct(self, since_power_on_ms: int, rate_dps: _Floats3, temperature_raw: _Floats3) -> Output:
-        """Corrects one sample. NaN/inf inputs are flagged, not raised."""
+    def correct(
+        self,
+        since_power_on_ms: int,
+        rate_dps: _Floats3,
+        temperature_raw: _Floats3,
+        *,
+        aux: _Floats4 | None = None,
+    ) -> Output:
+        """Corrects one sample. NaN/inf inputs are flagged, not raised.
+
+        `aux`: the sample's `AUX_INPUTS` auxiliary inputs (4 floats or a (4,) array, by input
+        index), read by an extended model's 'aux' terms (drift-core's `correct_with_aux`); other
+        models ignore them. Without `aux` (drift-core's `correct`), or with a NaN/inf input an
+        'aux' term reads, the extra terms' last good contribution is held, flagged
+        EXTENSION_INPUT_INVALID.
+        """
     def correct_batch(
         self,
         since_power_on_ms: NDArray[np.uint32],
         rate_dps: NDArray[np.float32] | NDArray[np.float64],
         temperature_raw: NDArray[np.float32] | NDArray[np.float64],
         *,
+        aux: NDArray[np.float32] | NDArray[np.float64] | None = None,
         out: tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.uint16]] | None = None,
     ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.uint16]]:
         """Corrects n samples in order, continuing the current activation.
 
         Arguments: `since_power_on_ms` uint32 (n,); `rate_dps` and `temperature_raw` float32 or
-        float64 (n, 3), any strides (read in place, not copied; float64 is rounded to f32 per
-        value). Returns `(corrected_dps, bias_dps, flags)`: float32, float32 and uint16 arrays of
-        shape (n, 3) — new arrays, or the arrays given as `out` (C-contiguous, writeable, none of
-        them an input), filled in place, which saves allocating for every block. The GIL is
-        released while correcting. Raises `InputError` for a wrong dtype or shape, an empty
-        array, or lengths that differ.
+        float64 (n, 3); `aux` None or float32 or float64 (n, AUX_INPUTS), each sample's auxiliary
+        inputs as in `correct`. Any strides (read in place, not copied; float64 is rounded to f32
+        per value). Returns `(corrected_dps, bias_dps, flags)`: float32, float32 and uint16
+        arrays of shape (n, 3) — new arrays, or the arrays given as `out` (C-contiguous,
+        writeable, none of them an input), filled in place, which saves allocating for every
+        block. The GIL is released while correcting. Raises `InputError` for a wrong dtype or
+        shape, an empty array, or lengths that differ.
         """
 
 # --- recordings -------------------------------------------------------------------------------
