@@ -69,6 +69,18 @@ fn simulate_fit_and_report_from_the_command_line() {
     assert!(text.contains("GIU-01:") && text.contains("  X: "), "{text}");
     let md = std::fs::read_to_string(diagnosis.join("diagnosis.md")).unwrap();
     assert!(md.contains("absorbed by the model"), "{md}");
+    // Closing the loop on a campaign without field sessions: the section says what it could do.
+    let extended = dir.path().join("extended");
+    run(&[
+        "diagnose",
+        c,
+        "-q",
+        "--extend",
+        "-o",
+        extended.to_str().unwrap(),
+    ]);
+    let md = std::fs::read_to_string(extended.join("diagnosis.md")).unwrap();
+    assert!(md.contains("## Extended model of unit GIU-01"), "{md}");
 }
 
 #[test]

@@ -71,10 +71,14 @@ pub fn run(
         md.push_str("Nothing significant maps to a term the firmware can compute: the paper's model is kept unchanged.\n\n");
         return Ok(md);
     }
-    anyhow::ensure!(
-        !training.is_empty(),
-        "unit {unit}: --extend needs field-like activations at the calibration set points to fit the terms' coefficients on (none found)"
-    );
+    if training.is_empty() {
+        let _ = writeln!(
+            md,
+            "Chosen terms: {}. Their coefficients need field-like activations at the calibration set points (other off-times, supply voltages, orientations: where the terms' inputs vary apart from the table's) and this campaign has none: record some (`gyrodrift simulate --field`) and run again.\n",
+            plan.terms.iter().map(|t| t.candidate.as_str()).collect::<Vec<_>>().join(", ")
+        );
+        return Ok(md);
+    }
     let Extended { tables, .. } = extend(base, &plan, calibration, training, settings, ROUNDS)?;
     let _ = writeln!(
         md,
