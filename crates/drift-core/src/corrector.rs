@@ -168,8 +168,12 @@ impl<S: Copy + Default> CorrectorState<S> {
         M: Model,
         M::Axis: AxisModel<State = S>,
     {
+        if !self.powered_on {
+            return not_powered_on(sample);
+        }
         let mut output = Output::default();
         let settings = model.settings();
+        let celsius_per_raw = settings.celsius_per_raw();
         let lanes = self
             .axes
             .iter_mut()
@@ -180,14 +184,18 @@ impl<S: Copy + Default> CorrectorState<S> {
             .zip(output.bias_dps.iter_mut())
             .zip(output.flags.iter_mut());
         for ((((((state, axis), rate), raw), corrected), bias), flags) in lanes {
-            (*corrected, *bias, *flags) = if self.powered_on {
-                correct_axis(axis, settings, state, sample.since_power_on_ms, rate, raw)
-            } else {
-                (rate, 0.0, Flags::NOT_POWERED_ON | rate_flag(rate))
-            };
+            (*corrected, *bias, *flags) = correct_axis(
+                axis,
+                settings,
+                celsius_per_raw,
+                state,
+                sample.since_power_on_ms,
+                rate,
+                raw,
+            );
         }
         let extension = model.extension();
-        if self.powered_on && !extension.is_empty() {
+        if !extension.is_empty() {
             // The extra terms read the last good temperature of every axis (a faulty reading is
             // held there, like the paper's drift).
             let mut inputs = TermInputs {
@@ -201,21 +209,20 @@ impl<S: Copy + Default> CorrectorState<S> {
                 .zip(&mut inputs.celsius)
                 .zip(&mut inputs.rise_celsius)
             {
-                *celsius = settings.celsius(state.last_raw);
-                *rise = (state.last_raw - state.switch_on_raw) / settings.raw_per_celsius;
+                *celsius = settings.celsius_with(state.last_raw, celsius_per_raw);
+                *rise = (state.last_raw - state.switch_on_raw) * celsius_per_raw;
             }
-            let values = self.extension.values(extension, &inputs);
-            let extra = extension.bias(&values);
-            for ((((state, extra), values), corrected), (bias, flags)) in self
+            let extra = self.extension.bias(extension, &inputs);
+            for (((state, extra), corrected), (bias, flags)) in self
                 .axes
                 .iter_mut()
                 .zip(extra)
-                .zip(&values)
                 .zip(&mut output.corrected_dps)
                 .zip(output.bias_dps.iter_mut().zip(&mut output.flags))
             {
-                let used = values.iter().take(extension.terms.len());
-                if extra.is_finite() && used.clone().all(|v| v.is_finite()) {
+                // A non-finite term value makes the sum non-finite (even times a zero
+                // coefficient), so this one check covers every term.
+                if extra.is_finite() {
                     state.extension_dps = extra;
                 } else {
                     *flags |= Flags::EXTENSION_INPUT_INVALID;
@@ -228,6 +235,22 @@ impl<S: Copy + Default> CorrectorState<S> {
     }
 }
 
+/// Before `power_on`: the rates pass through, flagged. Kept out of line: firmware calls it only
+/// by mistake.
+#[cold]
+#[inline(never)]
+fn not_powered_on(sample: &Sample) -> Output {
+    let mut output = Output {
+        corrected_dps: sample.rate_dps,
+        ..Output::default()
+    };
+    for (flags, rate) in output.flags.iter_mut().zip(sample.rate_dps) {
+        *flags = Flags::NOT_POWERED_ON | rate_flag(rate);
+    }
+    output
+}
+
+#[inline(always)]
 fn rate_flag(rate: f32) -> Flags {
     if rate.is_finite() {
         Flags::NONE
@@ -237,10 +260,11 @@ fn rate_flag(rate: f32) -> Flags {
 }
 
 /// The part every model shares: sensor-fault checks, rise, hold of the last good drift, flags.
-#[inline]
+#[inline(always)]
 fn correct_axis<A: AxisModel>(
     axis: &A,
     settings: &Settings,
+    celsius_per_raw: f32,
     state: &mut AxisState<A::State>,
     since_power_on_ms: u32,
     rate: f32,
@@ -259,12 +283,12 @@ fn correct_axis<A: AxisModel>(
         if stuck {
             flags |= Flags::TEMPERATURE_STUCK;
         } else {
-            let rise = (raw - state.switch_on_raw) / settings.raw_per_celsius;
+            let rise = (raw - state.switch_on_raw) * celsius_per_raw;
             let (drift, model_flags) = axis.drift(
                 settings,
                 &mut state.model,
                 since_power_on_ms,
-                settings.celsius(raw),
+                settings.celsius_with(raw, celsius_per_raw),
                 rise,
             );
             flags |= model_flags;

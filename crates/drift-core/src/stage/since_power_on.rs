@@ -1,8 +1,6 @@
 //! Stage 1: time since switch-on. Locates the current time among the table's reference times.
 
 use crate::error::saturating_u8;
-use crate::interp::lerp;
-use crate::table::CurvePoint;
 
 /// Where the current time since switch-on falls among the reference times, shared by every curve of
 /// an axis (the curves are all sampled at the same reference times).
@@ -31,26 +29,64 @@ pub struct TimePosition {
     pub past_last: bool,
 }
 
-impl TimePosition {
+/// One stretch of time that shares its reference-time indices: before the first reference time,
+/// between two reference times (the lower one included), or from the last one on. Located once
+/// when time enters it and kept in the axis state, so that a sample in the same stretch — almost
+/// every sample — costs a subtraction, a comparison and a multiplication instead of a search and
+/// a division.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Segment {
+    /// Whether the fields below describe a located segment (a default `Segment` is empty).
+    pub valid: bool,
+    /// What the segment is.
+    pub kind: SegmentKind,
+    /// Reference-time indices (low, high) of the segment's ends.
+    pub lo: u8,
+    /// See `lo`.
+    pub hi: u8,
+    /// First millisecond of the segment.
+    pub start_ms: u32,
+    /// Last millisecond of the segment, as an offset from `start_ms` (inclusive, so the segment
+    /// from the last reference time on can reach `u32::MAX`).
+    pub last_offset_ms: u32,
+    /// Reciprocal of the segment's length in ms (`1 / first reference time` before it, 0 from the
+    /// last one on): the per-sample division becomes a multiplication.
+    pub per_ms: f32,
+}
+
+/// Which stretch of time a [`Segment`] covers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SegmentKind {
+    /// Before the first reference time: rises scaled, `k` held.
+    #[default]
+    BeforeFirst,
+    /// Between two reference times.
+    Between,
+    /// At or after the last reference time: held, flagged when past it.
+    FromLast,
+}
+
+impl Segment {
     /// Locates `since_power_on_ms` among strictly increasing `reference_ms`, starting the search at
-    /// `hint` (the previous sample's segment, updated here): time moves forward a millisecond at a
-    /// time, so the search usually ends where it starts.
-    ///
-    /// Time stays an integer (milliseconds) until it is made relative to the bracketing reference
-    /// time, so hours of operation lose no resolution.
+    /// `hint` (the previous segment's low index, updated here): time moves forward, so the search
+    /// usually ends one step from where it starts. A missing reference time reads as `u32::MAX`
+    /// (only for tables that skipped validation).
     pub fn locate(reference_ms: &[u32], since_power_on_ms: u32, hint: &mut u8) -> Self {
         let last = reference_ms.len().saturating_sub(1);
         let at = |j: usize| reference_ms.get(j).copied().unwrap_or(u32::MAX);
         let first = at(0);
         if since_power_on_ms < first {
             *hint = 0;
-            return TimePosition {
+            return Self {
+                valid: true,
+                kind: SegmentKind::BeforeFirst,
                 lo: 0,
                 hi: 0,
-                fraction: 0.0,
-                // Both below 2^24 in practice (reference times are seconds to minutes), so exact.
-                rise_scale: since_power_on_ms as f32 / first as f32,
-                past_last: false,
+                start_ms: 0,
+                // `first` > `since_power_on_ms` ≥ 0 here.
+                last_offset_ms: first.saturating_sub(1),
+                // Reference times are seconds to minutes: below 2^24, so exact in f32.
+                per_ms: 1.0 / first as f32,
             };
         }
         let mut lo = usize::from(*hint).min(last);
@@ -61,36 +97,93 @@ impl TimePosition {
             lo = lo.saturating_add(1);
         }
         *hint = saturating_u8(lo);
-        let offset = since_power_on_ms.saturating_sub(at(lo));
+        let start_ms = at(lo);
         if lo == last {
-            return TimePosition {
-                lo,
-                hi: lo,
-                fraction: 0.0,
-                rise_scale: 1.0,
-                past_last: offset > 0,
+            return Self {
+                valid: true,
+                kind: SegmentKind::FromLast,
+                lo: saturating_u8(lo),
+                hi: saturating_u8(lo),
+                start_ms,
+                last_offset_ms: u32::MAX.saturating_sub(start_ms),
+                per_ms: 0.0,
             };
         }
         let hi = lo.saturating_add(1);
-        // Offsets within one segment are far below 2^24 ms, so the conversion is exact.
-        let span = at(hi).saturating_sub(at(lo));
-        TimePosition {
-            lo,
-            hi: if offset > 0 { hi } else { lo },
-            fraction: offset as f32 / span as f32,
-            rise_scale: 1.0,
-            past_last: false,
+        let span = at(hi).saturating_sub(start_ms);
+        Self {
+            valid: true,
+            kind: SegmentKind::Between,
+            lo: saturating_u8(lo),
+            hi: saturating_u8(hi),
+            start_ms,
+            last_offset_ms: span.saturating_sub(1),
+            // Spans are far below 2^24 ms, so exact in f32.
+            per_ms: 1.0 / span as f32,
         }
     }
 
-    /// A curve's point (rise and `k`) at this time, by linear interpolation between reference
-    /// times; `None` if the curve is too short (only for tables that skipped validation).
+    /// The position of `since_power_on_ms` if it lies in this segment.
     #[inline(always)]
-    pub fn point(&self, points: &[CurvePoint]) -> Option<CurvePoint> {
-        let (lo, hi) = (points.get(self.lo)?, points.get(self.hi)?);
-        Some(CurvePoint {
-            rise_celsius: lerp(lo.rise_celsius, hi.rise_celsius, self.fraction),
-            k_dps_per_celsius: lerp(lo.k_dps_per_celsius, hi.k_dps_per_celsius, self.fraction),
+    pub fn position(&self, since_power_on_ms: u32) -> Option<TimePosition> {
+        // Unsigned: a time before `start_ms` wraps to a large offset and misses too.
+        let offset = since_power_on_ms.wrapping_sub(self.start_ms);
+        if !self.valid || offset > self.last_offset_ms {
+            return None;
+        }
+        // Offsets within one segment are far below 2^24 ms, so the conversion is exact (and
+        // before the first reference time the offset is the time since switch-on).
+        let scaled = offset as f32 * self.per_ms;
+        let (fraction, rise_scale) = match self.kind {
+            SegmentKind::BeforeFirst => (0.0, scaled),
+            // From the last reference time on `per_ms` is 0, so the fraction is 0.
+            SegmentKind::Between | SegmentKind::FromLast => (scaled, 1.0),
+        };
+        Some(TimePosition {
+            lo: usize::from(self.lo),
+            hi: usize::from(self.hi),
+            fraction,
+            rise_scale,
+            past_last: self.kind == SegmentKind::FromLast && offset > 0,
+        })
+    }
+}
+
+impl TimePosition {
+    /// Locates `since_power_on_ms` among strictly increasing `reference_ms`, starting the search at
+    /// `hint` (the previous sample's segment, updated here).
+    ///
+    /// Time stays an integer (milliseconds) until it is made relative to the bracketing reference
+    /// time, so hours of operation lose no resolution.
+    pub fn locate(reference_ms: &[u32], since_power_on_ms: u32, hint: &mut u8) -> Self {
+        Self::locate_cached(
+            reference_ms,
+            since_power_on_ms,
+            hint,
+            &mut Segment::default(),
+        )
+    }
+
+    /// As [`Self::locate`], reusing `segment` when the time still lies in it and refilling it
+    /// otherwise. Cached or fresh, a time gives the same bits: both go through
+    /// [`Segment::position`].
+    #[inline(always)]
+    pub fn locate_cached(
+        reference_ms: &[u32],
+        since_power_on_ms: u32,
+        hint: &mut u8,
+        segment: &mut Segment,
+    ) -> Self {
+        if let Some(position) = segment.position(since_power_on_ms) {
+            return position;
+        }
+        *segment = Segment::locate(reference_ms, since_power_on_ms, hint);
+        segment.position(since_power_on_ms).unwrap_or(TimePosition {
+            lo: 0,
+            hi: 0,
+            fraction: f32::NAN,
+            rise_scale: f32::NAN,
+            past_last: false,
         })
     }
 }
@@ -113,8 +206,9 @@ mod tests {
     fn between_and_on_reference_times() {
         let p = TimePosition::locate(&REFS, 3_500, &mut 2);
         assert_eq!((p.lo, p.hi, p.fraction, p.rise_scale), (0, 1, 0.5, 1.0));
+        // On a reference time: the segment it starts, at fraction 0.
         let p = TimePosition::locate(&REFS, 5_000, &mut 0);
-        assert_eq!((p.lo, p.hi, p.fraction), (1, 1, 0.0));
+        assert_eq!((p.lo, p.hi, p.fraction), (1, 2, 0.0));
         let p = TimePosition::locate(&REFS, 30_000, &mut 1);
         assert_eq!((p.lo, p.hi, p.fraction, p.past_last), (2, 2, 0.0, false));
     }
@@ -124,6 +218,25 @@ mod tests {
         for ms in [30_001, 3_600_000, u32::MAX] {
             let p = TimePosition::locate(&REFS, ms, &mut 0);
             assert_eq!((p.lo, p.hi, p.past_last), (2, 2, true));
+        }
+    }
+
+    #[test]
+    fn a_cached_segment_gives_the_same_bits_as_a_fresh_search() {
+        let mut segment = Segment::default();
+        let mut hint = 0;
+        for ms in (0..40_000)
+            .step_by(7)
+            .chain([u32::MAX, 0, 29_999, 30_000, 1])
+        {
+            let cached = TimePosition::locate_cached(&REFS, ms, &mut hint, &mut segment);
+            let fresh = TimePosition::locate(&REFS, ms, &mut 1);
+            assert_eq!(
+                (cached.lo, cached.hi, cached.past_last),
+                (fresh.lo, fresh.hi, fresh.past_last)
+            );
+            assert_eq!(cached.fraction.to_bits(), fresh.fraction.to_bits(), "{ms}");
+            assert_eq!(cached.rise_scale.to_bits(), fresh.rise_scale.to_bits());
         }
     }
 }
