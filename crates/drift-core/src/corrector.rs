@@ -171,29 +171,23 @@ impl<S: Copy + Default> CorrectorState<S> {
         if !self.powered_on {
             return not_powered_on(sample);
         }
-        let mut output = Output::default();
         let settings = model.settings();
         let celsius_per_raw = settings.celsius_per_raw();
-        let lanes = self
-            .axes
-            .iter_mut()
-            .zip(model.axes())
-            .zip(sample.rate_dps)
-            .zip(sample.temperature_raw)
-            .zip(output.corrected_dps.iter_mut())
-            .zip(output.bias_dps.iter_mut())
-            .zip(output.flags.iter_mut());
-        for ((((((state, axis), rate), raw), corrected), bias), flags) in lanes {
-            (*corrected, *bias, *flags) = correct_axis(
-                axis,
-                settings,
-                celsius_per_raw,
-                state,
-                sample.since_power_on_ms,
-                rate,
-                raw,
-            );
-        }
+        // The three axes written out rather than a loop over zipped lanes: the loop kept its seven
+        // lane pointers on the stack and reloaded them every axis (~25 instructions per axis).
+        let [state_x, state_y, state_z] = &mut self.axes;
+        let [axis_x, axis_y, axis_z] = model.axes();
+        let [rate_x, rate_y, rate_z] = sample.rate_dps;
+        let [raw_x, raw_y, raw_z] = sample.temperature_raw;
+        let ms = sample.since_power_on_ms;
+        let x = correct_axis(axis_x, settings, celsius_per_raw, state_x, ms, rate_x, raw_x);
+        let y = correct_axis(axis_y, settings, celsius_per_raw, state_y, ms, rate_y, raw_y);
+        let z = correct_axis(axis_z, settings, celsius_per_raw, state_z, ms, rate_z, raw_z);
+        let mut output = Output {
+            corrected_dps: [x.0, y.0, z.0],
+            bias_dps: [x.1, y.1, z.1],
+            flags: [x.2, y.2, z.2],
+        };
         let extension = model.extension();
         if !extension.is_empty() {
             // The extra terms read the last good temperature of every axis (a faulty reading is

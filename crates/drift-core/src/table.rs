@@ -258,12 +258,16 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         since_power_on_ms: u32,
         rise_celsius: f32,
     ) -> (f32, Flags) {
-        let time = TimePosition::locate_cached(
+        let (time, new_segment) = TimePosition::locate_cached(
             &self.reference_ms,
             since_power_on_ms,
             &mut state.segment_hint,
             &mut state.segment,
         );
+        if new_segment {
+            // The cached knots were read at the old segment's reference times.
+            state.bracket.valid = false;
+        }
         let (k, out_of_span) = k_at(
             &self.ambients,
             &state.ambient,

@@ -101,7 +101,8 @@ fn at_time(time: &TimePosition, [lo, change]: Knots) -> CurvePoint {
 /// nearest curve's `k` is used: clamp).
 ///
 /// The bracket is the last curve whose rise does not exceed the current one. `cache` keeps the
-/// previous sample's bracket with its two curves' knots for the current reference-time segment:
+/// previous sample's bracket with its two curves' knots for the current reference-time segment
+/// (the caller empties it when the segment changes):
 /// while time stays in the segment and the rise in the bracket (almost every sample), a sample
 /// costs two time interpolations, one division and no table access. Otherwise the search walks
 /// the blended curves from the cached bracket and refills the cache. The cache only saves work: a
@@ -115,8 +116,7 @@ pub fn k_at<const R: usize, const C: usize>(
     margin_celsius: f32,
     cache: &mut BracketCache,
 ) -> (f32, bool) {
-    let key = [saturating_u8(time.lo), saturating_u8(time.hi)];
-    if cache.valid && cache.segment == key {
+    if cache.valid {
         let lower = at_time(&time, cache.knots[0]);
         let upper = at_time(&time, cache.knots[1]);
         let below = rise_celsius < lower.rise_celsius;
@@ -126,7 +126,6 @@ pub fn k_at<const R: usize, const C: usize>(
     }
     search(
         &BlendedCurves::new(ambients, ambient, time),
-        key,
         rise_celsius,
         margin_celsius,
         cache,
@@ -162,7 +161,6 @@ fn interpolate(
 #[inline(never)]
 fn search<const R: usize>(
     curves: &BlendedCurves<'_, R>,
-    key: [u8; 2],
     rise_celsius: f32,
     margin_celsius: f32,
     cache: &mut BracketCache,
@@ -189,7 +187,6 @@ fn search<const R: usize>(
     let top = lo >= last;
     *cache = BracketCache {
         valid: true,
-        segment: key,
         curve: saturating_u8(lo),
         top,
         knots: [lower_knots, upper_knots],
@@ -205,13 +202,12 @@ const MISSING: CurvePoint = CurvePoint {
 /// Stage 3's search state, kept per axis between samples: the bracketing curve and its blended
 /// knots for the current reference-time segment.
 ///
-/// Belongs to the tables and ambient it was filled with; `power_on` resets it.
+/// Belongs to the tables, ambient and reference-time segment it was filled with; `power_on` and
+/// a change of segment empty it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BracketCache {
-    /// Whether the knots below were filled.
+    /// Whether the knots below were filled (for the current segment).
     pub valid: bool,
-    /// Reference-time indices (low, high) the knots were read at.
-    pub segment: [u8; 2],
     /// Lower curve of the bracket.
     pub curve: u8,
     /// The lower curve is the last one (there is no upper curve; the rise is clamped above it).

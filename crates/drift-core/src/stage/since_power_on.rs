@@ -30,28 +30,25 @@ pub struct TimePosition {
 }
 
 /// One stretch of time that shares its reference-time indices: before the first reference time,
-/// between two reference times (the lower one included), or from the last one on. Located once
-/// when time enters it and kept in the axis state, so that a sample in the same stretch — almost
-/// every sample — costs a subtraction, a comparison and a multiplication instead of a search and
-/// a division.
+/// between two reference times (the lower one included), on the last one, or past it. Located
+/// once when time enters it and kept in the axis state, so that a sample in the same stretch —
+/// almost every sample — costs a subtraction, a comparison and a multiplication instead of a
+/// search and a division.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Segment {
-    /// Whether the fields below describe a located segment (a default `Segment` is empty).
-    pub valid: bool,
-    /// What the segment is.
-    pub kind: SegmentKind,
-    /// Reference-time indices (low, high) of the segment's ends.
-    pub lo: u8,
-    /// See `lo`.
-    pub hi: u8,
     /// First millisecond of the segment.
     pub start_ms: u32,
-    /// Last millisecond of the segment, as an offset from `start_ms` (inclusive, so the segment
-    /// from the last reference time on can reach `u32::MAX`).
-    pub last_offset_ms: u32,
+    /// Length in ms: the segment holds `start_ms ≤ t < start_ms + len_ms` (0: empty, as a
+    /// default `Segment` is; the stretch past the last reference time ends at `u32::MAX`, which
+    /// it reads as its own).
+    pub len_ms: u32,
     /// Reciprocal of the segment's length in ms (`1 / first reference time` before it, 0 from the
     /// last one on): the per-sample division becomes a multiplication.
     pub per_ms: f32,
+    /// Reference-time index of the segment's low end.
+    pub lo: u8,
+    /// What the segment is.
+    pub kind: SegmentKind,
 }
 
 /// Which stretch of time a [`Segment`] covers.
@@ -62,15 +59,18 @@ pub enum SegmentKind {
     BeforeFirst,
     /// Between two reference times.
     Between,
-    /// At or after the last reference time: held, flagged when past it.
-    FromLast,
+    /// Exactly on the last reference time.
+    OnLast,
+    /// Past the last reference time: held and flagged.
+    PastLast,
 }
 
 impl Segment {
     /// Locates `since_power_on_ms` among strictly increasing `reference_ms`, starting the search at
     /// `hint` (the previous segment's low index, updated here): time moves forward, so the search
     /// usually ends one step from where it starts. A missing reference time reads as `u32::MAX`
-    /// (only for tables that skipped validation).
+    /// (only for tables that skipped validation). Out of line: once per segment, not per sample.
+    #[inline(never)]
     pub fn locate(reference_ms: &[u32], since_power_on_ms: u32, hint: &mut u8) -> Self {
         let last = reference_ms.len().saturating_sub(1);
         let at = |j: usize| reference_ms.get(j).copied().unwrap_or(u32::MAX);
@@ -78,15 +78,12 @@ impl Segment {
         if since_power_on_ms < first {
             *hint = 0;
             return Self {
-                valid: true,
-                kind: SegmentKind::BeforeFirst,
-                lo: 0,
-                hi: 0,
                 start_ms: 0,
-                // `first` > `since_power_on_ms` ≥ 0 here.
-                last_offset_ms: first.saturating_sub(1),
+                len_ms: first,
                 // Reference times are seconds to minutes: below 2^24, so exact in f32.
                 per_ms: 1.0 / first as f32,
+                lo: 0,
+                kind: SegmentKind::BeforeFirst,
             };
         }
         let mut lo = usize::from(*hint).min(last);
@@ -98,28 +95,29 @@ impl Segment {
         }
         *hint = saturating_u8(lo);
         let start_ms = at(lo);
-        if lo == last {
-            return Self {
-                valid: true,
-                kind: SegmentKind::FromLast,
-                lo: saturating_u8(lo),
-                hi: saturating_u8(lo),
-                start_ms,
-                last_offset_ms: u32::MAX.saturating_sub(start_ms),
-                per_ms: 0.0,
-            };
-        }
-        let hi = lo.saturating_add(1);
-        let span = at(hi).saturating_sub(start_ms);
-        Self {
-            valid: true,
-            kind: SegmentKind::Between,
-            lo: saturating_u8(lo),
-            hi: saturating_u8(hi),
-            start_ms,
-            last_offset_ms: span.saturating_sub(1),
+        let (len_ms, per_ms, kind) = if lo < last {
+            let span = at(lo.saturating_add(1)).saturating_sub(start_ms);
             // Spans are far below 2^24 ms, so exact in f32.
-            per_ms: 1.0 / span as f32,
+            (span, 1.0 / span as f32, SegmentKind::Between)
+        } else if since_power_on_ms == start_ms {
+            (1, 0.0, SegmentKind::OnLast)
+        } else {
+            // Past the last reference time: from the next millisecond to the end of time.
+            let start_ms = start_ms.saturating_add(1);
+            return Self {
+                start_ms,
+                len_ms: u32::MAX.saturating_sub(start_ms).saturating_add(1),
+                per_ms: 0.0,
+                lo: saturating_u8(lo),
+                kind: SegmentKind::PastLast,
+            };
+        };
+        Self {
+            start_ms,
+            len_ms,
+            per_ms,
+            lo: saturating_u8(lo),
+            kind,
         }
     }
 
@@ -128,23 +126,35 @@ impl Segment {
     pub fn position(&self, since_power_on_ms: u32) -> Option<TimePosition> {
         // Unsigned: a time before `start_ms` wraps to a large offset and misses too.
         let offset = since_power_on_ms.wrapping_sub(self.start_ms);
-        if !self.valid || offset > self.last_offset_ms {
+        if offset >= self.len_ms {
             return None;
         }
         // Offsets within one segment are far below 2^24 ms, so the conversion is exact (and
         // before the first reference time the offset is the time since switch-on).
         let scaled = offset as f32 * self.per_ms;
-        let (fraction, rise_scale) = match self.kind {
-            SegmentKind::BeforeFirst => (0.0, scaled),
-            // From the last reference time on `per_ms` is 0, so the fraction is 0.
-            SegmentKind::Between | SegmentKind::FromLast => (scaled, 1.0),
-        };
-        Some(TimePosition {
-            lo: usize::from(self.lo),
-            hi: usize::from(self.hi),
-            fraction,
-            rise_scale,
-            past_last: self.kind == SegmentKind::FromLast && offset > 0,
+        let lo = usize::from(self.lo);
+        Some(match self.kind {
+            SegmentKind::BeforeFirst => TimePosition {
+                lo,
+                hi: lo,
+                fraction: 0.0,
+                rise_scale: scaled,
+                past_last: false,
+            },
+            SegmentKind::Between => TimePosition {
+                lo,
+                hi: lo.saturating_add(1),
+                fraction: scaled,
+                rise_scale: 1.0,
+                past_last: false,
+            },
+            SegmentKind::OnLast | SegmentKind::PastLast => TimePosition {
+                lo,
+                hi: lo,
+                fraction: 0.0,
+                rise_scale: 1.0,
+                past_last: self.kind == SegmentKind::PastLast,
+            },
         })
     }
 }
@@ -162,29 +172,31 @@ impl TimePosition {
             hint,
             &mut Segment::default(),
         )
+        .0
     }
 
     /// As [`Self::locate`], reusing `segment` when the time still lies in it and refilling it
-    /// otherwise. Cached or fresh, a time gives the same bits: both go through
-    /// [`Segment::position`].
+    /// otherwise; the second value says whether it was refilled. Cached or fresh, a time gives the
+    /// same bits: both go through [`Segment::position`].
     #[inline(always)]
     pub fn locate_cached(
         reference_ms: &[u32],
         since_power_on_ms: u32,
         hint: &mut u8,
         segment: &mut Segment,
-    ) -> Self {
+    ) -> (Self, bool) {
         if let Some(position) = segment.position(since_power_on_ms) {
-            return position;
+            return (position, false);
         }
         *segment = Segment::locate(reference_ms, since_power_on_ms, hint);
-        segment.position(since_power_on_ms).unwrap_or(TimePosition {
+        let position = segment.position(since_power_on_ms).unwrap_or(TimePosition {
             lo: 0,
             hi: 0,
             fraction: f32::NAN,
             rise_scale: f32::NAN,
             past_last: false,
-        })
+        });
+        (position, true)
     }
 }
 
@@ -229,7 +241,7 @@ mod tests {
             .step_by(7)
             .chain([u32::MAX, 0, 29_999, 30_000, 1])
         {
-            let cached = TimePosition::locate_cached(&REFS, ms, &mut hint, &mut segment);
+            let (cached, _) = TimePosition::locate_cached(&REFS, ms, &mut hint, &mut segment);
             let fresh = TimePosition::locate(&REFS, ms, &mut 1);
             assert_eq!(
                 (cached.lo, cached.hi, cached.past_last),
