@@ -180,9 +180,33 @@ impl<S: Copy + Default> CorrectorState<S> {
         let [rate_x, rate_y, rate_z] = sample.rate_dps;
         let [raw_x, raw_y, raw_z] = sample.temperature_raw;
         let ms = sample.since_power_on_ms;
-        let x = correct_axis(axis_x, settings, celsius_per_raw, state_x, ms, rate_x, raw_x);
-        let y = correct_axis(axis_y, settings, celsius_per_raw, state_y, ms, rate_y, raw_y);
-        let z = correct_axis(axis_z, settings, celsius_per_raw, state_z, ms, rate_z, raw_z);
+        let x = correct_axis(
+            axis_x,
+            settings,
+            celsius_per_raw,
+            state_x,
+            ms,
+            rate_x,
+            raw_x,
+        );
+        let y = correct_axis(
+            axis_y,
+            settings,
+            celsius_per_raw,
+            state_y,
+            ms,
+            rate_y,
+            raw_y,
+        );
+        let z = correct_axis(
+            axis_z,
+            settings,
+            celsius_per_raw,
+            state_z,
+            ms,
+            rate_z,
+            raw_z,
+        );
         let mut output = Output {
             corrected_dps: [x.0, y.0, z.0],
             bias_dps: [x.1, y.1, z.1],
