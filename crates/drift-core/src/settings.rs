@@ -72,7 +72,21 @@ impl Settings {
     }
 
     /// Converts a raw temperature reading to °C.
+    #[inline]
     pub fn celsius(&self, raw: f32) -> f32 {
-        (raw - self.raw_at_zero_celsius) / self.raw_per_celsius
+        self.celsius_with(raw, self.celsius_per_raw())
+    }
+
+    /// °C per raw unit, the reciprocal of `raw_per_celsius`: computed once per sample, so that the
+    /// conversions of every axis multiply instead of dividing.
+    #[inline]
+    pub(crate) fn celsius_per_raw(&self) -> f32 {
+        1.0 / self.raw_per_celsius
+    }
+
+    /// [`Self::celsius`] with `celsius_per_raw` already computed (the same bits).
+    #[inline]
+    pub(crate) fn celsius_with(&self, raw: f32, celsius_per_raw: f32) -> f32 {
+        (raw - self.raw_at_zero_celsius) * celsius_per_raw
     }
 }

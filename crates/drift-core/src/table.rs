@@ -8,8 +8,8 @@ use crate::flags::Flags;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
 use crate::stage::ambient::AmbientPosition;
-use crate::stage::heating::{BlendedCurves, BracketCache};
-use crate::stage::since_power_on::TimePosition;
+use crate::stage::heating::{k_at, BracketCache};
+use crate::stage::since_power_on::{Segment, TimePosition};
 use crate::AXES;
 
 /// One point of a heating-dynamics curve: where the curve stood at one reference time.
@@ -188,8 +188,10 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
 pub struct ModifiedAxisState {
     /// Stage 2's position, located at switch-on.
     pub ambient: AmbientPosition,
-    /// Stage 1's last reference-time segment.
+    /// Stage 1's last reference-time segment (where a search starts).
     pub segment_hint: u8,
+    /// Stage 1's current segment, located when time entered it.
+    pub segment: Segment,
     /// Stage 3's last bracket and its knots.
     pub bracket: BracketCache,
 }
@@ -246,7 +248,9 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
     /// blended curve by curve), heating dynamics (stage 3: the blended curves whose rises bracket the
     /// current rise). The drift is `k · rise`.
     ///
-    /// `state` comes from this axis's power-on (its ambient position); its search hints are updated.
+    /// `state` comes from this axis's power-on (its ambient position); its search hints and caches
+    /// are updated.
+    #[inline]
     pub fn correlation(
         &self,
         settings: &Settings,
@@ -254,13 +258,20 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         since_power_on_ms: u32,
         rise_celsius: f32,
     ) -> (f32, Flags) {
-        let time = TimePosition::locate(
+        let (time, new_segment) = TimePosition::locate_cached(
             &self.reference_ms,
             since_power_on_ms,
             &mut state.segment_hint,
+            &mut state.segment,
         );
-        let curves = BlendedCurves::new(&self.ambients, &state.ambient, time);
-        let (k, out_of_span) = curves.k_at(
+        if new_segment {
+            // The cached knots were read at the old segment's reference times.
+            state.bracket.valid = false;
+        }
+        let (k, out_of_span) = k_at(
+            &self.ambients,
+            &state.ambient,
+            time,
             rise_celsius,
             settings.rise_margin_celsius,
             &mut state.bracket,
