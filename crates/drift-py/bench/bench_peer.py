@@ -132,6 +132,25 @@ def correction(table: Table, samples: int, repeats: int) -> None:
         )
 
 
+def leaves(tree: Any) -> list[Any]:
+    """Every leaf of a JSON tree, in order."""
+    if isinstance(tree, dict):
+        return [v for k in sorted(tree) for v in leaves(tree[k])]
+    if isinstance(tree, list):
+        return [v for item in tree for v in leaves(item)]
+    return [tree]
+
+
+def max_ulp(got: Any, want: Any) -> int:
+    """Largest difference in float32 ulp between two tables of the same structure."""
+    g, w = leaves(got), leaves(want)
+    if len(g) != len(w):
+        return 2**31
+    a = np.array([float(v) for v in g], np.float32).view(np.int32).astype(np.int64)
+    b = np.array([float(v) for v in w], np.float32).view(np.int32).astype(np.int64)
+    return int(np.abs(a - b).max(initial=0))
+
+
 def campaign_folder(name: str, folder: Path) -> Path:
     if not (folder / "summary.json").exists():
         print(f"simulating the {name} campaign into {folder} (once) ...", flush=True)
@@ -155,9 +174,14 @@ def fitting(table: Table, folder: Path, repeats: int) -> None:
     files_s, _ = best_of(repeats, lambda: gyrodrift.fit(files))
     rust_s, rust_units = best_of(repeats, lambda: gyrodrift.fit(segments))
     numpy_s, numpy_units = best_of(repeats, lambda: peer_fit(activations))
-    same_shape = [len(u.curve_names) for u in rust_units] == [len(u.curve_names) for u in numpy_units]
+    same_shape = [u.curve_names for u in rust_units] == [u.curve_names for u in numpy_units]
     if not same_shape:
         table.failed.append("fit: the peer kept other curves")
+    worst = max(
+        max_ulp(getattr(n, model), json.loads(getattr(r, model).to_json()))
+        for r, n in zip(rust_units, numpy_units)
+        for model in ("modified", "standard", "third_order")
+    )
     ms = samples / 1e6
     table.add(
         f"fit from segments in memory, Rust (analyse + fit; {len(rust_units)} units, {ms:.1f} M samples)",
@@ -166,7 +190,7 @@ def fitting(table: Table, folder: Path, repeats: int) -> None:
     table.add(
         "fit from segments in memory, numpy peer",
         f"{numpy_s:.2f} s ({ms / numpy_s:.1f} M samples/s)",
-        f"Rust {numpy_s / rust_s:.1f}× peer",
+        f"Rust {numpy_s / rust_s:.1f}× peer (tables within {worst} ulp)",
         "≥ 10×",
         ok=numpy_s / rust_s >= 10,
     )
