@@ -31,7 +31,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 from bench_correct import ROOT, checksum, rust, stream
-from peer import Activation, PeerCorrector
+from peer import Activation, FitSettings, PeerCorrector, is_calibration
+from peer import analyse as peer_analyse
 from peer import fit as peer_fit
 
 import gyrodrift
@@ -174,6 +175,11 @@ def fitting(table: Table, folder: Path, repeats: int) -> None:
     files_s, _ = best_of(repeats, lambda: gyrodrift.fit(files))
     rust_s, rust_units = best_of(repeats, lambda: gyrodrift.fit(segments))
     numpy_s, numpy_units = best_of(repeats, lambda: peer_fit(activations))
+    # The analysis alone, one activation after another on one thread on both sides.
+    calibration = [(s, a) for s, a in zip(segments, activations) if is_calibration(a)]
+    settings = FitSettings()
+    rust_analyse_s, _ = best_of(repeats, lambda: [gyrodrift.analyse(s) for s, _ in calibration])
+    numpy_analyse_s, _ = best_of(repeats, lambda: [peer_analyse(a, settings) for _, a in calibration])
     same_shape = [u.curve_names for u in rust_units] == [u.curve_names for u in numpy_units]
     if not same_shape:
         table.failed.append("fit: the peer kept other curves")
@@ -193,6 +199,15 @@ def fitting(table: Table, folder: Path, repeats: int) -> None:
         f"Rust {numpy_s / rust_s:.1f}× peer (tables within {worst} ulp)",
         "≥ 10×",
         ok=numpy_s / rust_s >= 10,
+    )
+    table.add(
+        "analysis only, Rust (`gyrodrift.analyse` per activation, one thread)",
+        f"{rust_analyse_s:.2f} s ({ms / rust_analyse_s:.1f} M samples/s)",
+    )
+    table.add(
+        "analysis only, numpy peer",
+        f"{numpy_analyse_s:.2f} s ({ms / numpy_analyse_s:.1f} M samples/s)",
+        f"Rust {numpy_analyse_s / rust_analyse_s:.1f}× peer",
     )
     table.add(
         "read the calibration recordings only (`Recording.load`)",
