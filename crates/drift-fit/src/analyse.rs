@@ -4,7 +4,7 @@
 use drift_recording::{Segment, SegmentLabels, RAW_PER_CELSIUS};
 
 use crate::error::FitError;
-use crate::lowpass::centred_moving_average;
+use crate::lowpass::CentredAverages;
 use crate::settings::FitSettings;
 
 /// The curves of one activation, per axis, every `grid_ms` from switch-on.
@@ -110,30 +110,46 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         drift_dps: Default::default(),
         rise_celsius: Default::default(),
     };
+    // The low-passed temperature and rate of every axis, from one pass over the samples; evaluated
+    // only where they are used (the initial-bias window and the grid).
+    let [t0, t1, t2] = &segment.temperature_raw;
+    let [r0, r1, r2] = &segment.rate_dps;
+    let samples = t0
+        .iter()
+        .zip(t1)
+        .zip(t2)
+        .zip(r0.iter().zip(r1).zip(r2))
+        .map(|(((&t0, &t1), &t2), ((&r0, &r1), &r2))| {
+            [
+                f64::from(t0),
+                f64::from(t1),
+                f64::from(t2),
+                f64::from(r0),
+                f64::from(r1),
+                f64::from(r2),
+            ]
+        });
+    let averages = CentredAverages::new(samples, settings.lowpass_window_samples);
     for axis in 0..3 {
         let raw = &segment.temperature_raw[axis];
         let rate = &segment.rate_dps[axis];
         let on_raw = raw[..switch_on].iter().map(|&r| f64::from(r)).sum::<f64>() / switch_on as f64;
         out.switch_on_raw[axis] = on_raw as f32;
         out.switch_on_celsius[axis] = on_raw / RAW_PER_CELSIUS;
-        let temperature = centred_moving_average(raw, settings.lowpass_window_samples);
-        let rise: Vec<f64> = temperature
-            .iter()
-            .map(|t| (t - on_raw) / RAW_PER_CELSIUS)
-            .collect();
-        let rate_lf = centred_moving_average(rate, settings.lowpass_window_samples);
+        let rise = |i: usize| (averages.at(i, axis) - on_raw) / RAW_PER_CELSIUS;
+        let rate_lf = |i: usize| averages.at(i, 3 + axis);
         // The initial bias is where the rate would be at zero rise: the intercept of rate against
         // rise over the first seconds, which uses thousands of samples instead of the few
         // around t = 0.
+        let rise_head: Vec<f64> = (0..initial).map(rise).collect();
         let raw_rate: Vec<f64> = rate[..initial].iter().map(|&r| f64::from(r)).collect();
-        let bias0 = intercept(&rise[..initial], &raw_rate);
+        let bias0 = intercept(&rise_head, &raw_rate);
         out.initial_bias_dps[axis] = bias0;
-        out.drift_dps[axis] = rate_lf
-            .iter()
+        out.drift_dps[axis] = (0..n)
             .step_by(step)
-            .map(|g| (g - bias0) as f32)
+            .map(|i| (rate_lf(i) - bias0) as f32)
             .collect();
-        out.rise_celsius[axis] = rise.iter().step_by(step).map(|&r| r as f32).collect();
+        out.rise_celsius[axis] = (0..n).step_by(step).map(|i| rise(i) as f32).collect();
     }
     Ok(out)
 }

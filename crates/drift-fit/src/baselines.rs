@@ -57,23 +57,22 @@ fn axis_polynomial(range: [f64; 2], coefficients: &[f64]) -> PolynomialAxis {
 /// Solves the (small) least-squares or interpolation system `V c = y` in the normalised variable.
 fn solve(xs: &[f64], ys: &[f64], degree: usize) -> Vec<f64> {
     let columns = degree + 1;
-    // Normal equations accumulated in one pass: O(n · degree²), no n × degree matrix in memory.
-    let mut normal = DMatrix::<f64>::zeros(columns, columns);
+    // Normal equations accumulated in one pass: O(n · degree), no n × degree matrix in memory.
+    // Entry (r, c) is the sum of x^(r+c), so the 2·degree + 1 power sums are accumulated once (in
+    // the data's order, the same additions an entry-by-entry accumulation would make).
+    let mut power_sums = vec![0.0; 2 * columns];
     let mut rhs = DVector::<f64>::zeros(columns);
-    let mut powers = vec![0.0; 2 * columns];
     for (&x, &y) in xs.iter().zip(ys) {
         let mut p = 1.0;
-        for power in powers.iter_mut() {
-            *power = p;
+        for (k, sum) in power_sums.iter_mut().enumerate() {
+            if k < columns {
+                rhs[k] += p * y;
+            }
+            *sum += p;
             p *= x;
         }
-        for r in 0..columns {
-            rhs[r] += powers[r] * y;
-            for c in 0..columns {
-                normal[(r, c)] += powers[r + c];
-            }
-        }
     }
+    let normal = DMatrix::<f64>::from_fn(columns, columns, |r, c| power_sums[r + c]);
     normal
         .lu()
         .solve(&rhs)

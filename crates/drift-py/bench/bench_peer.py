@@ -1,0 +1,256 @@
+"""Rust vs a plain numpy peer (bench/peer.py), side by side in one run on the same data (issue 7).
+
+    python crates/drift-py/bench/bench_peer.py [--samples 2000000] [--repeats 3] [--campaign default]
+
+Correction: the deterministic stream of bench_correct.py through the paper's model and both
+polynomial baselines (testdata/vectors.json) — pure Rust (`cargo run --release --example
+correct_throughput`, writing into a buffer allocated once), the binding (`Corrector.correct_batch`,
+float32 into `out=` arrays) and the numpy peer; all three must give the same output bits (checksum).
+
+Fitting: a simulated campaign (the paper's default campaign unless `--campaign small`; simulated
+once into `--campaign-dir` and reused): the Rust fit (`gyrodrift.fit` on the segments in memory:
+analyse + fit, rayon on every core) vs the numpy peer's (same segments, as numpy arrays; one core,
+as numpy is); then the fit from the files (read + analyse + fit, `gyrodrift.fit(files)`) vs reading
+the same files alone (`gyrodrift.Recording.load`).
+
+Prints every figure with its ratio, best of `--repeats`; exits 1 if outputs differ or a floor fails:
+Rust batch correction ≥ 10× the peer, binding ≥ 50 % of pure Rust, Rust fit ≥ 10× the peer, fit from
+files < 3× reading them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+from bench_correct import ROOT, checksum, rust, stream
+from peer import Activation, FitSettings, PeerCorrector, is_calibration
+from peer import analyse as peer_analyse
+from peer import fit as peer_fit
+
+import gyrodrift
+
+T = TypeVar("T")
+
+SMALL = {
+    "units": 1,
+    "set_points_celsius": [30.0, 40.0],
+    "protocol": {"intervals_min": [1.0, 20.0], "activations": 3, "activation_s": 60.0, "repeats": 2},
+    "truth_bias": "aux_rate",
+}
+DEFAULT = {"truth_bias": "aux_rate"}  # the paper's campaign; ground truth (never read) at 100 Hz
+
+
+def best_of(repeats: int, run: Callable[[], T]) -> tuple[float, T]:
+    """Best wall time of `repeats` runs (seconds) and the last result."""
+    best, result = float("inf"), None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = run()
+        best = min(best, time.perf_counter() - start)
+    assert result is not None
+    return best, result
+
+
+class Table:
+    """Rows of (what, figure, ratio, floor) printed as Markdown; remembers failed floors."""
+
+    def __init__(self) -> None:
+        self.rows: list[tuple[str, str, str, str]] = []
+        self.failed: list[str] = []
+
+    def add(self, what: str, figure: str, ratio: str = "", floor: str = "", ok: bool = True) -> None:
+        self.rows.append((what, figure, ratio, floor + ("" if ok else " **FAILED**")))
+        if not ok:
+            self.failed.append(what)
+
+    def print(self) -> None:
+        print("| what | figure | ratio | floor |")
+        print("|---|---:|---:|---|")
+        for row in self.rows:
+            print("| " + " | ".join(row) + " |")
+
+
+def correction(table: Table, samples: int, repeats: int) -> None:
+    vectors = json.loads((ROOT / "testdata" / "vectors.json").read_text())
+    models = {
+        m["name"]: (
+            gyrodrift.ModifiedTables if m["kind"] == "modified" else gyrodrift.PolynomialTables
+        ).from_image(bytes.fromhex(m["image_hex"]))
+        for m in vectors["models"]
+    }
+    reference = rust(samples, repeats)
+    times, rate, temperature = stream(samples)
+    out = (
+        np.zeros((samples, 3), np.float32),
+        np.zeros((samples, 3), np.float32),
+        np.zeros((samples, 3), np.uint16),
+    )
+    for name, model in models.items():
+        rust_rate, _fresh, rust_check = reference[name]
+
+        def binding(model: Any = model) -> int:
+            corrector = gyrodrift.Corrector(model)
+            corrector.power_on(temperature[0])
+            return checksum(*corrector.correct_batch(times, rate, temperature, out=out))
+
+        def numpy(model: Any = model) -> int:
+            corrector = PeerCorrector(model)
+            corrector.power_on(temperature[0])
+            return checksum(*corrector.correct_batch(times, rate, temperature))
+
+        binding_s, binding_check = best_of(repeats, binding)
+        numpy_s, numpy_check = best_of(repeats, numpy)
+        same = rust_check == binding_check == numpy_check
+        if not same:
+            table.failed.append(
+                f"{name}: outputs differ (checksums {rust_check:08x} {binding_check:08x} {numpy_check:08x})"
+            )
+        ms = samples / 1e6
+        rust_vs_numpy = rust_rate / (samples / numpy_s)
+        binding_vs_rust = (samples / binding_s) / rust_rate
+        table.add(f"correct, {name}: pure Rust (`correct_block`)", f"{rust_rate / 1e6:.1f} M samples/s")
+        table.add(
+            f"correct, {name}: binding (`correct_batch`, f32, `out=`)",
+            f"{ms / binding_s:.1f} M samples/s",
+            f"{binding_vs_rust:.2f}× pure Rust",
+            "≥ 0.5×" if name == "modified" else "",
+            ok=binding_vs_rust >= 0.5 or name != "modified",
+        )
+        table.add(
+            f"correct, {name}: numpy peer",
+            f"{ms / numpy_s:.2f} M samples/s",
+            f"Rust {rust_vs_numpy:.0f}× peer" + ("" if same else " (OUTPUTS DIFFER)"),
+            "≥ 10×",
+            ok=rust_vs_numpy >= 10 and same,
+        )
+
+
+def leaves(tree: Any) -> list[Any]:
+    """Every leaf of a JSON tree, in order."""
+    if isinstance(tree, dict):
+        return [v for k in sorted(tree) for v in leaves(tree[k])]
+    if isinstance(tree, list):
+        return [v for item in tree for v in leaves(item)]
+    return [tree]
+
+
+def max_ulp(got: Any, want: Any) -> int:
+    """Largest difference in float32 ulp between two tables of the same structure."""
+    g, w = leaves(got), leaves(want)
+    if len(g) != len(w):
+        return 2**31
+    a = np.array([float(v) for v in g], np.float32).view(np.int32).astype(np.int64)
+    b = np.array([float(v) for v in w], np.float32).view(np.int32).astype(np.int64)
+    return int(np.abs(a - b).max(initial=0))
+
+
+def campaign_folder(name: str, folder: Path) -> Path:
+    if not (folder / "summary.json").exists():
+        print(f"simulating the {name} campaign into {folder} (once) ...", flush=True)
+        gyrodrift.simulate(folder, SMALL if name == "small" else DEFAULT)
+    return folder
+
+
+def fitting(table: Table, folder: Path, repeats: int) -> None:
+    files = sorted((folder / "recordings").glob("*.mcap"))
+    calibration_files = [
+        f
+        for f in files
+        if (m := gyrodrift.Recording.read_metadata(f)).get("series_kind") == "protocol"
+        and float(m["set_point_celsius"]) in (30.0, 40.0)
+    ]
+    read_s, recordings = best_of(repeats, lambda: [gyrodrift.Recording.load(f) for f in calibration_files])
+    segments = [s for r in recordings for s in r.segments]
+    samples = sum(len(s) for s in segments)
+    activations = [Activation.of(s) for s in segments]  # numpy arrays, outside the timing
+    del recordings
+    files_s, _ = best_of(repeats, lambda: gyrodrift.fit(files))
+    rust_s, rust_units = best_of(repeats, lambda: gyrodrift.fit(segments))
+    numpy_s, numpy_units = best_of(repeats, lambda: peer_fit(activations))
+    # The analysis alone, one activation after another on one thread on both sides.
+    calibration = [(s, a) for s, a in zip(segments, activations) if is_calibration(a)]
+    settings = FitSettings()
+    rust_analyse_s, _ = best_of(repeats, lambda: [gyrodrift.analyse(s) for s, _ in calibration])
+    numpy_analyse_s, _ = best_of(repeats, lambda: [peer_analyse(a, settings) for _, a in calibration])
+    same_shape = [u.curve_names for u in rust_units] == [u.curve_names for u in numpy_units]
+    if not same_shape:
+        table.failed.append("fit: the peer kept other curves")
+    worst = max(
+        max_ulp(getattr(n, model), json.loads(getattr(r, model).to_json()))
+        for r, n in zip(rust_units, numpy_units)
+        for model in ("modified", "standard", "third_order")
+    )
+    ms = samples / 1e6
+    table.add(
+        f"fit from segments in memory, Rust (analyse + fit; {len(rust_units)} units, {ms:.1f} M samples)",
+        f"{rust_s:.2f} s ({ms / rust_s:.1f} M samples/s)",
+    )
+    table.add(
+        "fit from segments in memory, numpy peer",
+        f"{numpy_s:.2f} s ({ms / numpy_s:.1f} M samples/s)",
+        f"Rust {numpy_s / rust_s:.1f}× peer (tables within {worst} ulp)",
+        "≥ 10×",
+        ok=numpy_s / rust_s >= 10,
+    )
+    table.add(
+        "analysis only, Rust (`gyrodrift.analyse` per activation, one thread)",
+        f"{rust_analyse_s:.2f} s ({ms / rust_analyse_s:.1f} M samples/s)",
+    )
+    table.add(
+        "analysis only, numpy peer",
+        f"{numpy_analyse_s:.2f} s ({ms / numpy_analyse_s:.1f} M samples/s)",
+        f"Rust {numpy_analyse_s / rust_analyse_s:.1f}× peer",
+    )
+    table.add(
+        "read the calibration recordings only (`Recording.load`)",
+        f"{read_s:.2f} s ({ms / read_s:.1f} M samples/s)",
+    )
+    table.add(
+        "fit from the files (`gyrodrift.fit(files)`: read + analyse + fit)",
+        f"{files_s:.2f} s",
+        f"{files_s / read_s:.2f}× read only",
+        "< 3×",
+        ok=files_s / read_s < 3,
+    )
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--samples", type=int, default=2_000_000, help="correction stream length")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--campaign", choices=["default", "small"], default="default")
+    parser.add_argument("--campaign-dir", type=Path, help="default: target/bench_peer/<campaign>")
+    parser.add_argument("--skip-fit", action="store_true")
+    parser.add_argument("--skip-correct", action="store_true")
+    args = parser.parse_args()
+    print(
+        f"gyrodrift {gyrodrift.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}, "
+        f"{os.cpu_count()} CPUs, load average at start {os.getloadavg()[0]:.2f}"
+    )
+    table = Table()
+    if not args.skip_correct:
+        print(f"correction: {args.samples:,} samples, best of {args.repeats}", flush=True)
+        correction(table, args.samples, args.repeats)
+    if not args.skip_fit:
+        folder = campaign_folder(
+            args.campaign, args.campaign_dir or ROOT / "target" / "bench_peer" / args.campaign
+        )
+        print(f"fitting: the {args.campaign} campaign in {folder}, best of {args.repeats}", flush=True)
+        fitting(table, folder, args.repeats)
+    print(f"load average at end {os.getloadavg()[0]:.2f}\n")
+    table.print()
+    for what in table.failed:
+        print(f"FAILED: {what}")
+    return 1 if table.failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
