@@ -55,13 +55,26 @@ def stream(n: int, switch_on: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     return times, rate, temperature
 
 
-def same_bits(a: np.ndarray, b: np.ndarray) -> None:
+# drift-core's per-sample path multiplies by reciprocals it caches per reference-time segment and
+# keeps stage-3 knots as point + change (for the Cortex-M4's instruction budget); the peer divides
+# and interpolates the textbook way. Both are f32: they agree to rounding, far below the noise
+# floor (~1e-3 °/s). Flags, NaN/inf positions and the polynomial baselines stay exact.
+ROUNDING_DPS = 1e-6
+
+
+def same_values(a: np.ndarray, b: np.ndarray, exact: bool) -> None:
     assert a.dtype == b.dtype and a.shape == b.shape
-    if a.dtype == np.float32:
-        both_nan = np.isnan(a) & np.isnan(b)
-        assert np.array_equal(a.view(np.uint32)[~both_nan], b.view(np.uint32)[~both_nan])
-    else:
+    if a.dtype != np.float32:
         assert np.array_equal(a, b)
+        return
+    both_nan = np.isnan(a) & np.isnan(b)
+    if exact:
+        assert np.array_equal(a.view(np.uint32)[~both_nan], b.view(np.uint32)[~both_nan])
+        return
+    assert np.array_equal(np.isfinite(a), np.isfinite(b))
+    finite = np.isfinite(a)
+    assert np.array_equal(a[~finite & ~both_nan], b[~finite & ~both_nan])  # same infinities
+    assert np.max(np.abs(a[finite].astype(np.float64) - b[finite]), initial=0.0) <= ROUNDING_DPS
 
 
 @pytest.mark.parametrize("name", ["modified", "standard", "third_order"])
@@ -82,7 +95,7 @@ def test_correction_matches_rust(
         got = numpy.correct_batch(times[block], rate[block], temperature[block])
         want = rust.correct_batch(times[block], rate[block], temperature[block])
         for g, w in zip(got, want):
-            same_bits(g, w)
+            same_values(g, w, exact=name != "modified")
     # The test exercised what it claims to.
     flags = want[2]
     for flag in (
