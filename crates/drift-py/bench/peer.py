@@ -123,7 +123,8 @@ class PeerCorrector:
         self.axes: list[_ModifiedAxis | _PolynomialAxis] = []
 
     def _celsius(self, raw: Any) -> Any:
-        return (raw - self.raw_at_zero) / self.raw_per_celsius
+        # drift-core multiplies by the f32 reciprocal (computed once per sample, not divided per axis).
+        return (raw - self.raw_at_zero) * (F32(1.0) / self.raw_per_celsius)
 
     def power_on(self, switch_on_raw: Sequence[float] | F32Array) -> tuple[int, int, int]:
         raw = np.asarray(switch_on_raw, dtype=np.float32)
@@ -291,7 +292,7 @@ class PeerCorrector:
             live = np.flatnonzero(good & ~stuck)
             live_raw = raw[live]
             if isinstance(axis, _ModifiedAxis):
-                rise = (live_raw - self.switch_on_raw[a]) / self.raw_per_celsius
+                rise = (live_raw - self.switch_on_raw[a]) * (F32(1.0) / self.raw_per_celsius)
                 drift, model_flags = self._drift_modified(axis, since_power_on_ms[live], rise)
                 initial_bias = axis.initial_bias
             else:

@@ -39,8 +39,10 @@ def restated(tables: dict, switch_on_raw: np.ndarray, rate: np.ndarray, temperat
     )
     corrected, bias, flags = np.empty_like(rate), np.empty_like(rate), np.zeros(rate.shape, np.uint16)
     for a, axis in enumerate(tables["axes"]):
-        on, on_outside = evaluate(axis, (switch_on_raw[a : a + 1] - raw0) / rpc, margin)
-        value, outside = evaluate(axis, (temperature[:, a] - raw0) / rpc, margin)
+        # drift-core converts with the f32 reciprocal of the scale (one division per sample).
+        per = f32(1.0) / rpc
+        on, on_outside = evaluate(axis, (switch_on_raw[a : a + 1] - raw0) * per, margin)
+        value, outside = evaluate(axis, (temperature[:, a] - raw0) * per, margin)
         bias[:, a] = on[0] + (value - on[0])
         corrected[:, a] = rate[:, a] - bias[:, a]
         flags[:, a] = np.where(outside, Flags.TEMPERATURE_OUT_OF_RANGE.value, 0)
