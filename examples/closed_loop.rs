@@ -19,9 +19,8 @@ use std::path::Path;
 use anyhow::Context;
 use drift_fit::analyse::analyse;
 use drift_fit::diagnose::{diagnose, series, AxisDiagnosis};
-use drift_fit::evaluate::switch_on_raw;
+use drift_fit::evaluate::{self, switch_on_raw};
 use drift_fit::extend::{correct_with_terms, extend, TermPlan};
-use drift_fit::lowpass::centred_moving_average;
 use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{read_recording, Segment, SeriesKind};
 use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, UnitModel};
@@ -129,20 +128,10 @@ fn is(set_point: f64, value: f64) -> bool {
     (set_point - value).abs() < 1e-6
 }
 
-/// (max − min, RMS) of the 1-s mean of each axis, `offset` subtracted first.
-fn metric(rates: &[Vec<f32>; 3], window: usize, offset: [f64; 3]) -> [(f64, f64); 3] {
-    std::array::from_fn(|a| {
-        let low = centred_moving_average(&rates[a], window);
-        let (lo, hi) = low
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-                (l.min(v), h.max(v))
-            });
-        let rms = (low.iter().map(|v| (v - offset[a]).powi(2)).sum::<f64>()
-            / low.len().max(1) as f64)
-            .sqrt();
-        (hi - lo, rms)
-    })
+/// (max − min, RMS) of the 1-s mean of each axis (the evaluation's own metric).
+fn metric(rates: &[Vec<f32>; 3], window: usize) -> [(f64, f64); 3] {
+    let (drift, rms) = evaluate::metric(rates, window);
+    std::array::from_fn(|a| (drift[a], rms[a]))
 }
 
 fn mean(values: &[f64]) -> f64 {
@@ -241,14 +230,9 @@ fn run(
         let plain = metric(
             &correct_with_terms(&base.modified, &plan, segment, on),
             window,
-            [0.0; 3],
         );
         let ext = match &extended {
-            Some(e) => metric(
-                &correct_with_terms(&e.tables, &e.plan, segment, on),
-                window,
-                [0.0; 3],
-            ),
+            Some(e) => metric(&correct_with_terms(&e.tables, &e.plan, segment, on), window),
             None => plain,
         };
         for a in 0..3 {
@@ -277,7 +261,13 @@ fn run(
     });
     let mut floor: [Vec<(f64, f64)>; 3] = Default::default();
     for s in &twin_field {
-        let m = metric(&s.rate_dps, window, offset);
+        let centred: [Vec<f32>; 3] = std::array::from_fn(|a| {
+            s.rate_dps[a]
+                .iter()
+                .map(|&v| (f64::from(v) - offset[a]) as f32)
+                .collect()
+        });
+        let m = metric(&centred, window);
         for a in 0..3 {
             floor[a].push(m[a]);
         }

@@ -9,9 +9,8 @@ use std::path::Path;
 
 use drift_core::blob;
 use drift_fit::diagnose::AxisDiagnosis;
-use drift_fit::evaluate::switch_on_raw;
+use drift_fit::evaluate::{self, switch_on_raw};
 use drift_fit::extend::{correct_with_terms, extend, Extended, TermPlan};
-use drift_fit::lowpass::centred_moving_average;
 use drift_fit::{FitSettings, FittedUnit};
 use drift_recording::Segment;
 
@@ -36,18 +35,10 @@ pub struct Roles<'a> {
     pub validation: Vec<&'a Segment>,
 }
 
-/// (max − min, RMS) of the 1-s mean of each axis.
+/// Per axis, (max − min, RMS) of the 1-s mean of the corrected rate.
 fn metric(rates: &[Vec<f32>; 3], window: usize) -> Metrics {
-    std::array::from_fn(|a| {
-        let low = centred_moving_average(&rates[a], window);
-        let (lo, hi) = low
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-                (l.min(v), h.max(v))
-            });
-        let rms = (low.iter().map(|v| v * v).sum::<f64>() / low.len().max(1) as f64).sqrt();
-        (hi - lo, rms)
-    })
+    let (drift, rms) = evaluate::metric(rates, window);
+    std::array::from_fn(|a| (drift[a], rms[a]))
 }
 
 /// Fits the extended model of one unit and writes its tables and the before/after table.

@@ -68,7 +68,9 @@ pub struct ActivationResult {
     pub models: Vec<ModelResult>,
 }
 
-fn metric(rates: &[Vec<f32>; 3], window: usize) -> ([f64; 3], [f64; 3]) {
+/// Per axis, the paper's drift metric (max − min of the low-passed rate) and the RMS of the
+/// low-passed rate, with a `window`-sample centred moving average.
+pub fn metric(rates: &[Vec<f32>; 3], window: usize) -> ([f64; 3], [f64; 3]) {
     let mut drift = [0.0; 3];
     let mut rms = [0.0; 3];
     for axis in 0..3 {
@@ -106,6 +108,17 @@ pub fn switch_on_raw(segment: &Segment, settings: &FitSettings) -> [f32; 3] {
     })
 }
 
+/// Sample `i` of `segment` as the firmware sees it: time in ms, rates, temperature readings (a
+/// dropout reads as NaN).
+pub fn sample_at(segment: &Segment, i: usize) -> Sample {
+    let rate_hz = u64::from(segment.sample_rate_hz.max(1));
+    Sample {
+        since_power_on_ms: (u64::from(segment.since_power_on[i]) * 1000 / rate_hz) as u32,
+        rate_dps: [0, 1, 2].map(|a| segment.rate_dps[a][i]),
+        temperature_raw: [0, 1, 2].map(|a| temperature_reading(segment.temperature_raw[a][i])),
+    }
+}
+
 /// Corrects a whole activation with one model; returns the corrected rates and flag unions.
 pub fn correct_segment<M: Model>(
     model: &M,
@@ -131,17 +144,8 @@ pub fn correct_segment<M: Model>(
             [drift_core::Flags::NOT_POWERED_ON.0; 3],
         );
     }
-    let rate_hz = u64::from(segment.sample_rate_hz.max(1));
     for i in 0..n {
-        let sample = Sample {
-            since_power_on_ms: (u64::from(segment.since_power_on[i]) * 1000 / rate_hz) as u32,
-            rate_dps: [
-                segment.rate_dps[0][i],
-                segment.rate_dps[1][i],
-                segment.rate_dps[2][i],
-            ],
-            temperature_raw: [0, 1, 2].map(|a| temperature_reading(segment.temperature_raw[a][i])),
-        };
+        let sample = sample_at(segment, i);
         let out = corrector.correct(&sample);
         for axis in 0..3 {
             corrected[axis].push(out.corrected_dps[axis]);

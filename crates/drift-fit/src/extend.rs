@@ -14,16 +14,16 @@
 //! ambients.
 
 use drift_core::{
-    Corrector, Extension, ExtensionState, ExtraTerm, Model, ModifiedTables, Sample, Term,
-    TermInputs, AUX_INPUTS, MAX_TERMS,
+    Corrector, Extension, ExtensionState, ExtraTerm, Model, ModifiedTables, Term, TermInputs,
+    AUX_INPUTS, MAX_TERMS,
 };
-use drift_recording::{temperature_reading, Segment};
+use drift_recording::Segment;
 use serde::Serialize;
 
 use crate::analyse::analyse;
 use crate::diagnose::AxisDiagnosis;
 use crate::error::FitError;
-use crate::evaluate::switch_on_raw;
+use crate::evaluate::{sample_at, switch_on_raw};
 use crate::fit::{fit_unit, FittedUnit};
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
@@ -99,15 +99,16 @@ impl TermPlan {
                 if plan.terms.len() == MAX_TERMS {
                     return plan;
                 }
-                let before = plan.aux_inputs.clone();
-                match plan.term_for(&candidate.name) {
-                    Some(term) if !plan.terms.iter().any(|t| t.term == term) => {
-                        plan.terms.push(ChosenTerm {
-                            candidate: candidate.name.clone(),
-                            term,
-                        });
-                    }
-                    _ => plan.aux_inputs = before,
+                // A new auxiliary channel always makes a new term, so the channel list only grows
+                // with the terms.
+                let new = plan
+                    .term_for(&candidate.name)
+                    .filter(|term| !plan.terms.iter().any(|t| t.term == *term));
+                if let Some(term) = new {
+                    plan.terms.push(ChosenTerm {
+                        candidate: candidate.name.clone(),
+                        term,
+                    });
                 }
             }
         }
@@ -142,15 +143,6 @@ impl TermPlan {
             });
         }
         extension
-    }
-}
-
-fn sample_at(segment: &Segment, i: usize) -> Sample {
-    let rate_hz = u64::from(segment.sample_rate_hz.max(1));
-    Sample {
-        since_power_on_ms: (u64::from(segment.since_power_on[i]) * 1000 / rate_hz) as u32,
-        rate_dps: [0, 1, 2].map(|a| segment.rate_dps[a][i]),
-        temperature_raw: [0, 1, 2].map(|a| temperature_reading(segment.temperature_raw[a][i])),
     }
 }
 
@@ -228,10 +220,12 @@ pub fn fit_coefficients(
     let window = settings.lowpass_window_samples;
     let mut rows: [Vec<Vec<f64>>; 3] = Default::default();
     let mut targets: [Vec<f64>; 3] = Default::default();
+    // The residual the terms must explain is the paper model's, without any terms.
+    let Ok(plain) = tables.clone().with_extension(Extension::NONE) else {
+        return plan.extension(&[], &[]);
+    };
     for segment in training {
         let switch_on = switch_on_raw(segment, settings);
-        let plain = tables.clone().with_extension(Extension::NONE);
-        let Ok(plain) = plain else { continue };
         let residual = correct_with_terms(&plain, plan, segment, switch_on);
         let values = term_values(plan, tables, segment, switch_on);
         let step = (segment.sample_rate_hz as usize / 10).max(1);
