@@ -4,22 +4,55 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use drift_fit::diagnose::{diagnose, series, ActivationSeries, AxisDiagnosis, CandidateScore};
-use drift_fit::pipeline;
+use drift_fit::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, CandidateScore, Diagnoser};
+use drift_fit::evaluate::{switch_on_raw, within_ambient_range};
+use drift_fit::{pipeline, FitSettings, FittedUnit};
 use drift_recording::{read_recording, Segment, SeriesKind};
-use rayon::prelude::*;
 
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use crate::output::write_atomic;
 use crate::report::plots;
 
-/// One unit's activations, split for `--extend`.
+/// One unit's activations by role.
 #[derive(Default)]
 struct UnitSegments {
+    /// Protocol activations at the calibration set points: the tables' fit.
     calibration: Vec<Segment>,
+    /// Field-like activations at the calibration set points: diagnosed, and (with `--extend`)
+    /// the terms' guard and coefficients.
     training: Vec<Segment>,
+    /// Everything else: held out, the before/after is measured on it.
     validation: Vec<Segment>,
+}
+
+impl UnitSegments {
+    /// Moves the field-like activations at the calibration set points that switch on outside the
+    /// paper model's calibrated ambient range (after a short off-time the switch-on temperature
+    /// is above the hottest calibration ambient) to the held-out set: the model clamps their
+    /// ambient by design, and a term learnt there would learn the clamp. Returns how many moved.
+    fn hold_out_outside_range(&mut self, fitted: &FittedUnit, settings: &FitSettings) -> usize {
+        let (inside, outside): (Vec<Segment>, Vec<Segment>) = std::mem::take(&mut self.training)
+            .into_iter()
+            .partition(|s| within_ambient_range(&fitted.modified, switch_on_raw(s, settings)));
+        self.training = inside;
+        let moved = outside.len();
+        self.validation.extend(outside);
+        moved
+    }
+
+    /// The activations the diagnosis ranks candidates on: the field-like ones at the calibration
+    /// set points when the campaign has them (so the set points and sessions held out stay
+    /// unseen until the before/after), else every activation the fit did not see.
+    fn diagnosed(&self) -> &[Segment] {
+        // (training holds only activations inside the calibrated ambient range: see
+        // `hold_out_outside_range`)
+        if self.training.is_empty() {
+            &self.validation
+        } else {
+            &self.training
+        }
+    }
 }
 
 /// Options of `gyrodrift diagnose`.
@@ -34,16 +67,17 @@ pub struct Args {
     /// How many candidates to print per axis.
     #[arg(long, default_value_t = 5)]
     pub top: usize,
-    /// Close the loop: add the significant winners as the extended model's terms, fit their
-    /// coefficients on the field-like activations at the calibration set points (which the
-    /// diagnosis then leaves out), refit the tables, and report the error before and after.
+    /// Close the loop: offer the significant winners as the extended model's terms, admit each
+    /// only where it lowers the error on held-out field-like activations at the calibration set
+    /// points, fit their coefficients there, refit the tables, and report the error before and
+    /// after on the activations held out (other set points and sessions).
     #[arg(long)]
     pub extend: bool,
 }
 
 /// The ranking as Markdown.
 pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
-    let mut md = String::from("## Diagnosis of the residual after the paper's model\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for (time since switch-on, rise, the model's drift estimate, ambient). Significant: one-sided test of the held-out improvement per activation, Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
+    let mut md = String::from("## Diagnosis of the residual after the paper's model\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: one-sided test of the held-out improvement per activation, Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
     for axis in axes {
         let _ = writeln!(
             md,
@@ -89,7 +123,7 @@ fn residual_plot(
             .iter()
             .map(|a| {
                 (
-                    mean(&a.candidates[axis][&top.name]),
+                    mean(&a.left_over[axis][&top.name]),
                     mean(&a.residual_dps[axis]),
                 )
             })
@@ -98,7 +132,7 @@ fn residual_plot(
         activations
             .iter()
             .flat_map(|a| {
-                let c = &a.candidates[axis][&top.name];
+                let c = &a.left_over[axis][&top.name];
                 let r = &a.residual_dps[axis];
                 let (mc, mr) = (mean(c), mean(r));
                 c.iter()
@@ -110,9 +144,12 @@ fn residual_plot(
     };
     let title = format!("Residual against {} ({})", top.name, top.level);
     let x = if top.level == "between activations" {
-        top.name.clone()
+        format!("{}, less what the tables predict of it", top.name)
     } else {
-        format!("{} − its activation mean", top.name)
+        format!(
+            "{}, less what the tables predict of it, less its activation mean",
+            top.name
+        )
     };
     plots::draw(
         &plots::Chart {
@@ -132,57 +169,51 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
         .map_err(|e| super::measured::explain(e, &files))?;
-    // Every activation the fit did not see: field sessions and non-calibration set points. With
-    // --extend, the field sessions at the calibration set points train the terms instead.
-    let mut by_unit: BTreeMap<String, Vec<ActivationSeries>> = BTreeMap::new();
-    let mut kept: BTreeMap<String, UnitSegments> = BTreeMap::new();
+    let mut units: BTreeMap<String, UnitSegments> = BTreeMap::new();
     for (i, path) in files.iter().enumerate() {
-        steps.update(
-            "putting unseen activations on the diagnosis grid",
-            i as u64,
-            files.len() as u64,
-        );
-        if !args.extend && pipeline::calibration_file(path, &options)? == Some(true) {
-            continue;
-        }
+        steps.update("reading activations by role", i as u64, files.len() as u64);
         let recording = read_recording(path)?;
-        let Some(fitted) = outcome
-            .fitted
-            .iter()
-            .find(|f| f.unit_id == recording.unit_id)
-        else {
-            continue;
-        };
-        let training = |s: &Segment| {
-            args.extend
-                && s.labels.series_kind == SeriesKind::Field
-                && options
-                    .calibration_set_points
-                    .iter()
-                    .any(|c| (c - s.labels.set_point_celsius).abs() < 1e-6)
-        };
-        let prepared: Vec<ActivationSeries> = recording
-            .segments
-            .par_iter()
-            .filter(|s| !pipeline::calibration_segment(s, &options) && !training(s))
-            .map(|s| series(fitted, s, &options.fit))
-            .collect();
-        if args.extend {
-            let unit = kept.entry(recording.unit_id.clone()).or_default();
-            for segment in recording.segments {
-                if pipeline::calibration_segment(&segment, &options) {
-                    unit.calibration.push(segment);
-                } else if training(&segment) {
-                    unit.training.push(segment);
-                } else {
-                    unit.validation.push(segment);
-                }
+        let unit = units.entry(recording.unit_id.clone()).or_default();
+        for segment in recording.segments {
+            let at_calibration_set_point = options
+                .calibration_set_points
+                .iter()
+                .any(|c| (c - segment.labels.set_point_celsius).abs() < 1e-6);
+            if pipeline::calibration_segment(&segment, &options) {
+                unit.calibration.push(segment);
+            } else if at_calibration_set_point && segment.labels.series_kind == SeriesKind::Field {
+                unit.training.push(segment);
+            } else {
+                unit.validation.push(segment);
             }
         }
-        by_unit
-            .entry(recording.unit_id.clone())
-            .or_default()
-            .extend(prepared);
+    }
+    let mut by_unit: BTreeMap<String, Vec<ActivationSeries>> = BTreeMap::new();
+    let mut held_out_of_range: BTreeMap<String, usize> = BTreeMap::new();
+    let unit_count = units.len() as u64;
+    for (n, (unit, segments)) in units.iter_mut().enumerate() {
+        steps.update(
+            "fitting the tables to every candidate, then the diagnosis grid",
+            n as u64,
+            unit_count,
+        );
+        let Some(fitted) = outcome.fitted.iter().find(|f| &f.unit_id == unit) else {
+            continue;
+        };
+        held_out_of_range.insert(
+            unit.clone(),
+            segments.hold_out_outside_range(fitted, &options.fit),
+        );
+        let calibration: Vec<&Segment> = segments.calibration.iter().collect();
+        let diagnoser = Diagnoser::new(fitted, &calibration, &options.fit)?;
+        let prepared: Vec<ActivationSeries> = segments
+            .diagnosed()
+            .iter()
+            .map(|s| diagnoser.series(s))
+            .collect();
+        if !prepared.is_empty() {
+            by_unit.insert(unit.clone(), prepared);
+        }
     }
     steps.finish();
     anyhow::ensure!(
@@ -195,6 +226,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for (unit, activations) in &by_unit {
         let axes = diagnose(activations);
         let _ = writeln!(md, "# Unit {unit}\n");
+        if let Some(segments) = units.get(unit) {
+            let _ = writeln!(
+                md,
+                "Diagnosed on {} activations the fit never saw ({}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are held out with the rest ({} held out in all).\n",
+                activations.len(),
+                if segments.training.is_empty() {
+                    "every activation outside the calibration protocol"
+                } else {
+                    "field-like activations at the calibration set points"
+                },
+                held_out_of_range.get(unit).copied().unwrap_or(0),
+                segments.validation.len()
+            );
+        }
         md.push_str(&markdown(&axes, args.top));
         println!("{unit}:");
         for axis in &axes {
@@ -236,7 +281,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         if let (true, Some(segments), Some(fitted)) = (
             args.extend,
-            kept.get(unit),
+            units.get(unit),
             outcome.fitted.iter().find(|f| &f.unit_id == unit),
         ) {
             md.push_str(&super::extend::run(

@@ -1,7 +1,8 @@
-//! `gyrodrift diagnose --extend`: the diagnosis's significant winners become the extended model's
-//! extra terms; their coefficients are fitted on field-like activations at the calibration set
-//! points, the tables refitted, and the error before and after is reported on the activations the
-//! diagnosis saw (set points and sessions the fit never used).
+//! `gyrodrift diagnose --extend`: the diagnosis's significant winners are offered as the extended
+//! model's extra terms; a guard admits each on an axis only where it lowers the error on held-out
+//! field-like activations at the calibration set points (the ones the diagnosis ranked on), their
+//! coefficients are fitted there, the tables refitted, and the error before and after is reported
+//! on the activations nothing was fitted or chosen on (other set points and sessions).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -16,9 +17,6 @@ use drift_recording::Segment;
 
 use crate::output::write_atomic;
 
-/// Alternations of coefficient fit and table refit.
-const ROUNDS: usize = 2;
-
 /// Per axis, (max − min, RMS) of the 1-s mean of the corrected rate.
 type Metrics = [(f64, f64); 3];
 
@@ -29,9 +27,10 @@ type BeforeAfter = (Metrics, Metrics);
 pub struct Roles<'a> {
     /// Protocol activations at the calibration set points (the tables are fitted on these).
     pub calibration: Vec<&'a Segment>,
-    /// Field-like activations at the calibration set points (the terms' coefficients).
+    /// Field-like activations at the calibration set points (the diagnosis, the guard and the
+    /// terms' coefficients).
     pub training: Vec<&'a Segment>,
-    /// Everything else: what the diagnosis saw and the before/after is measured on.
+    /// Everything else: held out, the before/after is measured on it.
     pub validation: Vec<&'a Segment>,
 }
 
@@ -70,10 +69,39 @@ pub fn run(
         );
         return Ok(md);
     }
-    let Extended { tables, .. } = extend(base, &plan, calibration, training, settings, ROUNDS)?;
+    let Extended {
+        tables,
+        plan,
+        admissions,
+        ..
+    } = extend(base, &plan, calibration, training, settings)?;
     let _ = writeln!(
         md,
-        "Terms (coefficients fitted on {} field-like activations at the calibration set points, tables refitted on {} calibration activations, {ROUNDS} rounds):\n",
+        "Guard: each proposed term is admitted on an axis only if the refitted model with it (coefficients and tables fitted without the held-out fold) lowers the residual on held-out activations among the {} field-like activations at the calibration set points within the calibrated ambient range (5-fold cross-validation by activation, against the terms admitted before it; one-sided test, Bonferroni over every term and axis, family-wise 5 %):\n",
+        training.len()
+    );
+    md.push_str(
+        "| term | axis | held-out gain, (°/s)² | p | admitted |\n|---|---|---:|---:|:---:|\n",
+    );
+    for a in &admissions {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.2e} | {:.3} | {} |",
+            a.candidate,
+            a.axis,
+            a.improvement,
+            a.p_value,
+            if a.admitted { "yes" } else { "no" }
+        );
+    }
+    md.push('\n');
+    if plan.terms.is_empty() {
+        md.push_str("No term lowers the held-out error: the paper's model is kept unchanged.\n\n");
+        return Ok(md);
+    }
+    let _ = writeln!(
+        md,
+        "Terms (coefficients fitted on the {} field-like activations against what the paper's tables leave of each term, tables refitted once on {} calibration activations with the terms' contribution removed):\n",
         training.len(),
         calibration.len()
     );
@@ -100,7 +128,7 @@ pub fn run(
         );
     }
 
-    // Before/after on the activations the diagnosis saw, per set point and axis.
+    // Before/after on the held-out activations, per set point and axis.
     let window = settings.lowpass_window_samples;
     let mut by_set_point: BTreeMap<String, Vec<BeforeAfter>> = BTreeMap::new();
     for segment in validation {

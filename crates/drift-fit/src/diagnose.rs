@@ -1,14 +1,15 @@
 //! Diagnosis: after correction by the paper's model, is a systematic effect left in the residual,
 //! and which recorded or derived quantity explains it?
 //!
-//! For every evaluated activation, the corrected rate's low-frequency residual is put on a coarse
-//! grid beside candidate explanations: every auxiliary channel the recording has (whatever its
-//! name) and derived quantities (temperature rate per axis, rise², the other axes' rises, time since
-//! switch-on, switch-on temperature, residual heat at switch-on, campaign time). Before scoring, each
-//! candidate is stripped of what the paper's model already accounts for: it is replaced by its
-//! residual after a least-squares fit on the model's own inputs (time since switch-on, rise, the
-//! model's drift estimate, ambient), within the training folds. A candidate the table explains is
-//! then left with nothing to explain.
+//! For every diagnosed activation, the corrected rate's low-frequency residual is put on a coarse
+//! grid beside candidate explanations ([`crate::candidates`]): every auxiliary channel the
+//! recording has (whatever its name) and derived quantities (temperature rate per axis, rise², the
+//! other axes' rises, time since switch-on, switch-on temperature, residual heat at switch-on,
+//! campaign time). Before scoring, each candidate is stripped of what the paper's model already
+//! accounts for: the paper's tables are fitted to the candidate itself on the calibration
+//! activations ([`crate::absorb`]) and what they predict of it is taken out. A candidate the table
+//! explains is then left with nothing to explain, and what is left is exactly what a term in that
+//! candidate would add to the paper's model.
 //!
 //! Score: out-of-sample explained variance of the residual, cross-validated by activation
 //! (K folds of whole activations, never samples), for a one-coefficient linear term. Significance:
@@ -18,10 +19,13 @@
 
 use std::collections::BTreeMap;
 
-use drift_core::Model;
 use drift_recording::{Segment, SegmentLabels};
+use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::absorb::Absorber;
+use crate::candidates::{Kind, SET_POINT_CHANNEL};
+use crate::error::FitError;
 use crate::evaluate::{correct_segment, switch_on_raw};
 use crate::fit::FittedUnit;
 use crate::lowpass::centred_moving_average;
@@ -38,15 +42,10 @@ pub struct ActivationSeries {
     pub labels: SegmentLabels,
     /// Low-frequency residual after the paper's model, per axis, °/s.
     pub residual_dps: [Vec<f64>; 3],
-    /// The model's own inputs per axis (what candidates are stripped of): time, rise, drift
-    /// estimate, ambient.
-    pub model_inputs: [Vec<[f64; 4]>; 3],
-    /// Candidates per axis, by name.
+    /// Candidates per axis, by name, as recorded or derived.
     pub candidates: [BTreeMap<String, Vec<f64>>; 3],
-}
-
-fn grid_step(segment: &Segment) -> usize {
-    (segment.sample_rate_hz as usize * GRID_MS as usize / 1000).max(1)
+    /// The same candidates less what the paper's tables predict of them: what is scored.
+    pub left_over: [BTreeMap<String, Vec<f64>>; 3],
 }
 
 /// Low-pass at the fit's window and sample on the diagnosis grid.
@@ -57,93 +56,80 @@ fn on_grid<T: Copy + Into<f64>>(values: &[T], window: usize, step: usize) -> Vec
         .collect()
 }
 
-/// Puts one activation, corrected by `fitted`'s paper model, on the diagnosis grid.
-pub fn series(fitted: &FittedUnit, segment: &Segment, settings: &FitSettings) -> ActivationSeries {
-    let window = settings.lowpass_window_samples;
-    let step = grid_step(segment);
-    let switch_on = switch_on_raw(segment, settings);
-    let (corrected, _) = correct_segment(&fitted.modified, segment, switch_on);
-    let settings_core = fitted.modified.settings();
-    let n = segment.len().div_ceil(step);
-    let time: Vec<f64> = (0..n)
-        .map(|i| (i * step) as f64 / f64::from(segment.sample_rate_hz))
-        .collect();
-    let celsius: [Vec<f64>; 3] = [0, 1, 2].map(|a| {
-        on_grid(&segment.temperature_raw[a], window, step)
+/// Puts activations of one unit on the diagnosis grid, with the paper's model fitted on its
+/// calibration activations and, for every candidate, what those tables absorb of it.
+pub struct Diagnoser<'a> {
+    fitted: &'a FittedUnit,
+    settings: FitSettings,
+    /// Each candidate kind with the tables fitted to it; a kind the calibration activations cannot
+    /// carry (an auxiliary channel they lack) is not offered.
+    kinds: Vec<(Kind, Absorber)>,
+}
+
+impl<'a> Diagnoser<'a> {
+    /// Learns what the paper's tables absorb of every candidate, on the activations `fitted` was
+    /// fitted on. Candidates are the auxiliary channels every calibration activation has and the
+    /// derived quantities.
+    pub fn new(
+        fitted: &'a FittedUnit,
+        calibration: &[&Segment],
+        settings: &FitSettings,
+    ) -> Result<Self, FitError> {
+        let mut channels: Vec<String> = calibration
+            .first()
+            .map(|s| s.aux.keys().cloned().collect())
+            .unwrap_or_default();
+        channels.retain(|c| calibration.iter().all(|s| s.aux.contains_key(c)));
+        let has_set_point = channels.iter().any(|c| c == SET_POINT_CHANNEL);
+        let kinds = Kind::all(channels, has_set_point)
             .into_iter()
-            .map(|r| f64::from(settings_core.celsius(r as f32)))
-            .collect()
-    });
-    let on_celsius: [f64; 3] = switch_on.map(|r| f64::from(settings_core.celsius(r)));
-    let rise: [Vec<f64>; 3] =
-        [0, 1, 2].map(|a| celsius[a].iter().map(|c| c - on_celsius[a]).collect());
-    let residual: [Vec<f64>; 3] = [0, 1, 2].map(|a| on_grid(&corrected[a], window, step));
-    let raw_rate: [Vec<f64>; 3] = [0, 1, 2].map(|a| on_grid(&segment.rate_dps[a], window, step));
-    // Shared candidates: auxiliary channels (resampled to the grid), time, campaign time.
-    let mut shared: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    for (name, channel) in &segment.aux {
-        let aux_step = ((channel.sample_rate_hz as usize * GRID_MS as usize) / 1000).max(1);
-        let aux_window = (channel.sample_rate_hz as usize).max(1); // 1 s, like the residual
-        let mut values = on_grid(&channel.values, aux_window, aux_step);
-        values.resize(n, values.last().copied().unwrap_or(0.0));
-        shared.insert(format!("aux:{name}"), values);
+            .map(|kind| {
+                let absorber = Absorber::fit(
+                    calibration,
+                    |s| kind.values(s, switch_on_raw(s, settings)),
+                    settings,
+                )?;
+                Ok((kind, absorber))
+            })
+            .collect::<Result<Vec<_>, FitError>>()?;
+        Ok(Self {
+            fitted,
+            settings: settings.clone(),
+            kinds,
+        })
     }
-    shared.insert("time since switch-on".into(), time.clone());
-    let campaign_s = segment.power_on_ns as f64 / 1e9;
-    shared.insert(
-        "campaign time (ageing)".into(),
-        time.iter().map(|t| campaign_s + t).collect(),
-    );
-    let set_point = segment
-        .aux
-        .get("chamber_set_point")
-        .and_then(|c| c.values.first())
-        .map(|&v| f64::from(v));
-    let candidates = [0, 1, 2].map(|a| {
-        let mut own = shared.clone();
-        // Temperature rate, °C/s, from the low-passed temperature (central difference over ±1 s).
-        let half = (1000 / GRID_MS) as usize;
-        let rate: Vec<f64> = (0..n)
-            .map(|i| {
-                let (lo, hi) = (i.saturating_sub(half), (i + half).min(n - 1));
-                if hi > lo {
-                    (celsius[a][hi] - celsius[a][lo]) / (time[hi] - time[lo])
-                } else {
-                    0.0
-                }
+
+    /// Puts one activation, corrected by the paper's model, on the diagnosis grid.
+    pub fn series(&self, segment: &Segment) -> ActivationSeries {
+        let window = self.settings.lowpass_window_samples;
+        let step = (segment.sample_rate_hz as usize * GRID_MS as usize / 1000).max(1);
+        let switch_on = switch_on_raw(segment, &self.settings);
+        let (corrected, _) = correct_segment(&self.fitted.modified, segment, switch_on);
+        let residual: [Vec<f64>; 3] = [0, 1, 2].map(|a| on_grid(&corrected[a], window, step));
+        let mut candidates: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
+        let mut left_over: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
+        let computed: Vec<_> = self
+            .kinds
+            .par_iter()
+            .filter_map(|(kind, absorber)| {
+                let values = kind.values(segment, switch_on)?;
+                let left = absorber.left_over(segment, values.clone(), switch_on);
+                Some((kind, values, left))
             })
             .collect();
-        own.insert(format!("temperature rate {}", AXES[a]), rate);
-        own.insert(
-            format!("rise² {}", AXES[a]),
-            rise[a].iter().map(|r| r * r).collect(),
-        );
-        for b in (0..3).filter(|&b| b != a) {
-            own.insert(format!("rise {}", AXES[b]), rise[b].clone());
+        for (kind, values, left) in computed {
+            for axis in 0..3 {
+                let name = kind.name(axis);
+                candidates[axis].insert(name.clone(), on_grid(&values[axis], window, step));
+                left_over[axis].insert(name, on_grid(&left[axis], window, step));
+            }
         }
-        own.insert("switch-on temperature".into(), vec![on_celsius[a]; n]);
-        if let Some(set_point) = set_point {
-            own.insert(
-                "residual heat at switch-on (off-time)".into(),
-                vec![on_celsius[a] - set_point; n],
-            );
+        ActivationSeries {
+            labels: segment.labels.clone(),
+            residual_dps: residual,
+            candidates,
+            left_over,
         }
-        own
-    });
-    let model_inputs = [0, 1, 2].map(|a| {
-        (0..n)
-            .map(|i| {
-                // The model's drift estimate is what it subtracted beyond the initial bias.
-                let estimate = raw_rate[a][i] - residual[a][i];
-                [time[i], rise[a][i], estimate, on_celsius[a]]
-            })
-            .collect()
-    });
-    ActivationSeries {
-        labels: segment.labels.clone(),
-        residual_dps: residual,
-        model_inputs,
-        candidates,
     }
 }
 
@@ -158,10 +144,11 @@ pub struct CandidateScore {
     pub p_value: f64,
     /// Whether it passes the Bonferroni-corrected test at `alpha`.
     pub significant: bool,
-    /// Fitted coefficient on all data ((°/s) per candidate unit, after stripping).
+    /// Fitted coefficient on all data ((°/s) per candidate unit, on what the tables leave of it).
     pub coefficient: f64,
-    /// Share of the candidate's own variance that the paper's model inputs already explain. Near 1:
-    /// the table accounts for this quantity, and it is not scored.
+    /// Share of the candidate's own variance that the paper's tables, fitted to it on the
+    /// calibration activations, predict. Near 1: the table accounts for this quantity, and it is
+    /// not scored.
     pub absorbed_by_model: f64,
     /// Where the effect shows: within activations (shape), between activations (offsets), or
     /// absorbed by the model.
@@ -188,35 +175,28 @@ impl AxisDiagnosis {
     }
 }
 
-/// A candidate whose variance the model inputs explain beyond this share is the table's already.
+/// A candidate whose variance the paper's tables explain beyond this share is the table's already.
 const ABSORBED: f64 = 0.999;
 
-fn model_row(a: &ActivationSeries, axis: usize, i: usize) -> Vec<f64> {
-    let m = a.model_inputs[axis][i];
-    vec![1.0, m[0], m[1], m[2], m[3]]
-}
-
-/// R² of the candidate regressed on the model's inputs, over all activations.
+/// Share of the candidate's variance (about its mean, over every activation) that the paper's
+/// tables predict: 1 − var(left over) / var(candidate).
 fn absorbed_share(activations: &[ActivationSeries], axis: usize, name: &str) -> f64 {
-    let (rows, values): (Vec<Vec<f64>>, Vec<f64>) = activations
-        .iter()
-        .flat_map(|a| {
-            (0..a.residual_dps[axis].len())
-                .map(move |i| (model_row(a, axis, i), a.candidates[axis][name][i]))
-        })
-        .unzip();
-    let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
-    let total: f64 = values.iter().map(|v| (v - mean).powi(2)).sum();
+    let spread = |pick: &dyn Fn(&ActivationSeries) -> Option<&Vec<f64>>| {
+        let values: Vec<f64> = activations
+            .iter()
+            .filter_map(pick)
+            .flatten()
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect();
+        let m = mean(values.iter().copied());
+        values.iter().map(|v| (v - m).powi(2)).sum::<f64>()
+    };
+    let total = spread(&|a| a.candidates[axis].get(name));
     if total <= 0.0 {
         return 1.0; // a constant: nothing left once the intercept is taken out
     }
-    let b = least_squares(&rows, &values);
-    let left: f64 = rows
-        .iter()
-        .zip(&values)
-        .map(|(r, v)| (v - r.iter().zip(&b).map(|(x, c)| x * c).sum::<f64>()).powi(2))
-        .sum();
-    1.0 - left / total
+    (1.0 - spread(&|a| a.left_over[axis].get(name)) / total).max(0.0)
 }
 
 /// Least squares `y ≈ X b` via normal equations (columns ≤ 6).
@@ -262,32 +242,56 @@ fn standard_normal_tail(z: f64) -> f64 {
     }
 }
 
-/// One point of the scoring data: residual, candidate, the model-input row it is stripped against.
-type Point = (f64, f64, [f64; 5]);
+/// The mean of `gains` and the one-sided p-value of "the mean is above zero" (normal approximation
+/// of the t statistic; the gains are per activation, so there are dozens).
+pub(crate) fn one_sided_mean_test(gains: &[f64]) -> (f64, f64) {
+    let n = gains.len() as f64;
+    let mean = gains.iter().sum::<f64>() / n.max(1.0);
+    let sd = (gains.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
+    let z = if sd > 0.0 {
+        mean / (sd / n.sqrt())
+    } else {
+        0.0
+    };
+    (mean, standard_normal_tail(z))
+}
 
-/// Scores one candidate on groups of points (one group per activation): cross-validated by group,
-/// stripped within the training folds. Returns (explained share, one-sided p, coefficient).
+/// One point of the scoring data: residual and candidate (left over after the tables).
+type Point = (f64, f64);
+
+/// Slope and intercept of `y` on `x` over the finite points of `train`; `None` without spread.
+fn line(train: &[&Vec<Point>]) -> Option<(f64, f64)> {
+    let points = || {
+        train
+            .iter()
+            .flat_map(|g| g.iter())
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+    };
+    let n = points().count() as f64;
+    if n < 2.0 {
+        return None;
+    }
+    let (mx, my) = (
+        points().map(|p| p.1).sum::<f64>() / n,
+        points().map(|p| p.0).sum::<f64>() / n,
+    );
+    let sxx: f64 = points().map(|p| (p.1 - mx).powi(2)).sum();
+    let sxy: f64 = points().map(|p| (p.1 - mx) * (p.0 - my)).sum();
+    if sxx <= 0.0 {
+        return Some((0.0, my));
+    }
+    let slope = sxy / sxx;
+    Some((slope, my - slope * mx))
+}
+
+/// Scores one candidate on groups of points (one group per activation), cross-validated by
+/// group. Returns (explained share, one-sided p, coefficient on all data).
 fn score(groups: &[Vec<Point>], folds: usize) -> (f64, f64, f64) {
-    let all: Vec<&Point> = groups.iter().flatten().collect();
+    let finite = |p: &&Point| p.0.is_finite() && p.1.is_finite();
+    let all: Vec<&Point> = groups.iter().flatten().filter(finite).collect();
     let mean_y = all.iter().map(|p| p.0).sum::<f64>() / all.len().max(1) as f64;
     let total: f64 = all.iter().map(|p| (p.0 - mean_y).powi(2)).sum();
     let folds = folds.clamp(2, groups.len().max(2));
-    let fit = |train: &[&Vec<Point>]| {
-        let (rows, values): (Vec<Vec<f64>>, Vec<f64>) = train
-            .iter()
-            .flat_map(|g| g.iter().map(|p| (p.2.to_vec(), p.1)))
-            .unzip();
-        let strip = least_squares(&rows, &values);
-        let stripped =
-            move |p: &Point| p.1 - p.2.iter().zip(&strip).map(|(x, b)| x * b).sum::<f64>();
-        let (rows, ys): (Vec<Vec<f64>>, Vec<f64>) = train
-            .iter()
-            .flat_map(|g| g.iter().map(|p| (vec![1.0, stripped(p)], p.0)))
-            .unzip();
-        let beta = least_squares(&rows, &ys);
-        let intercept_only = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
-        (stripped, beta, intercept_only)
-    };
     let mut improvements = Vec::with_capacity(groups.len());
     let mut sse = 0.0;
     for fold in 0..folds {
@@ -297,39 +301,39 @@ fn score(groups: &[Vec<Point>], folds: usize) -> (f64, f64, f64) {
             .filter(|(i, _)| i % folds != fold)
             .map(|(_, g)| g)
             .collect();
-        let (stripped, beta, intercept_only) = fit(&train);
+        let Some((slope, intercept)) = line(&train) else {
+            continue;
+        };
+        let intercept_only = mean(
+            train
+                .iter()
+                .flat_map(|g| g.iter())
+                .filter(finite)
+                .map(|p| p.0),
+        );
         for group in groups
             .iter()
             .enumerate()
             .filter(|(i, _)| i % folds == fold)
             .map(|(_, g)| g)
         {
-            let (mut without, mut with) = (0.0, 0.0);
-            for p in group {
+            let (mut without, mut with, mut n) = (0.0, 0.0, 0usize);
+            for p in group.iter().filter(finite) {
                 without += (p.0 - intercept_only).powi(2);
-                with += (p.0 - beta[0] - beta[1] * stripped(p)).powi(2);
+                with += (p.0 - intercept - slope * p.1).powi(2);
+                n += 1;
             }
-            sse += with;
-            improvements.push((without - with) / group.len().max(1) as f64);
+            if n > 0 {
+                sse += with;
+                improvements.push((without - with) / n as f64);
+            }
         }
     }
-    let n = improvements.len() as f64;
-    let mean = improvements.iter().sum::<f64>() / n.max(1.0);
-    let sd =
-        (improvements.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
-    let z = if sd > 0.0 {
-        mean / (sd / n.sqrt())
-    } else {
-        0.0
-    };
+    let (_, p_value) = one_sided_mean_test(&improvements);
     let all_groups: Vec<&Vec<Point>> = groups.iter().collect();
-    let (_, beta, _) = fit(&all_groups);
+    let coefficient = line(&all_groups).map_or(0.0, |(slope, _)| slope);
     let explained = if total > 0.0 { 1.0 - sse / total } else { 0.0 };
-    (
-        explained,
-        standard_normal_tail(z),
-        beta.get(1).copied().unwrap_or(0.0),
-    )
+    (explained, p_value, coefficient)
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
@@ -360,7 +364,7 @@ pub fn diagnose_axis(
         .filter(|n| {
             activations
                 .iter()
-                .all(|a| a.candidates[axis].contains_key(n))
+                .all(|a| a.candidates[axis].contains_key(n) && a.left_over[axis].contains_key(n))
         })
         .collect();
     let rms = mean(
@@ -369,10 +373,6 @@ pub fn diagnose_axis(
             .flat_map(|a| a.residual_dps[axis].iter().map(|y| y * y)),
     )
     .sqrt();
-    let row = |a: &ActivationSeries, i: usize| {
-        let m = a.model_inputs[axis][i];
-        [1.0, m[0], m[1], m[2], m[3]]
-    };
     let mut ranking: Vec<CandidateScore> = names
         .iter()
         .map(|name| {
@@ -390,37 +390,21 @@ pub fn diagnose_axis(
                 candidate.level = "absorbed by the model";
                 return candidate;
             }
+            let finite_mean = |v: &[f64]| mean(v.iter().copied().filter(|x| x.is_finite()));
             let within: Vec<Vec<Point>> = activations
                 .iter()
                 .map(|a| {
-                    let n = a.residual_dps[axis].len();
-                    let c = &a.candidates[axis][name];
-                    let (my, mc) = (
-                        mean(a.residual_dps[axis].iter().copied()),
-                        mean(c.iter().copied()),
-                    );
-                    let mrow: [f64; 5] =
-                        std::array::from_fn(|k| mean((0..n).map(|i| row(a, i)[k])));
-                    (0..n)
-                        .map(|i| {
-                            (
-                                a.residual_dps[axis][i] - my,
-                                c[i] - mc,
-                                std::array::from_fn(|k| row(a, i)[k] - mrow[k]),
-                            )
-                        })
-                        .collect()
+                    let (y, c) = (&a.residual_dps[axis], &a.left_over[axis][name]);
+                    let (my, mc) = (finite_mean(y), finite_mean(c));
+                    y.iter().zip(c).map(|(y, c)| (y - my, c - mc)).collect()
                 })
                 .collect();
             let between: Vec<Vec<Point>> = activations
                 .iter()
                 .map(|a| {
-                    let n = a.residual_dps[axis].len();
-                    let c = &a.candidates[axis][name];
                     vec![(
-                        mean(a.residual_dps[axis].iter().copied()),
-                        mean(c.iter().copied()),
-                        std::array::from_fn(|k| mean((0..n).map(|i| row(a, i)[k]))),
+                        finite_mean(&a.residual_dps[axis]),
+                        finite_mean(&a.left_over[axis][name]),
                     )]
                 })
                 .collect();

@@ -108,6 +108,21 @@ pub fn switch_on_raw(segment: &Segment, settings: &FitSettings) -> [f32; 3] {
     })
 }
 
+/// Whether `model` switches on inside its calibrated ambient range on every axis for this
+/// switch-on reading (no [`drift_core::Flags::AMBIENT_OUT_OF_RANGE`]). Outside it the model clamps
+/// the ambient by design (a documented, flagged degradation), so such activations' residuals mix
+/// that clamp with whatever else is left.
+pub fn within_ambient_range<M: Model>(model: &M, switch_on: [f32; 3]) -> bool {
+    let Ok(mut corrector) = Corrector::new(model) else {
+        return false;
+    };
+    corrector.power_on(switch_on).is_ok_and(|flags| {
+        flags
+            .iter()
+            .all(|f| !f.intersects(drift_core::Flags::AMBIENT_OUT_OF_RANGE))
+    })
+}
+
 /// Sample `i` of `segment` as the firmware sees it: time in ms, rates, temperature readings (a
 /// dropout reads as NaN).
 pub fn sample_at(segment: &Segment, i: usize) -> Sample {

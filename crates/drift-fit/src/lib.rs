@@ -7,8 +7,10 @@
 //! - [`evaluate`] runs the fitted models through drift-core's f32 corrector (exactly what firmware
 //!   runs) on activations the fit did not see, and measures the paper's drift metric.
 
+pub mod absorb;
 pub mod analyse;
 pub mod baselines;
+pub mod candidates;
 pub mod curves;
 pub mod diagnose;
 pub mod error;
