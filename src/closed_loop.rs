@@ -16,6 +16,7 @@ use drift_fit::analyse::analyse;
 use drift_fit::diagnose::{diagnose, AxisDiagnosis, Diagnoser};
 use drift_fit::evaluate::{self, switch_on_raw};
 use drift_fit::extend::{correct_with_terms, extend, TermPlan};
+use drift_fit::roles::Roles;
 use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{read_recording, Segment, SeriesKind};
 use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, UnitModel};
@@ -216,40 +217,29 @@ pub fn run(
         |_| {},
     )?;
     let all = segments(&dir)?;
-    let calibration: Vec<&Segment> = all
-        .iter()
-        .filter(|s| {
-            s.labels.series_kind == SeriesKind::Protocol
-                && CALIBRATION
-                    .iter()
-                    .any(|&c| is(c, s.labels.set_point_celsius))
-        })
-        .collect();
-    let training: Vec<&Segment> = all
-        .iter()
-        .filter(|s| {
-            s.labels.series_kind == SeriesKind::Field
-                && CALIBRATION
-                    .iter()
-                    .any(|&c| is(c, s.labels.set_point_celsius))
-        })
-        .collect();
-    let validation: Vec<&Segment> = all
-        .iter()
-        .filter(|s| {
-            s.labels.series_kind == SeriesKind::Field && is(VALIDATION, s.labels.set_point_celsius)
-        })
-        .collect();
-    let analysed = calibration
+    let mut roles = Roles::split(&all, &CALIBRATION);
+    let analysed = roles
+        .calibration
         .iter()
         .map(|s| analyse(s, settings))
         .collect::<Result<Vec<_>, _>>()?;
     let base = fit_unit(&analysed, settings)?;
-    // The diagnosis, the guard and the coefficients see only the field activations at the
-    // calibration set points; the +33 °C field activations are measured, never fitted or chosen on.
-    let (training, out_of_range) = drift_fit::extend::within_range(&base, &training, settings);
+    roles.hold_out_outside_range(&base, settings);
+    let Roles {
+        calibration,
+        training,
+        held_out,
+        outside_range,
+    } = roles;
+    // Measured on: the +33 °C field activations (never fitted or chosen on).
+    let validation: Vec<&Segment> = held_out
+        .into_iter()
+        .filter(|s| {
+            s.labels.series_kind == SeriesKind::Field && is(VALIDATION, s.labels.set_point_celsius)
+        })
+        .collect();
     eprintln!(
-        "  {} field activations at the calibration set points within the calibrated ambient range, {out_of_range} outside left out",
+        "  {} field activations at the calibration set points inside the calibrated ambient range, {outside_range} outside held out",
         training.len()
     );
     let diagnoser = Diagnoser::new(&base, &calibration, settings)?;

@@ -5,55 +5,14 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use drift_fit::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, CandidateScore, Diagnoser};
-use drift_fit::evaluate::{switch_on_raw, within_ambient_range};
-use drift_fit::{pipeline, FitSettings, FittedUnit};
-use drift_recording::{read_recording, Segment, SeriesKind};
+use drift_fit::pipeline;
+use drift_fit::roles::Roles;
+use drift_recording::{read_recording, Segment};
 
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use crate::output::write_atomic;
 use crate::report::plots;
-
-/// One unit's activations by role.
-#[derive(Default)]
-struct UnitSegments {
-    /// Protocol activations at the calibration set points: the tables' fit.
-    calibration: Vec<Segment>,
-    /// Field-like activations at the calibration set points: diagnosed, and (with `--extend`)
-    /// the terms' guard and coefficients.
-    training: Vec<Segment>,
-    /// Everything else: held out, the before/after is measured on it.
-    validation: Vec<Segment>,
-}
-
-impl UnitSegments {
-    /// Moves the field-like activations at the calibration set points that switch on outside the
-    /// paper model's calibrated ambient range (after a short off-time the switch-on temperature
-    /// is above the hottest calibration ambient) to the held-out set: the model clamps their
-    /// ambient by design, and a term learnt there would learn the clamp. Returns how many moved.
-    fn hold_out_outside_range(&mut self, fitted: &FittedUnit, settings: &FitSettings) -> usize {
-        let (inside, outside): (Vec<Segment>, Vec<Segment>) = std::mem::take(&mut self.training)
-            .into_iter()
-            .partition(|s| within_ambient_range(&fitted.modified, switch_on_raw(s, settings)));
-        self.training = inside;
-        let moved = outside.len();
-        self.validation.extend(outside);
-        moved
-    }
-
-    /// The activations the diagnosis ranks candidates on: the field-like ones at the calibration
-    /// set points when the campaign has them (so the set points and sessions held out stay
-    /// unseen until the before/after), else every activation the fit did not see.
-    fn diagnosed(&self) -> &[Segment] {
-        // (training holds only activations inside the calibrated ambient range: see
-        // `hold_out_outside_range`)
-        if self.training.is_empty() {
-            &self.validation
-        } else {
-            &self.training
-        }
-    }
-}
 
 /// Options of `gyrodrift diagnose`.
 #[derive(Debug, clap::Args)]
@@ -169,44 +128,30 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
         .map_err(|e| super::measured::explain(e, &files))?;
-    let mut units: BTreeMap<String, UnitSegments> = BTreeMap::new();
+    let mut recorded: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
     for (i, path) in files.iter().enumerate() {
         steps.update("reading activations by role", i as u64, files.len() as u64);
         let recording = read_recording(path)?;
-        let unit = units.entry(recording.unit_id.clone()).or_default();
-        for segment in recording.segments {
-            let at_calibration_set_point = options
-                .calibration_set_points
-                .iter()
-                .any(|c| (c - segment.labels.set_point_celsius).abs() < 1e-6);
-            if pipeline::calibration_segment(&segment, &options) {
-                unit.calibration.push(segment);
-            } else if at_calibration_set_point && segment.labels.series_kind == SeriesKind::Field {
-                unit.training.push(segment);
-            } else {
-                unit.validation.push(segment);
-            }
-        }
+        recorded
+            .entry(recording.unit_id.clone())
+            .or_default()
+            .extend(recording.segments);
     }
+    let mut units: BTreeMap<&String, Roles<'_>> = BTreeMap::new();
     let mut by_unit: BTreeMap<String, Vec<ActivationSeries>> = BTreeMap::new();
-    let mut held_out_of_range: BTreeMap<String, usize> = BTreeMap::new();
-    let unit_count = units.len() as u64;
-    for (n, (unit, segments)) in units.iter_mut().enumerate() {
+    for (n, (unit, segments)) in recorded.iter().enumerate() {
         steps.update(
             "fitting the tables to every candidate, then the diagnosis grid",
             n as u64,
-            unit_count,
+            recorded.len() as u64,
         );
         let Some(fitted) = outcome.fitted.iter().find(|f| &f.unit_id == unit) else {
             continue;
         };
-        held_out_of_range.insert(
-            unit.clone(),
-            segments.hold_out_outside_range(fitted, &options.fit),
-        );
-        let calibration: Vec<&Segment> = segments.calibration.iter().collect();
-        let diagnoser = Diagnoser::new(fitted, &calibration, &options.fit)?;
-        let prepared: Vec<ActivationSeries> = segments
+        let mut roles = Roles::split(segments, &options.calibration_set_points);
+        roles.hold_out_outside_range(fitted, &options.fit);
+        let diagnoser = Diagnoser::new(fitted, &roles.calibration, &options.fit)?;
+        let prepared: Vec<ActivationSeries> = roles
             .diagnosed()
             .iter()
             .map(|s| diagnoser.series(s))
@@ -214,6 +159,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         if !prepared.is_empty() {
             by_unit.insert(unit.clone(), prepared);
         }
+        units.insert(unit, roles);
     }
     steps.finish();
     anyhow::ensure!(
@@ -226,18 +172,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for (unit, activations) in &by_unit {
         let axes = diagnose(activations);
         let _ = writeln!(md, "# Unit {unit}\n");
-        if let Some(segments) = units.get(unit) {
+        if let Some(roles) = units.get(unit) {
             let _ = writeln!(
                 md,
                 "Diagnosed on {} activations the fit never saw ({}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are held out with the rest ({} held out in all).\n",
                 activations.len(),
-                if segments.training.is_empty() {
+                if roles.training.is_empty() {
                     "every activation outside the calibration protocol"
                 } else {
                     "field-like activations at the calibration set points"
                 },
-                held_out_of_range.get(unit).copied().unwrap_or(0),
-                segments.validation.len()
+                roles.outside_range,
+                roles.held_out.len()
             );
         }
         md.push_str(&markdown(&axes, args.top));
@@ -279,7 +225,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 );
             }
         }
-        if let (true, Some(segments), Some(fitted)) = (
+        if let (true, Some(roles), Some(fitted)) = (
             args.extend,
             units.get(unit),
             outcome.fitted.iter().find(|f| &f.unit_id == unit),
@@ -288,11 +234,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 unit,
                 &axes,
                 fitted,
-                &super::extend::Roles {
-                    calibration: segments.calibration.iter().collect(),
-                    training: segments.training.iter().collect(),
-                    validation: segments.validation.iter().collect(),
-                },
+                roles,
                 &options.fit,
                 &args.out,
             )?);

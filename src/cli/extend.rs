@@ -12,8 +12,8 @@ use drift_core::blob;
 use drift_fit::diagnose::AxisDiagnosis;
 use drift_fit::evaluate::{self, switch_on_raw};
 use drift_fit::extend::{correct_with_terms, extend, Extended, TermPlan};
+use drift_fit::roles::Roles;
 use drift_fit::{FitSettings, FittedUnit};
-use drift_recording::Segment;
 
 use crate::output::write_atomic;
 
@@ -22,17 +22,6 @@ type Metrics = [(f64, f64); 3];
 
 /// One activation's metrics with the paper's model and with the extended one.
 type BeforeAfter = (Metrics, Metrics);
-
-/// One unit's activations by role.
-pub struct Roles<'a> {
-    /// Protocol activations at the calibration set points (the tables are fitted on these).
-    pub calibration: Vec<&'a Segment>,
-    /// Field-like activations at the calibration set points (the diagnosis, the guard and the
-    /// terms' coefficients).
-    pub training: Vec<&'a Segment>,
-    /// Everything else: held out, the before/after is measured on it.
-    pub validation: Vec<&'a Segment>,
-}
 
 /// Per axis, (max − min, RMS) of the 1-s mean of the corrected rate.
 fn metric(rates: &[Vec<f32>; 3], window: usize) -> Metrics {
@@ -53,7 +42,8 @@ pub fn run(
     let Roles {
         calibration,
         training,
-        validation,
+        held_out,
+        ..
     } = roles;
     let mut md = format!("## Extended model of unit {unit}\n\n");
     let plan = TermPlan::choose(axes);
@@ -131,7 +121,7 @@ pub fn run(
     // Before/after on the held-out activations, per set point and axis.
     let window = settings.lowpass_window_samples;
     let mut by_set_point: BTreeMap<String, Vec<BeforeAfter>> = BTreeMap::new();
-    for segment in validation {
+    for segment in held_out {
         let on = switch_on_raw(segment, settings);
         let before = metric(
             &correct_with_terms(&base.modified, &plan, segment, on),

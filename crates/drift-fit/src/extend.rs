@@ -25,7 +25,7 @@ use crate::absorb::Absorber;
 use crate::analyse::analyse;
 use crate::diagnose::AxisDiagnosis;
 use crate::error::FitError;
-use crate::evaluate::{sample_at, switch_on_raw, within_ambient_range};
+use crate::evaluate::{sample_at, switch_on_raw};
 use crate::fit::{fit_unit, FittedUnit};
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
@@ -240,25 +240,6 @@ fn term_values(
         }
     }
     values
-}
-
-/// The activations among `segments` that switch on inside the paper model's calibrated ambient
-/// range ([`within_ambient_range`]), and how many were left out. The diagnosis and the terms are
-/// learnt on these only: outside the range the model clamps the ambient by design and flags it,
-/// and a term fitted there would learn the clamp, not the effect (it then fails between the
-/// calibration ambients).
-pub fn within_range<'a>(
-    base: &FittedUnit,
-    segments: &[&'a Segment],
-    settings: &FitSettings,
-) -> (Vec<&'a Segment>, usize) {
-    let kept: Vec<&Segment> = segments
-        .iter()
-        .copied()
-        .filter(|s| within_ambient_range(&base.modified, switch_on_raw(s, settings)))
-        .collect();
-    let left_out = segments.len() - kept.len();
-    (kept, left_out)
 }
 
 /// Family-wise significance level of the guard over every (term, axis) it tests.

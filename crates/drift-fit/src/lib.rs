@@ -21,6 +21,7 @@ pub mod knots;
 pub mod lowpass;
 pub mod measured;
 pub mod pipeline;
+pub mod roles;
 pub mod settings;
 pub mod summary;
 

@@ -89,7 +89,7 @@ pub struct Outcome {
 /// Reports progress: (step, done, total).
 pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
 
-fn is_one_of(set_point: f64, list: &[f64]) -> bool {
+pub(crate) fn is_one_of(set_point: f64, list: &[f64]) -> bool {
     list.iter().any(|s| (s - set_point).abs() < 1e-6)
 }
 
