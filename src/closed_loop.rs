@@ -13,9 +13,8 @@ use std::path::Path;
 
 use anyhow::Context;
 use drift_fit::analyse::analyse;
-use drift_fit::diagnose::{diagnose, AxisDiagnosis, Diagnoser};
-use drift_fit::evaluate::{self, switch_on_raw};
-use drift_fit::extend::{correct_with_terms, extend, TermPlan};
+use drift_fit::closing::{close, BeforeAfter};
+use drift_fit::evaluate;
 use drift_fit::roles::Roles;
 use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{read_recording, Segment, SeriesKind};
@@ -217,71 +216,47 @@ pub fn run(
         |_| {},
     )?;
     let all = segments(&dir)?;
-    let mut roles = Roles::split(&all, &CALIBRATION);
-    let analysed = roles
+    let analysed = Roles::split(&all, &CALIBRATION)
         .calibration
         .iter()
         .map(|s| analyse(s, settings))
         .collect::<Result<Vec<_>, _>>()?;
     let base = fit_unit(&analysed, settings)?;
-    roles.hold_out_outside_range(&base, settings);
-    let Roles {
-        calibration,
-        training,
-        held_out,
-        outside_range,
-    } = roles;
-    // Measured on: the +33 °C field activations (never fitted or chosen on).
-    let validation: Vec<&Segment> = held_out
-        .into_iter()
-        .filter(|s| {
-            s.labels.series_kind == SeriesKind::Field && is(VALIDATION, s.labels.set_point_celsius)
-        })
-        .collect();
+    let closed = close(&base, &all, &CALIBRATION, settings, true)?;
     eprintln!(
-        "  {} field activations at the calibration set points inside the calibrated ambient range, {outside_range} outside held out",
-        training.len()
+        "  {} field activations at the calibration set points inside the calibrated ambient range, {} outside held out",
+        closed.roles.training.len(),
+        closed.roles.outside_range
     );
-    let diagnoser = Diagnoser::new(&base, &calibration, settings)?;
-    let prepared: Vec<_> = training.iter().map(|s| diagnoser.series(s)).collect();
-    let axes: [AxisDiagnosis; 3] = diagnose(&prepared);
-    let proposed = TermPlan::choose(&axes);
-    let extended = if proposed.terms.is_empty() {
-        None
-    } else {
-        Some(extend(&base, &proposed, &calibration, &training, settings)?)
-    };
-    for a in extended.iter().flat_map(|e| &e.admissions) {
+    for a in closed.extended.iter().flat_map(|e| &e.admissions) {
         eprintln!(
-            "  guard: {} on {}: held-out gain {:.2e} (°/s)², p {:.3} → {}",
+            "  guard: {} on {}: held-out gain {:.2e} (°/s)², p {:.3}, drift gain {:+.2e} °/s → {}",
             a.candidate,
             a.axis,
             a.improvement,
             a.p_value,
+            a.drift_gain_dps,
             if a.admitted { "admitted" } else { "left out" }
         );
     }
-    let plan = extended
-        .as_ref()
-        .map_or_else(TermPlan::default, |e| e.plan.clone());
-    let window = settings.lowpass_window_samples;
-    let mut before: [Vec<(f64, f64)>; 3] = Default::default();
-    let mut after: [Vec<(f64, f64)>; 3] = Default::default();
-    for segment in &validation {
-        let on = switch_on_raw(segment, settings);
-        let plain = metric(
-            &correct_with_terms(&base.modified, &plan, segment, on),
-            window,
-        );
-        let ext = match &extended {
-            Some(e) => metric(&correct_with_terms(&e.tables, &e.plan, segment, on), window),
-            None => plain,
-        };
-        for a in 0..3 {
-            before[a].push(plain[a]);
-            after[a].push(ext[a]);
-        }
-    }
+    // Measured on: the +33 °C field activations (never fitted or chosen on).
+    let measured: Vec<BeforeAfter> = closed
+        .before_after(&base, settings)
+        .into_iter()
+        .filter(|r| r.series_kind == "field" && is(VALIDATION, r.set_point_celsius))
+        .collect();
+    let before: [Vec<(f64, f64)>; 3] = std::array::from_fn(|a| {
+        measured
+            .iter()
+            .map(|r| (r.drift_dps[a].0, r.rms_dps[a].0))
+            .collect()
+    });
+    let after: [Vec<(f64, f64)>; 3] = std::array::from_fn(|a| {
+        measured
+            .iter()
+            .map(|r| (r.drift_dps[a].1, r.rms_dps[a].1))
+            .collect()
+    });
     // Noise floor: the zero-drift twin's field activations at +33 °C, uncorrected, less the unit's
     // constant bias (the mean over all its activations): what a perfect model would leave.
     let twin = segments(&twin_dir)?;
@@ -309,14 +284,15 @@ pub fn run(
                 .map(|&v| (f64::from(v) - offset[a]) as f32)
                 .collect()
         });
-        let m = metric(&centred, window);
+        let m = metric(&centred, settings.lowpass_window_samples);
         for a in 0..3 {
             floor[a].push(m[a]);
         }
     }
     // Per axis: the terms the guard admitted there, and those proposed but left out.
     let terms = |axis: &str, admitted: bool| -> Vec<String> {
-        extended
+        closed
+            .extended
             .iter()
             .flat_map(|e| &e.admissions)
             .filter(|a| a.axis == axis && a.admitted == admitted)
@@ -335,6 +311,7 @@ pub fn run(
     }
     Ok((0..3)
         .map(|a| {
+            let axes = &closed.axes;
             let top = axes[a].ranking.first();
             Row {
                 effect: effect.to_owned(),
@@ -347,8 +324,8 @@ pub fn run(
                 before: avg(&before[a]),
                 after: avg(&after[a]),
                 floor: avg(&floor[a]),
-                field_activations: validation.len(),
-                training_activations: training.len(),
+                field_activations: measured.len(),
+                training_activations: closed.roles.training.len(),
             }
         })
         .collect())

@@ -4,9 +4,10 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use drift_fit::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, CandidateScore, Diagnoser};
+use drift_fit::closing::{close, Closed};
+use drift_fit::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_fit::pipeline;
-use drift_fit::roles::Roles;
+use drift_fit::FittedUnit;
 use drift_recording::{read_recording, Segment};
 
 use super::campaign_args::CampaignArgs;
@@ -137,42 +138,43 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .or_default()
             .extend(recording.segments);
     }
-    let mut units: BTreeMap<&String, Roles<'_>> = BTreeMap::new();
-    let mut by_unit: BTreeMap<String, Vec<ActivationSeries>> = BTreeMap::new();
+    let mut units: BTreeMap<&String, (Closed<'_>, &FittedUnit)> = BTreeMap::new();
     for (n, (unit, segments)) in recorded.iter().enumerate() {
         steps.update(
-            "fitting the tables to every candidate, then the diagnosis grid",
+            if args.extend {
+                "fitting the tables to every candidate, diagnosing, guarding the extended model"
+            } else {
+                "fitting the tables to every candidate, diagnosing"
+            },
             n as u64,
             recorded.len() as u64,
         );
         let Some(fitted) = outcome.fitted.iter().find(|f| &f.unit_id == unit) else {
             continue;
         };
-        let mut roles = Roles::split(segments, &options.calibration_set_points);
-        roles.hold_out_outside_range(fitted, &options.fit);
-        let diagnoser = Diagnoser::new(fitted, &roles.calibration, &options.fit)?;
-        let prepared: Vec<ActivationSeries> = roles
-            .diagnosed()
-            .iter()
-            .map(|s| diagnoser.series(s))
-            .collect();
-        if !prepared.is_empty() {
-            by_unit.insert(unit.clone(), prepared);
+        let closed = close(
+            fitted,
+            segments,
+            &options.calibration_set_points,
+            &options.fit,
+            args.extend,
+        )?;
+        if !closed.series.is_empty() {
+            units.insert(unit, (closed, fitted));
         }
-        units.insert(unit, roles);
     }
     steps.finish();
     anyhow::ensure!(
-        !by_unit.is_empty(),
+        !units.is_empty(),
         "no activations outside the calibration set points {:?} to diagnose",
         input.calibration
     );
     let mut md = String::from("# gyrodrift diagnosis\n\n");
     let mut json = Vec::new();
-    for (unit, activations) in &by_unit {
-        let axes = diagnose(activations);
+    for (unit, (closed, fitted)) in &units {
+        let (activations, axes, roles) = (&closed.series, &closed.axes, &closed.roles);
         let _ = writeln!(md, "# Unit {unit}\n");
-        if let Some(roles) = units.get(unit) {
+        {
             let _ = writeln!(
                 md,
                 "Diagnosed on {} activations the fit never saw ({}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are held out with the rest ({} held out in all).\n",
@@ -186,9 +188,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 roles.held_out.len()
             );
         }
-        md.push_str(&markdown(&axes, args.top));
+        md.push_str(&markdown(axes, args.top));
         println!("{unit}:");
-        for axis in &axes {
+        for axis in axes.iter() {
             let chosen = axis
                 .chosen()
                 .map_or("no significant systematic effect left".to_owned(), |c| {
@@ -225,21 +227,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 );
             }
         }
-        if let (true, Some(roles), Some(fitted)) = (
-            args.extend,
-            units.get(unit),
-            outcome.fitted.iter().find(|f| &f.unit_id == unit),
-        ) {
-            md.push_str(&super::extend::run(
-                unit,
-                &axes,
-                fitted,
-                roles,
-                &options.fit,
-                &args.out,
-            )?);
+        let before_after = if closed.extended.is_some() {
+            closed.before_after(fitted, &options.fit)
+        } else {
+            Vec::new()
+        };
+        if args.extend {
+            md.push_str(&super::extend::run(unit, closed, &before_after, &args.out)?);
         }
-        json.push(serde_json::json!({ "unit": unit, "axes": axes }));
+        json.push(serde_json::json!({
+            "unit": unit,
+            "axes": axes,
+            "proposed_terms": closed.proposed.terms.iter().map(|t| &t.candidate).collect::<Vec<_>>(),
+            "admissions": closed.extended.as_ref().map(|e| &e.admissions),
+            "before_after": before_after,
+        }));
     }
     write_atomic(&args.out.join("diagnosis.md"), md.as_bytes())?;
     write_atomic(

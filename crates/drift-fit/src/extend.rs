@@ -23,9 +23,10 @@ use serde::Serialize;
 
 use crate::absorb::Absorber;
 use crate::analyse::analyse;
+use crate::candidates::SET_POINT_CHANNEL;
 use crate::diagnose::AxisDiagnosis;
 use crate::error::FitError;
-use crate::evaluate::{sample_at, switch_on_raw};
+use crate::evaluate::{metric, sample_at, switch_on_raw};
 use crate::fit::{fit_unit, FittedUnit};
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
@@ -75,6 +76,11 @@ impl TermPlan {
             });
         }
         let channel = candidate.strip_prefix("aux:")?;
+        // The chamber's set point is the bench's ambient: a unit in the field has no chamber to
+        // ask, and the paper's tables already index the ambient (by the switch-on temperature).
+        if channel == SET_POINT_CHANNEL {
+            return None;
+        }
         let input = match self.aux_inputs.iter().position(|c| c == channel) {
             Some(input) => input,
             None if self.aux_inputs.len() < AUX_INPUTS => {
@@ -259,6 +265,9 @@ pub struct Admission {
     pub improvement: f64,
     /// One-sided p-value of that reduction.
     pub p_value: f64,
+    /// Mean held-out reduction of the paper's drift metric per activation, °/s (the term is
+    /// refused when it is significantly negative).
+    pub drift_gain_dps: f64,
     /// Whether the term was admitted on this axis (coefficient fitted) or left at zero.
     pub admitted: bool,
 }
@@ -370,19 +379,17 @@ fn refit(
     Ok((refitted, tables))
 }
 
-/// Per axis, the mean square of the 1-s low-passed residual `tables` leave on `segment`.
-fn squared_error(
+/// Per axis, the mean square of the 1-s low-passed residual `tables` leave on `segment`, and the
+/// paper's drift metric of it (max − min).
+fn errors(
     tables: &ModifiedTables,
     plan: &TermPlan,
     segment: &Segment,
     settings: &FitSettings,
-) -> [f64; 3] {
+) -> [(f64, f64); 3] {
     let corrected = correct_with_terms(tables, plan, segment, switch_on_raw(segment, settings));
-    corrected.map(|c| {
-        let low = centred_moving_average(&c, settings.lowpass_window_samples);
-        let finite: Vec<f64> = low.into_iter().filter(|v| v.is_finite()).collect();
-        finite.iter().map(|v| v * v).sum::<f64>() / finite.len().max(1) as f64
-    })
+    let (drift, rms) = metric(&corrected, settings.lowpass_window_samples);
+    std::array::from_fn(|a| (rms[a] * rms[a], drift[a]))
 }
 
 /// Coefficients per term and axis: least squares over `series` of each axis's residual on the
@@ -402,9 +409,10 @@ fn coefficients(
     coefficient
 }
 
-/// The guard's evidence for adding `term` to each axis's admitted terms: per axis, the held-out
-/// gain per training activation (squared error of the model without the term less with it), both
-/// models fitted — coefficients and refitted tables — without the held-out activations' fold.
+/// The guard's evidence for adding `term` to each axis's admitted terms: per axis and training
+/// activation, the held-out gains (squared error, and the paper's drift metric, of the model
+/// without the term less with it), both models fitted — coefficients and refitted tables —
+/// without the held-out activations' fold.
 /// This measures the model firmware would run, not a linear stand-in: a coefficient fitted on a
 /// small left-over part can be large, and the refitted tables then cancel most, not all, of it.
 #[allow(clippy::too_many_arguments)]
@@ -418,12 +426,12 @@ fn held_out_gains(
     admitted: &[Vec<usize>; 3],
     term: usize,
     settings: &FitSettings,
-) -> Result<[Vec<f64>; 3], FitError> {
+) -> Result<[Vec<(f64, f64)>; 3], FitError> {
     let with: [Vec<usize>; 3] = admitted
         .clone()
         .map(|a| a.into_iter().chain([term]).collect());
     let folds = FOLDS.clamp(2, training.len().max(2));
-    let mut gains: [Vec<f64>; 3] = Default::default();
+    let mut gains: [Vec<(f64, f64)>; 3] = Default::default();
     for fold in 0..folds {
         let train: Vec<&TrainingSeries> = series
             .iter()
@@ -437,18 +445,21 @@ fn held_out_gains(
             .filter(|(i, _)| i % folds == fold)
             .map(|(_, s)| *s)
             .collect();
-        let errors = |chosen: &[Vec<usize>; 3]| -> Result<Vec<[f64; 3]>, FitError> {
+        let held_out_errors = |chosen: &[Vec<usize>; 3]| -> Result<Vec<[(f64, f64); 3]>, FitError> {
             let extension = plan.extension(centre, &coefficients(&train, chosen, plan.terms.len()));
             let (_, tables) = refit(base, plan, &extension, calibration, settings)?;
             Ok(held_out
                 .par_iter()
-                .map(|s| squared_error(&tables, plan, s, settings))
+                .map(|s| errors(&tables, plan, s, settings))
                 .collect())
         };
-        let (without, with) = (errors(admitted)?, errors(&with)?);
+        let (without, with) = (held_out_errors(admitted)?, held_out_errors(&with)?);
         for (before, after) in without.iter().zip(&with) {
             for axis in 0..3 {
-                gains[axis].push(before[axis] - after[axis]);
+                gains[axis].push((
+                    before[axis].0 - after[axis].0,
+                    before[axis].1 - after[axis].1,
+                ));
             }
         }
     }
@@ -529,10 +540,18 @@ pub fn extend(
             settings,
         )?;
         for (axis, gains) in gains.iter().enumerate() {
-            let (improvement, p_value) = crate::diagnose::one_sided_mean_test(gains);
+            let squared: Vec<f64> = gains.iter().map(|g| g.0).collect();
+            let (improvement, p_value) = crate::diagnose::one_sided_mean_test(&squared);
+            let drift: Vec<f64> = gains.iter().map(|g| g.1).collect();
+            let (drift_gain, drift_better) = crate::diagnose::one_sided_mean_test(&drift);
             // Bonferroni over every (term, axis) pair: the guard is a test like the diagnosis.
             let level = ADMIT_ALPHA / (3 * plan.terms.len()).max(1) as f64;
-            let admit = p_value < level && improvement > 0.0;
+            // A term may lower the squared error by fixing offsets while adding wiggles within
+            // activations: it is refused when the paper's drift metric gets significantly worse
+            // (one-sided, 5 %). An offset term leaves the drift metric alone up to noise, so "not
+            // worse on average" would be a coin toss for it.
+            let drift_worse = drift_gain < 0.0 && 1.0 - drift_better < ADMIT_ALPHA;
+            let admit = p_value < level && improvement > 0.0 && !drift_worse;
             if admit {
                 admitted[axis].push(t);
             }
@@ -541,6 +560,7 @@ pub fn extend(
                 axis: AXIS_NAMES[axis],
                 improvement,
                 p_value,
+                drift_gain_dps: drift_gain,
                 admitted: admit,
             });
         }

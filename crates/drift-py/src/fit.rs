@@ -200,6 +200,30 @@ impl PyFittedUnit {
         Ok(PyActivationResult { split, result })
     }
 
+    /// Diagnoses what the paper's model leaves in the residual of this unit's activations among
+    /// `segments` (recordings, segments or files; other units' activations are skipped), as
+    /// `gyrodrift diagnose` does: candidates ranked on the field-like activations at the
+    /// calibration set points inside the calibrated ambient range (else on every activation the
+    /// fit did not see); with `extend`, the guarded extended model and its error before and after
+    /// on the held-out activations. The GIL is released.
+    #[pyo3(signature = (segments, *, calibration = None, extend = false))]
+    fn diagnose(
+        &self,
+        py: Python<'_>,
+        segments: &Bound<'_, PyAny>,
+        calibration: Option<&Bound<'_, PyAny>>,
+        extend: bool,
+    ) -> PyResult<crate::diagnosis::PyDiagnosis> {
+        crate::diagnosis::diagnose_unit(
+            py,
+            &self.unit,
+            &self.settings,
+            segments,
+            calibration,
+            extend,
+        )
+    }
+
     /// Writes `<folder>/<unit_id>/{modified,standard,third_order}.{json,bin}` as `gyrodrift fit`
     /// does; returns the unit's folder.
     fn save(&self, folder: &Bound<'_, PyAny>) -> Result<PathBuf, Error> {

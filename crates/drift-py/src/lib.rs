@@ -9,6 +9,7 @@ mod analysed;
 mod args;
 mod arrays;
 mod corrector;
+mod diagnosis;
 mod errors;
 mod evaluation;
 mod extension;
@@ -48,6 +49,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(simulate::resolve_campaign, module)?)?;
     module.add_class::<fit_settings::PyFitSettings>()?;
     module.add_class::<fit::PyFittedUnit>()?;
+    module.add_class::<diagnosis::PyDiagnosis>()?;
     module.add_function(wrap_pyfunction!(fit::fit, module)?)?;
     module.add_class::<analysed::PyAnalysed>()?;
     module.add_function(wrap_pyfunction!(analysed::analyse, module)?)?;

@@ -36,6 +36,7 @@ __all__ = [
     "AuxChannel",
     "CampaignError",
     "Corrector",
+    "Diagnosis",
     "Evaluation",
     "ExtraTerm",
     "FileError",
@@ -684,6 +685,48 @@ class ActivationResult:
         """Per model: union of the corrector's flags over the activation, per axis."""
 
 @final
+class Diagnosis:
+    """What the diagnosis found for one unit, and the extended model when one was asked for."""
+
+    @property
+    def unit_id(self) -> str:
+        """Unit id."""
+    @property
+    def ranking(self) -> list[dict[str, Any]]:
+        """The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
+        significant, coefficient, absorbed_by_model): a new list of dicts."""
+    def to_dataframe(self) -> Any:
+        """The ranking as a pandas DataFrame (needs pandas; raises ImportError without it)."""
+    @property
+    def chosen(self) -> list[tuple[str, str | None]]:
+        """Per axis ("X", "Y", "Z"), the significant winner's name, or None when no significant
+        systematic effect is left."""
+    @property
+    def proposed_terms(self) -> list[str]:
+        """The terms the diagnosis proposes for the extended model."""
+    @property
+    def admissions(self) -> list[dict[str, Any]]:
+        """The guard's decision for every proposed term and axis (records: candidate, axis,
+        improvement, p_value, drift_gain_dps, admitted); empty unless `extend=True`."""
+    @property
+    def extended(self) -> ModifiedTables | None:
+        """The extended model (the refitted tables with the admitted terms), or None when none was
+        asked for or no term was admitted."""
+    @property
+    def aux_inputs(self) -> list[str]:
+        """The recorded channels the firmware passes as the extended model's auxiliary inputs 0..,
+        in order."""
+    @property
+    def before_after(self) -> list[dict[str, Any]]:
+        """Per held-out activation, the error before (paper's model) and after (extended model):
+        records with set_point_celsius, series_kind, drift_dps and rms_dps (per axis, [before,
+        after]); empty unless `extend=True` and terms were proposed."""
+    @property
+    def activations(self) -> list[tuple[str, int]]:
+        """How many activations played each part: calibration, training, held_out, outside_range,
+        diagnosed."""
+
+@final
 class FittedUnit:
     """Everything fitted for one unit: the paper's tables and both baselines."""
 
@@ -714,6 +757,20 @@ class FittedUnit:
     def evaluate(self, segment: Segment, *, split: str | None = None) -> ActivationResult:
         """Corrects one activation with every model and measures the paper's metric; `split`
         ("validation" by default) labels the result for `summarise`. The GIL is released."""
+    def diagnose(
+        self,
+        segments: _Source,
+        *,
+        calibration: Sequence[float] | str | None = None,
+        extend: bool = False,
+    ) -> Diagnosis:
+        """Diagnoses what the paper's model leaves in the residual of this unit's activations among
+        `segments` (recordings, segments or files; other units' activations are skipped), as
+        `gyrodrift diagnose` does: candidates ranked on the field-like activations at the
+        calibration set points inside the calibrated ambient range (else on every activation the
+        fit did not see); with `extend`, the guarded extended model and its error before and after
+        on the held-out activations. The GIL is released. Raises `InputError` (no activation of
+        this unit to diagnose) or `FitError`."""
     def save(self, folder: _Path) -> Path:
         """Writes <folder>/<unit_id>/{modified,standard,third_order}.{json,bin} as `gyrodrift fit`
         does; returns the unit's folder. Raises `FileError`."""

@@ -1,0 +1,122 @@
+//! Closing the loop for one unit, in the data's one direction: activations by role → the
+//! diagnosis of the paper model's residual → proposed terms → the guarded extended model → the
+//! error before and after on the held-out activations. The command line (`gyrodrift diagnose
+//! [--extend]`), the Python module and the closed-loop experiment all run this.
+
+use drift_recording::Segment;
+use serde::Serialize;
+
+use crate::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, Diagnoser};
+use crate::error::FitError;
+use crate::evaluate::{metric, switch_on_raw};
+use crate::extend::{correct_with_terms, extend, Extended, TermPlan};
+use crate::fit::FittedUnit;
+use crate::roles::Roles;
+use crate::settings::FitSettings;
+
+/// One unit's loop, closed as far as its data allow.
+pub struct Closed<'a> {
+    /// Which activations played which part.
+    pub roles: Roles<'a>,
+    /// The diagnosed activations on the diagnosis grid.
+    pub series: Vec<ActivationSeries>,
+    /// The ranking per axis.
+    pub axes: [AxisDiagnosis; 3],
+    /// The terms the diagnosis proposes (significant winners the firmware can compute).
+    pub proposed: TermPlan,
+    /// The extended model, when asked for, when something was proposed and there are training
+    /// activations to fit it on.
+    pub extended: Option<Extended>,
+}
+
+/// The error of one held-out activation with the paper's model and with the extended one.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BeforeAfter {
+    /// Chamber set point, °C.
+    pub set_point_celsius: f64,
+    /// `protocol` or `field`.
+    pub series_kind: &'static str,
+    /// Per axis, the paper's drift metric (max − min of the 1-s mean), °/s: before, after.
+    pub drift_dps: [(f64, f64); 3],
+    /// Per axis, RMS of the 1-s mean, °/s: before, after.
+    pub rms_dps: [(f64, f64); 3],
+}
+
+/// Splits `segments` (one unit's) by role, diagnoses the paper model `fitted` on the training
+/// activations (or, without any, on every activation the fit did not see), and with `extend`
+/// fits the guarded extended model.
+pub fn close<'a>(
+    fitted: &FittedUnit,
+    segments: impl IntoIterator<Item = &'a Segment>,
+    calibration_set_points: &[f64],
+    settings: &FitSettings,
+    extend_model: bool,
+) -> Result<Closed<'a>, FitError> {
+    let mut roles = Roles::split(segments, calibration_set_points);
+    roles.hold_out_outside_range(fitted, settings);
+    let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings)?;
+    let series: Vec<ActivationSeries> = roles
+        .diagnosed()
+        .iter()
+        .map(|s| diagnoser.series(s))
+        .collect();
+    let axes = diagnose(&series);
+    let proposed = TermPlan::choose(&axes);
+    let extended = if extend_model && !proposed.terms.is_empty() && !roles.training.is_empty() {
+        Some(extend(
+            fitted,
+            &proposed,
+            &roles.calibration,
+            &roles.training,
+            settings,
+        )?)
+    } else {
+        None
+    };
+    Ok(Closed {
+        roles,
+        series,
+        axes,
+        proposed,
+        extended,
+    })
+}
+
+impl Closed<'_> {
+    /// The terms the guard admitted (empty without an extended model).
+    pub fn admitted(&self) -> TermPlan {
+        self.extended
+            .as_ref()
+            .map_or_else(TermPlan::default, |e| e.plan.clone())
+    }
+
+    /// The error before (paper's model `fitted`) and after (the extended model; the paper's model
+    /// when nothing was admitted) on every held-out activation.
+    pub fn before_after(&self, fitted: &FittedUnit, settings: &FitSettings) -> Vec<BeforeAfter> {
+        let plan = self.admitted();
+        let window = settings.lowpass_window_samples;
+        self.roles
+            .held_out
+            .iter()
+            .map(|segment| {
+                let on = switch_on_raw(segment, settings);
+                let (drift_before, rms_before) = metric(
+                    &correct_with_terms(&fitted.modified, &plan, segment, on),
+                    window,
+                );
+                let (drift_after, rms_after) = match &self.extended {
+                    Some(e) if !e.plan.terms.is_empty() => {
+                        metric(&correct_with_terms(&e.tables, &plan, segment, on), window)
+                    }
+                    _ => (drift_before, rms_before),
+                };
+                BeforeAfter {
+                    set_point_celsius: segment.labels.set_point_celsius,
+                    series_kind: segment.labels.series_kind.as_str(),
+                    drift_dps: std::array::from_fn(|a| (drift_before[a], drift_after[a])),
+                    rms_dps: std::array::from_fn(|a| (rms_before[a], rms_after[a])),
+                }
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,258 @@
+//! `FittedUnit.diagnose` and `gyrodrift.Diagnosis`: the command line's `gyrodrift diagnose
+//! [--extend]` for one unit, through drift-fit's `closing` (roles → diagnosis → guarded extended
+//! model → error before and after). Conversion and delegation only.
+
+use std::sync::Arc;
+
+use drift_fit::closing::close;
+use drift_fit::closing::BeforeAfter;
+use drift_fit::diagnose::AxisDiagnosis;
+use drift_fit::extend::Admission;
+use drift_fit::{FitSettings, FittedUnit};
+use drift_recording::{read_recording, Segment};
+use pyo3::prelude::*;
+use serde::Serialize;
+
+use crate::errors::Error;
+use crate::sources::{self, Source};
+use crate::tables::PyModifiedTables;
+
+/// What the diagnosis found for one unit, and the extended model when one was asked for.
+#[pyclass(module = "gyrodrift", name = "Diagnosis", frozen)]
+#[derive(Debug)]
+pub struct PyDiagnosis {
+    unit_id: String,
+    axes: [AxisDiagnosis; 3],
+    proposed: Vec<String>,
+    admissions: Vec<Admission>,
+    extended: Option<PyModifiedTables>,
+    aux_inputs: Vec<String>,
+    before_after: Vec<BeforeAfter>,
+    counts: [(&'static str, usize); 5],
+}
+
+/// Serialisable values as Python objects (lists and dicts), through JSON like `report.json`.
+fn to_python<'py>(py: Python<'py>, value: &impl Serialize) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value)
+        .map_err(|e| Error::Input(format!("internal: records JSON: {e}")))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// One row of the ranking, flat for a DataFrame.
+#[derive(Serialize)]
+struct RankRecord<'a> {
+    axis: &'static str,
+    rank: usize,
+    candidate: &'a str,
+    level: &'static str,
+    explained: f64,
+    p_value: f64,
+    significant: bool,
+    coefficient: f64,
+    absorbed_by_model: f64,
+}
+
+/// The activations of `segments`: files are read, objects in memory are shared.
+fn activations(source: Source) -> Result<Vec<Arc<Segment>>, Error> {
+    match source {
+        Source::Segments(segments) => Ok(segments),
+        Source::Files(files) => {
+            let mut all = Vec::new();
+            for path in files {
+                all.extend(read_recording(&path)?.segments.into_iter().map(Arc::new));
+            }
+            Ok(all)
+        }
+    }
+}
+
+/// Runs the loop for `unit` on its activations among `segments`.
+pub fn diagnose_unit(
+    py: Python<'_>,
+    unit: &FittedUnit,
+    settings: &FitSettings,
+    segments: &Bound<'_, PyAny>,
+    calibration: Option<&Bound<'_, PyAny>>,
+    extend: bool,
+) -> PyResult<PyDiagnosis> {
+    let source = sources::source(py, "segments", segments)?;
+    let set_points = match calibration {
+        Some(v) if !v.is_none() => sources::set_points("calibration", v, false)?,
+        _ => unit
+            .set_points
+            .iter()
+            .map(|s| s.set_point_celsius)
+            .collect(),
+    };
+    let diagnosis = py.detach(|| -> Result<PyDiagnosis, Error> {
+        let all = activations(source)?;
+        let own: Vec<&Segment> = all
+            .iter()
+            .map(AsRef::as_ref)
+            .filter(|s| s.labels.unit_id == unit.unit_id)
+            .collect();
+        if own.is_empty() {
+            return Err(Error::Input(format!(
+                "`segments` holds no activation of unit {} ({} activations of other units)",
+                unit.unit_id,
+                all.len()
+            )));
+        }
+        let closed = close(unit, own, &set_points, settings, extend)?;
+        if closed.series.is_empty() {
+            return Err(Error::Input(format!(
+                "`segments` holds no activation of unit {} outside the calibration protocol at {set_points:?} °C to diagnose",
+                unit.unit_id
+            )));
+        }
+        let before_after = if closed.extended.is_some() {
+            closed.before_after(unit, settings)
+        } else {
+            Vec::new()
+        };
+        let admitted = closed.extended.as_ref().filter(|e| !e.plan.terms.is_empty());
+        Ok(PyDiagnosis {
+            unit_id: unit.unit_id.clone(),
+            proposed: closed
+                .proposed
+                .terms
+                .iter()
+                .map(|t| t.candidate.clone())
+                .collect(),
+            admissions: closed
+                .extended
+                .as_ref()
+                .map(|e| e.admissions.clone())
+                .unwrap_or_default(),
+            extended: admitted.map(|e| PyModifiedTables(Arc::new(e.tables.clone()))),
+            aux_inputs: admitted
+                .map(|e| e.plan.aux_inputs.clone())
+                .unwrap_or_default(),
+            before_after,
+            counts: [
+                ("calibration", closed.roles.calibration.len()),
+                ("training", closed.roles.training.len()),
+                ("held_out", closed.roles.held_out.len()),
+                ("outside_range", closed.roles.outside_range),
+                ("diagnosed", closed.series.len()),
+            ],
+            axes: closed.axes,
+        })
+    })?;
+    Ok(diagnosis)
+}
+
+#[pymethods]
+impl PyDiagnosis {
+    /// Unit id.
+    #[getter]
+    fn unit_id(&self) -> &str {
+        &self.unit_id
+    }
+
+    /// The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
+    /// significant, coefficient, absorbed_by_model): a new list of dicts.
+    #[getter]
+    fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.records())
+    }
+
+    /// The ranking as a pandas DataFrame (needs pandas; raises ImportError without it).
+    fn to_dataframe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pandas = py.import("pandas").map_err(|error| {
+            pyo3::exceptions::PyImportError::new_err(format!(
+                "Diagnosis.to_dataframe needs pandas (pip install pandas): {error}"
+            ))
+        })?;
+        pandas.call_method1("DataFrame", (to_python(py, &self.records())?,))
+    }
+
+    /// Per axis ("X", "Y", "Z"), the significant winner's name, or None when no significant
+    /// systematic effect is left.
+    #[getter]
+    fn chosen(&self) -> Vec<(&'static str, Option<String>)> {
+        self.axes
+            .iter()
+            .map(|a| (a.axis, a.chosen().map(|c| c.name.clone())))
+            .collect()
+    }
+
+    /// The terms the diagnosis proposes for the extended model.
+    #[getter]
+    fn proposed_terms(&self) -> Vec<String> {
+        self.proposed.clone()
+    }
+
+    /// The guard's decision for every proposed term and axis (records: candidate, axis,
+    /// improvement, p_value, drift_gain_dps, admitted); empty unless `extend=True`.
+    #[getter]
+    fn admissions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.admissions)
+    }
+
+    /// The extended model (the refitted tables with the admitted terms), or None when none was
+    /// asked for or no term was admitted.
+    #[getter]
+    fn extended(&self) -> Option<PyModifiedTables> {
+        self.extended.clone()
+    }
+
+    /// The recorded channels the firmware passes as the extended model's auxiliary inputs 0..,
+    /// in order.
+    #[getter]
+    fn aux_inputs(&self) -> Vec<String> {
+        self.aux_inputs.clone()
+    }
+
+    /// Per held-out activation, the error before (paper's model) and after (extended model):
+    /// records with set_point_celsius, series_kind, drift_dps and rms_dps (per axis, [before,
+    /// after]); empty unless `extend=True` and terms were proposed.
+    #[getter]
+    fn before_after<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.before_after)
+    }
+
+    /// How many activations played each part: calibration, training, held_out, outside_range,
+    /// diagnosed.
+    #[getter]
+    fn activations(&self) -> Vec<(&'static str, usize)> {
+        self.counts.to_vec()
+    }
+
+    fn __repr__(&self) -> String {
+        let chosen: Vec<String> = self
+            .axes
+            .iter()
+            .map(|a| {
+                format!(
+                    "{}: {}",
+                    a.axis,
+                    a.chosen()
+                        .map_or("nothing significant", |c| c.name.as_str())
+                )
+            })
+            .collect();
+        format!("<Diagnosis {}: {}>", self.unit_id, chosen.join("; "))
+    }
+}
+
+impl PyDiagnosis {
+    fn records(&self) -> Vec<RankRecord<'_>> {
+        self.axes
+            .iter()
+            .flat_map(|axis| {
+                axis.ranking.iter().enumerate().map(|(i, c)| RankRecord {
+                    axis: axis.axis,
+                    rank: i + 1,
+                    candidate: &c.name,
+                    level: c.level,
+                    explained: c.explained,
+                    p_value: c.p_value,
+                    significant: c.significant,
+                    coefficient: c.coefficient,
+                    absorbed_by_model: c.absorbed_by_model,
+                })
+            })
+            .collect()
+    }
+}

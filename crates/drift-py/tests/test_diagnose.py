@@ -1,0 +1,96 @@
+"""FittedUnit.diagnose: the command line's `gyrodrift diagnose --extend` from Python, on a campaign
+with a supply-voltage sensitivity the fitter is never told about."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import gyrodrift
+
+CAMPAIGN = """
+name = "py-diagnose"
+seed = 3
+units = 1
+set_points_celsius = [30.0, 40.0, 33.0]
+[protocol]
+intervals_min = [1.0, 5.0, 30.0]
+repeats = 2
+[field]
+sessions = 3
+ambient_ramp_c_per_min = 0.0
+carry_probability = 0.0
+[effects.supply_voltage]
+dps_per_v = 0.04
+"""
+
+
+@pytest.fixture(scope="module")
+def campaign(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("diagnose")
+    gyrodrift.simulate(out, CAMPAIGN)
+    return out
+
+
+@pytest.fixture(scope="module")
+def diagnosis(campaign: Path) -> gyrodrift.Diagnosis:
+    (unit,) = gyrodrift.fit(campaign)
+    return unit.diagnose(gyrodrift.load_campaign(campaign), extend=True)
+
+
+def test_the_hidden_supply_effect_is_found_admitted_and_lowers_the_held_out_error(
+    diagnosis: gyrodrift.Diagnosis,
+) -> None:
+    chosen = dict(diagnosis.chosen)
+    found = [axis for axis, name in chosen.items() if name == "aux:supply_voltage"]
+    assert len(found) >= 2, diagnosis.ranking
+    assert "aux:supply_voltage" in diagnosis.proposed_terms
+    assert "supply_voltage" in diagnosis.aux_inputs
+    admitted = {(a["candidate"], a["axis"]) for a in diagnosis.admissions if a["admitted"]}
+    assert all(("aux:supply_voltage", axis) in admitted for axis in found), diagnosis.admissions
+    extended = diagnosis.extended
+    assert extended is not None and len(extended.extension) >= 1
+    # The error before/after on the held-out +33 °C field activations, per axis where it was found.
+    field33 = [
+        r for r in diagnosis.before_after if r["series_kind"] == "field" and r["set_point_celsius"] == 33.0
+    ]
+    assert field33
+    for axis in found:
+        a = "XYZ".index(axis)
+        before = sum(r["rms_dps"][a][0] for r in field33) / len(field33)
+        after = sum(r["rms_dps"][a][1] for r in field33) / len(field33)
+        assert after < 0.8 * before, (axis, before, after)
+
+
+def test_the_ranking_is_records_with_every_axis(diagnosis: gyrodrift.Diagnosis) -> None:
+    records = diagnosis.ranking
+    assert {r["axis"] for r in records} == {"X", "Y", "Z"}
+    first = [r for r in records if r["rank"] == 1]
+    assert len(first) == 3
+    assert set(records[0]) >= {
+        "candidate",
+        "level",
+        "explained",
+        "p_value",
+        "significant",
+        "absorbed_by_model",
+    }
+    counts = dict(diagnosis.activations)
+    assert counts["diagnosed"] == counts["training"] > 0
+    assert "Diagnosis GIU-01" in repr(diagnosis)
+
+
+def test_a_unit_without_activations_is_an_input_error(campaign: Path) -> None:
+    (unit,) = gyrodrift.fit(campaign)
+    calibration_only = [
+        s
+        for recording in gyrodrift.load_campaign(campaign)
+        for s in recording.segments
+        if s.labels.series_kind == "protocol" and s.labels.set_point_celsius != 33.0
+    ]
+    assert calibration_only
+    with pytest.raises(gyrodrift.InputError, match="outside the calibration protocol"):
+        unit.diagnose(calibration_only)
+    with pytest.raises(gyrodrift.InputError, match="`segments`"):
+        unit.diagnose(42)  # type: ignore[arg-type]
