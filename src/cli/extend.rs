@@ -34,7 +34,7 @@ pub fn run(
     };
     let _ = writeln!(
         md,
-        "Guard: each proposed term is admitted on an axis only if the refitted model with it (coefficients and tables fitted without the held-out fold) lowers the residual on held-out activations among the {} field-like activations at the calibration set points within the calibrated ambient range (5-fold cross-validation by activation, against the terms admitted before it; one-sided test, Bonferroni over every term and axis, family-wise 5 %), and the paper's drift metric on the same held-out activations does not get significantly worse (one-sided, 5 %):\n",
+        "Guard: each proposed term is admitted on an axis only if the refitted model with it (coefficients and tables fitted without the held-out fold) lowers the residual on held-out activations among the {} field-like activations at the calibration set points within the calibrated ambient range (5-fold cross-validation by activation, against the terms admitted before it; one-sided test, Bonferroni over every term and axis, family-wise 5 %), and the paper's drift metric on the same held-out activations does not get significantly worse (one-sided, 5 %, by more than 1 %):\n",
         training.len()
     );
     md.push_str(
