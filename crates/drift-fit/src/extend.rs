@@ -146,6 +146,33 @@ impl TermPlan {
         plan
     }
 
+    /// The plan with only the terms `keep` (indices, in order) and the auxiliary inputs they read,
+    /// renumbered.
+    fn keeping(&self, keep: &[usize]) -> Self {
+        let mut kept = Self::default();
+        for chosen in keep.iter().filter_map(|&t| self.terms.get(t)) {
+            let mut chosen = chosen.clone();
+            if let Term::Aux { input } = chosen.term {
+                let Some(channel) = self.aux_inputs.get(usize::from(input)) else {
+                    continue;
+                };
+                let renumbered = match kept.aux_inputs.iter().position(|c| c == channel) {
+                    Some(i) => i,
+                    None => {
+                        kept.aux_inputs.push(channel.clone());
+                        kept.aux_inputs.len() - 1
+                    }
+                };
+                let Ok(input) = u8::try_from(renumbered) else {
+                    continue;
+                };
+                chosen.term = Term::Aux { input };
+            }
+            kept.terms.push(chosen);
+        }
+        kept
+    }
+
     /// The auxiliary inputs of sample `i` of `segment`, NaN where the channel is missing.
     fn aux_at(&self, segment: &Segment, i: usize) -> [f32; AUX_INPUTS] {
         let mut aux = [f32::NAN; AUX_INPUTS];
@@ -409,12 +436,22 @@ fn coefficients(
     coefficient
 }
 
+/// One held-out activation's evidence on one axis.
+struct HeldOutGain {
+    /// Mean square of the 1-s residual without the term less with it, (°/s)².
+    squared: f64,
+    /// The paper's drift metric without the term less with it, °/s.
+    drift: f64,
+    /// The drift metric without the term, °/s.
+    drift_before: f64,
+}
+
 /// The guard's evidence for adding `term` to each axis's admitted terms: per axis and training
 /// activation, the held-out gains (squared error, and the paper's drift metric, of the model
-/// without the term less with it) and the drift metric without it, both models fitted — coefficients and refitted tables —
-/// without the held-out activations' fold.
-/// This measures the model firmware would run, not a linear stand-in: a coefficient fitted on a
-/// small left-over part can be large, and the refitted tables then cancel most, not all, of it.
+/// without the term less with it) and the drift metric without it; both models are fitted —
+/// coefficients and refitted tables — without the held-out activations' fold. This measures the
+/// model firmware would run, not a linear stand-in: a coefficient fitted on a small left-over part
+/// can be large, and the refitted tables then cancel most, not all, of it.
 #[allow(clippy::too_many_arguments)]
 fn held_out_gains(
     base: &FittedUnit,
@@ -426,12 +463,12 @@ fn held_out_gains(
     admitted: &[Vec<usize>; 3],
     term: usize,
     settings: &FitSettings,
-) -> Result<[Vec<(f64, f64, f64)>; 3], FitError> {
+) -> Result<[Vec<HeldOutGain>; 3], FitError> {
     let with: [Vec<usize>; 3] = admitted
         .clone()
         .map(|a| a.into_iter().chain([term]).collect());
     let folds = FOLDS.clamp(2, training.len().max(2));
-    let mut gains: [Vec<(f64, f64, f64)>; 3] = Default::default();
+    let mut gains: [Vec<HeldOutGain>; 3] = Default::default();
     for fold in 0..folds {
         let train: Vec<&TrainingSeries> = series
             .iter()
@@ -456,11 +493,11 @@ fn held_out_gains(
         let (without, with) = (held_out_errors(admitted)?, held_out_errors(&with)?);
         for (before, after) in without.iter().zip(&with) {
             for axis in 0..3 {
-                gains[axis].push((
-                    before[axis].0 - after[axis].0,
-                    before[axis].1 - after[axis].1,
-                    before[axis].1,
-                ));
+                gains[axis].push(HeldOutGain {
+                    squared: before[axis].0 - after[axis].0,
+                    drift: before[axis].1 - after[axis].1,
+                    drift_before: before[axis].1,
+                });
             }
         }
     }
@@ -541,19 +578,18 @@ pub fn extend(
             settings,
         )?;
         for (axis, gains) in gains.iter().enumerate() {
-            let squared: Vec<f64> = gains.iter().map(|g| g.0).collect();
+            let squared: Vec<f64> = gains.iter().map(|g| g.squared).collect();
             let (improvement, p_value) = crate::diagnose::one_sided_mean_test(&squared);
-            let drift: Vec<f64> = gains.iter().map(|g| g.1).collect();
+            let drift: Vec<f64> = gains.iter().map(|g| g.drift).collect();
             let (drift_gain, drift_better) = crate::diagnose::one_sided_mean_test(&drift);
             // Bonferroni over every (term, axis) pair: the guard is a test like the diagnosis.
             let level = ADMIT_ALPHA / (3 * plan.terms.len()).max(1) as f64;
             // A term may lower the squared error by fixing offsets while adding wiggles within
             // activations: it is refused when the paper's drift metric gets significantly worse
-            // (one-sided, 5 %, by more than 1 %). An offset term leaves the drift metric alone up to noise, so "not
-            // worse on average" would be a coin toss for it.
-            // A consistent change far below anything measurable (a refit moves the tables by
-            // ~1e-7 °/s) is not "worse": it must exceed 1 % of the drift metric as well.
-            let drift_before = gains.iter().map(|g| g.2).sum::<f64>() / gains.len().max(1) as f64;
+            // (one-sided, 5 %) by more than 1 %. Not "no worse on average": an offset term leaves
+            // the metric alone up to noise, and a refit moves it consistently by ~1e-7 °/s.
+            let drift_before =
+                gains.iter().map(|g| g.drift_before).sum::<f64>() / gains.len().max(1) as f64;
             let drift_worse = drift_gain < -0.01 * drift_before && 1.0 - drift_better < ADMIT_ALPHA;
             let admit = p_value < level && improvement > 0.0 && !drift_worse;
             if admit {
@@ -571,15 +607,12 @@ pub fn extend(
     }
     let all: Vec<&TrainingSeries> = series.iter().collect();
     let coefficient = coefficients(&all, &admitted, plan.terms.len());
-    // Terms no axis admitted are dropped, and the plan with them (the firmware computes nothing
-    // for them); auxiliary inputs keep their numbers.
+    // Terms no axis admitted are dropped (the firmware computes nothing for them), and so are
+    // auxiliary inputs no kept term reads: the inputs are renumbered in order.
     let keep: Vec<usize> = (0..plan.terms.len())
         .filter(|&t| coefficient[t].iter().any(|c| *c != 0.0))
         .collect();
-    let kept = TermPlan {
-        terms: keep.iter().map(|&t| plan.terms[t].clone()).collect(),
-        aux_inputs: plan.aux_inputs.clone(),
-    };
+    let kept = plan.keeping(&keep);
     let extension = kept.extension(
         &keep.iter().map(|&t| centre[t]).collect::<Vec<_>>(),
         &keep.iter().map(|&t| coefficient[t]).collect::<Vec<_>>(),
@@ -595,7 +628,7 @@ pub fn extend(
 
 /// `segment` with the extension's contribution taken out of its rates (what the tables should
 /// see once the extra terms explain their part).
-pub fn without_terms(
+fn without_terms(
     extension: &Extension,
     plan: &TermPlan,
     core_settings: &Settings,
@@ -701,6 +734,20 @@ mod tests {
             ]
         );
         assert_eq!(plan.aux_inputs, ["accel_y", "accel_x", "accel_z"]);
+    }
+
+    #[test]
+    fn keeping_terms_renumbers_the_auxiliary_inputs_they_read() {
+        let axes = [axis(
+            "X",
+            &[("aux:a", true), ("aux:b", true), ("rise² X", true)],
+        )];
+        let plan = TermPlan::choose(&axes);
+        let kept = plan.keeping(&[1, 2]);
+        let terms: Vec<Term> = kept.terms.iter().map(|t| t.term).collect();
+        assert_eq!(terms, [Term::Aux { input: 0 }, Term::RiseSquared]);
+        assert_eq!(kept.aux_inputs, ["b"]);
+        assert!(plan.keeping(&[]).terms.is_empty() && plan.keeping(&[]).aux_inputs.is_empty());
     }
 
     #[test]
