@@ -8,6 +8,7 @@
 //! [`write_recording`] writes the same format from a real test bench's data, and [`read_csv`] reads
 //! measured data from CSV into the same segments.
 
+mod aux;
 pub mod cdr;
 mod csv_file;
 mod error;
@@ -16,9 +17,11 @@ mod messages;
 mod read;
 pub mod schema;
 mod segment;
+mod writable;
 mod write;
 pub mod writer;
 
+pub use aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic, FIXED_AUX_CHANNELS};
 pub use csv_file::{
     read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming, RateUnit, TimeUnit,
 };
