@@ -10,6 +10,7 @@
 
 mod aux;
 pub mod cdr;
+mod csv_aux;
 mod csv_file;
 mod error;
 mod layout;
@@ -22,6 +23,7 @@ mod write;
 pub mod writer;
 
 pub use aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic, FIXED_AUX_CHANNELS};
+pub use csv_aux::CsvAuxColumn;
 pub use csv_file::{
     read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming, RateUnit, TimeUnit,
 };

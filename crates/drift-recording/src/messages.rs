@@ -76,12 +76,13 @@ pub(crate) fn for_each_message<E>(
                 channels.insert(channel.id, info);
             }
             Record::Message { header, data } => {
-                let channel = channels
-                    .get(&header.channel_id)
-                    .ok_or(Ok(McapError::UnknownChannel(
-                        header.sequence,
-                        header.channel_id,
-                    )))?;
+                let channel =
+                    channels
+                        .get(&header.channel_id)
+                        .ok_or(Ok(McapError::UnknownChannel(
+                            header.sequence,
+                            header.channel_id,
+                        )))?;
                 each(channel, header.log_time, &data).map_err(Err)?;
             }
             // The summary repeats channels; messages are all in the data section.

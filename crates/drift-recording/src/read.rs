@@ -12,8 +12,8 @@
 //! than a skip: a channel a bench meant to record would otherwise vanish from the diagnosis
 //! unnoticed. Topics outside `/aux/` that the format does not know are ignored.
 
-use crate::error::ReadError;
 use crate::aux::check_named_aux_channel;
+use crate::error::ReadError;
 use crate::layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use crate::messages::ChannelInfo;
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};

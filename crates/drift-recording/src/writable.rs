@@ -47,9 +47,8 @@ pub(crate) fn check_writable(recording: &Recording) -> Result<Vec<NamedTopic>, S
                     }
                 }
             }
-            check_samples(segment, channel).map_err(|e| {
-                format!("{}, auxiliary channel `{name}`: {e}", at())
-            })?;
+            check_samples(segment, channel)
+                .map_err(|e| format!("{}, auxiliary channel `{name}`: {e}", at()))?;
         }
     }
     Ok(named

@@ -106,11 +106,7 @@ impl McapFile {
     }
 
     /// Writes the message currently in `self.enc` on `topic` at `log_time_ns`.
-    pub fn write_encoded(
-        &mut self,
-        topic: &str,
-        log_time_ns: u64,
-    ) -> Result<(), WriteError> {
+    pub fn write_encoded(&mut self, topic: &str, log_time_ns: u64) -> Result<(), WriteError> {
         let channel_id = *self
             .channels
             .get(topic)
