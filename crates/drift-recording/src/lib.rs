@@ -2,9 +2,10 @@
 //! corrector → residual → report.
 //!
 //! The format (specified in `docs/recording-format.md`): MCAP files with CDR-encoded (`ros2msg`)
-//! batches of samples, one topic per signal, zstd chunks. [`read_recording`] validates while it
-//! reads and yields [`Segment`]s, one per activation, with their protocol labels; it refuses
-//! simulator ground truth, so code that reads through it cannot see the truth.
+//! batches of samples, one topic per signal (and one per named auxiliary channel, `/aux/<name>`),
+//! zstd chunks. [`read_recording`] validates while it reads and yields [`Segment`]s, one per
+//! activation, with their protocol labels; it refuses simulator ground truth, so code that reads
+//! through it cannot see the truth.
 //! [`write_recording`] writes the same format from a real test bench's data, and [`read_csv`] reads
 //! measured data from CSV into the same segments.
 
