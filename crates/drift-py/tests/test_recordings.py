@@ -82,7 +82,9 @@ def test_named_channels_round_trip_through_mcap(tmp_path: Path) -> None:
         "0": (np.zeros(m), ""),
     }
     first = make_segment(n)
-    base = {name: (channel.values, channel.unit, channel.sample_rate_hz) for name, channel in first.aux.items()}
+    base = {
+        name: (channel.values, channel.unit, channel.sample_rate_hz) for name, channel in first.aux.items()
+    }
     aux = {**base, **{name: (values, unit, 100) for name, (values, unit) in named.items()}}
     with_named = gyrodrift.Segment(first.labels, first.rate_dps, first.temperature_raw, aux=aux)
     second = make_segment(1000, power_on_ns=10**10, activation=2)  # the format's channels only
@@ -96,7 +98,10 @@ def test_named_channels_round_trip_through_mcap(tmp_path: Path) -> None:
         assert channel.unit == unit and channel.sample_rate_hz == 100
         assert np.array_equal(channel.values, np.asarray(values, dtype=np.float32)), name
     for name in base:
-        assert np.array_equal(read[name].values, first.aux[name].values) and read[name].unit == first.aux[name].unit
+        assert (
+            np.array_equal(read[name].values, first.aux[name].values)
+            and read[name].unit == first.aux[name].unit
+        )
     assert sorted(back.segments[1].aux) == sorted(base)
 
 

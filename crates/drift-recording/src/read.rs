@@ -14,7 +14,7 @@
 
 use crate::aux::check_named_aux_channel;
 use crate::error::ReadError;
-use crate::layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+use crate::layout::{aux_samples_covered, AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use crate::messages::ChannelInfo;
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use crate::segment::{AuxChannel, Segment, SegmentLabels, SeriesKind};
@@ -457,6 +457,16 @@ impl Reader<'_> {
         ]);
         // Named channels never shadow these: their names were checked at their first message.
         aux.extend(open.named);
+        // Samples past the switch-off would be dropped by a write back (and be nonsense).
+        let covered = aux_samples_covered(n, self.rate_hz);
+        if let Some((name, c)) = aux.iter().find(|(_, c)| c.values.len() > covered) {
+            return Err(format!(
+                "auxiliary channel `{name}` has {} samples, but the activation ({n} samples at {} \
+                 Hz) covers {covered} at {AUX_RATE_HZ} Hz",
+                c.values.len(),
+                self.rate_hz
+            ));
+        }
         self.segments.push(Segment {
             labels: open.labels,
             sample_rate_hz: self.rate_hz,

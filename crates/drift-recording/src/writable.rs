@@ -1,11 +1,12 @@
 //! What [`crate::write_recording`] can store, checked before the file is created: every auxiliary
 //! channel of every segment is either one of the format's own (in its fixed unit) or a valid named
 //! channel with one unit across the recording; all are at the format's auxiliary rate, finite, and
-//! no longer than their activation. The reader refuses anything else, so a file written without
-//! these checks could be unreadable, or silently relabel or drop samples.
+//! no longer than their activation. The reader refuses or relabels anything else, so a file written
+//! without these checks could be unreadable, or silently relabel or drop samples; and whatever the
+//! reader accepts passes them, so a recording read can always be written back.
 
 use crate::aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic};
-use crate::layout::AUX_RATE_HZ;
+use crate::layout::{aux_samples_covered, AUX_RATE_HZ};
 use crate::read::Recording;
 use crate::segment::{AuxChannel, Segment};
 use std::collections::BTreeMap;
@@ -76,19 +77,8 @@ fn check_samples(segment: &Segment, channel: &AuxChannel) -> Result<(), String> 
             channel.sample_rate_hz
         ));
     }
-    if channel.values.is_empty() {
-        return Ok(());
-    }
     let fs = segment.sample_rate_hz;
-    if fs == 0 || fs % AUX_RATE_HZ != 0 {
-        // The writer puts auxiliary sample j beside gyro sample j · fs / 100: that needs a whole
-        // number of gyro samples per auxiliary one.
-        return Err(format!(
-            "the activation is sampled at {fs} Hz, which is not a multiple of the auxiliary \
-             {AUX_RATE_HZ} Hz"
-        ));
-    }
-    let covered = segment.len().div_ceil((fs / AUX_RATE_HZ) as usize);
+    let covered = aux_samples_covered(segment.len(), fs);
     if channel.values.len() > covered {
         return Err(format!(
             "{} values, but the activation ({} samples at {fs} Hz) covers {covered} at \

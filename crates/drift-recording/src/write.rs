@@ -2,7 +2,7 @@
 //! converts real test-bench logs (give it [`Recording`] segments, get the same MCAP).
 
 use crate::error::WriteError;
-use crate::layout::AUX_RATE_HZ;
+use crate::layout::{aux_every, AUX_RATE_HZ};
 use crate::read::Recording;
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use crate::segment::Segment;
@@ -108,7 +108,7 @@ pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteE
                 ),
             })?;
         let batch = (fs / 10).max(1) as usize;
-        let aux_every = (fs / AUX_RATE_HZ).max(1) as usize;
+        let aux_every = aux_every(fs);
         f.power(&event(segment, true), segment.power_on_ns)?;
         let n = segment.len();
         let mut first = 0usize;

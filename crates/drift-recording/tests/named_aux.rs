@@ -2,7 +2,7 @@
 //! through MCAP with their units and only in the activations that have them; the writer refuses a
 //! channel it cannot store, naming segment and channel, and leaves nothing behind; the reader turns
 //! every `/aux/<name>` ScalarBatch into channel `<name>` and refuses any other schema there, naming
-//! file, topic and message.
+//! file, topic and message, and samples of any auxiliary channel past the switch-off.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -530,4 +530,19 @@ fn bad_samples_in_a_named_channel_are_named_like_the_format_s_own() {
         );
         assert!(reason.contains(expected), "{reason}");
     }
+    // More samples than the activation covers: found at the switch-off, when its length is known
+    // (a write back would drop them).
+    let (topic, index, reason) = message_error(read_bench(extra, &|t, b| {
+        regular(t, b).map(|(f, r, mut v)| {
+            if b == 2 {
+                v.push(9.0);
+            }
+            (f, r, v)
+        })
+    }));
+    assert_eq!((topic.as_str(), index), ("/power/state", 1));
+    assert_eq!(
+        reason,
+        "auxiliary channel `humidity` has 31 samples, but the activation (300 samples at 1000 Hz) covers 30 at 100 Hz"
+    );
 }

@@ -451,8 +451,8 @@ class Segment:
         rounded to f32), `temperature_raw` int16 (n, 3), consecutive samples from switch-on at
         `sample_rate_hz` (default 1000; a multiple of 100 dividing 10**9); `power_on_ns` the
         switch-on time on the recording clock (default 0); `aux` auxiliary channels by name, any
-        names (`Recording.save` says which a recording stores). Raises `InputError` for a wrong dtype or shape, an empty or non-finite array, or lengths
-        that differ."""
+        names (`Recording.save` says which a recording stores). Raises `InputError` for a wrong
+        dtype or shape, an empty or non-finite array, or lengths that differ."""
     @property
     def labels(self) -> Labels:
         """The activation's labels."""
