@@ -271,6 +271,7 @@ fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
         open: None,
         segments: Vec::new(),
         topics: HashMap::new(),
+        named_units: HashMap::new(),
     };
     crate::messages::for_each_message(&buf, |channel, log_ns, data| {
         reader.message(channel, log_ns, data)
@@ -304,6 +305,8 @@ struct Reader<'p> {
     open: Option<Open>,
     segments: Vec<Segment>,
     topics: HashMap<String, TopicState>,
+    /// Unit of each named channel, from the first channel record it was read with.
+    named_units: HashMap<String, String>,
 }
 
 fn nan_free(values: &[f32], from: usize) -> Result<(), String> {
@@ -481,6 +484,16 @@ impl Reader<'_> {
 
     /// A batch of the named channel `name` (its unit from the channel metadata).
     fn named(&mut self, name: &str, unit: &str, data: &[u8]) -> Result<(), String> {
+        // MCAP allows several channel records on one topic: a recording gives a name one unit.
+        let first_unit = self
+            .named_units
+            .entry(name.to_owned())
+            .or_insert_with(|| unit.to_owned());
+        if first_unit != unit {
+            return Err(format!(
+                "channel metadata unit `{unit}`, but an earlier channel on this topic has `{first_unit}`"
+            ));
+        }
         let open = self
             .open
             .as_mut()

@@ -323,13 +323,16 @@ fn channels_the_format_cannot_store_are_refused_naming_segment_and_channel() {
 
 // --- reading files a bench wrote -----------------------------------------------------------------
 
+/// An extra topic of a bench file: name, schema (name, text), channel metadata.
+type Extra<'a> = (&'a str, (&'a str, &'a str), &'a [(&'a str, &'a str)]);
+/// A batch of an extra topic: (first sample, rate, values); `None` leaves the batch out.
+type Batch = Option<(u32, u32, Vec<f32>)>;
+/// The extra topics' batches, by topic and batch number.
+type Batches<'a> = &'a dyn Fn(&str, u32) -> Batch;
+
 /// A file with the format's topics and one activation of 300 samples, plus `extra` topics (name,
 /// schema, channel metadata) whose batch `b` is `batch(b)`: (first sample, rate, values).
-fn bench_file(
-    path: &Path,
-    extra: &[(&str, (&str, &str), &[(&str, &str)])],
-    batch: &dyn Fn(&str, u32) -> Option<(u32, u32, Vec<f32>)>,
-) {
+fn bench_file(path: &Path, extra: &[Extra], batch: Batches) {
     let metadata = BTreeMap::from([
         ("unit_id".to_owned(), "BENCH-9".to_owned()),
         ("sample_rate_hz".to_owned(), "1000".to_owned()),
@@ -379,7 +382,7 @@ fn bench_file(
 }
 
 /// Regular batches of 10 values, `k`-th value `k as f32 / 4`.
-fn regular(_: &str, b: u32) -> Option<(u32, u32, Vec<f32>)> {
+fn regular(_: &str, b: u32) -> Batch {
     Some((
         b * 10,
         100,
@@ -387,10 +390,7 @@ fn regular(_: &str, b: u32) -> Option<(u32, u32, Vec<f32>)> {
     ))
 }
 
-fn read_bench(
-    extra: &[(&str, (&str, &str), &[(&str, &str)])],
-    batch: &dyn Fn(&str, u32) -> Option<(u32, u32, Vec<f32>)>,
-) -> Result<Recording, ReadError> {
+fn read_bench(extra: &[Extra], batch: Batches) -> Result<Recording, ReadError> {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bench.mcap");
     bench_file(&path, extra, batch);
@@ -486,13 +486,8 @@ fn a_topic_that_cannot_be_a_named_channel_is_an_error_naming_it() {
 
 #[test]
 fn bad_samples_in_a_named_channel_are_named_like_the_format_s_own() {
-    let extra: &[(&str, (&str, &str), &[(&str, &str)])] =
-        &[("/aux/humidity", schema::SCHEMA_SCALAR, &[("unit", "%RH")])];
-    let cases: [(
-        &dyn Fn(&str, u32) -> Option<(u32, u32, Vec<f32>)>,
-        usize,
-        &str,
-    ); 4] = [
+    let extra: &[Extra] = &[("/aux/humidity", schema::SCHEMA_SCALAR, &[("unit", "%RH")])];
+    let cases: [(Batches, usize, &str); 4] = [
         (
             &|t, b| {
                 regular(t, b).map(|(f, r, mut v)| {
@@ -544,5 +539,50 @@ fn bad_samples_in_a_named_channel_are_named_like_the_format_s_own() {
     assert_eq!(
         reason,
         "auxiliary channel `humidity` has 31 samples, but the activation (300 samples at 1000 Hz) covers 30 at 100 Hz"
+    );
+}
+
+#[test]
+fn two_channel_records_of_one_named_topic_with_different_units_are_an_error() {
+    // MCAP allows several channel records on one topic; a recording's channel has one unit. The
+    // third batch goes out on a second channel record of the topic, in per mille.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bench.mcap");
+    let metadata = BTreeMap::from([
+        ("unit_id".to_owned(), "BENCH-9".to_owned()),
+        ("sample_rate_hz".to_owned(), "1000".to_owned()),
+    ]);
+    let mut f = create_recording(&path, metadata).unwrap();
+    let topic = "/aux/humidity";
+    f.add_topic(topic, schema::SCHEMA_SCALAR, &[("unit", "%RH")])
+        .unwrap();
+    let event = |powered| PowerEvent {
+        powered,
+        series_kind: "protocol".into(),
+        series: 1,
+        repeat: 1,
+        activation: 1,
+        interval_min: 5.0,
+        off_before_s: f64::NAN,
+        set_point_celsius: 30.0,
+    };
+    f.power(&event(true), 0).unwrap();
+    for b in 0..3u32 {
+        if b == 2 {
+            // Registering the topic again with other metadata makes a second channel record.
+            f.add_topic(topic, schema::SCHEMA_SCALAR, &[("unit", "‰")])
+                .unwrap();
+        }
+        let (first, rate, values) = regular(topic, b).unwrap();
+        ScalarBatch::encode(first, rate, &values, &mut f.enc);
+        f.write_encoded(topic, u64::from(b) * 100_000_000).unwrap();
+    }
+    f.power(&event(false), 300 * 1_000_000).unwrap();
+    f.finish().unwrap();
+    let (topic, index, reason) = message_error(read_recording(&path));
+    assert_eq!((topic.as_str(), index), ("/aux/humidity", 2));
+    assert_eq!(
+        reason,
+        "channel metadata unit `‰`, but an earlier channel on this topic has `%RH`"
     );
 }
