@@ -1,7 +1,8 @@
 //! `gyrodrift import csv` end to end: a CSV made here (irregular millisecond timestamps, rad/s,
 //! accelerometer columns) → a campaign folder → its MCAP contents; bad inputs named by file, row,
-//! column or option with nothing written; the rest of the loop on data the paper's method cannot
-//! be fitted on; and the measured MPU6050 file of `../shared/data/measured/` when it is present.
+//! column or option with nothing written; extra columns as named auxiliary channels (`--aux`); the
+//! rest of the loop on data the paper's method cannot be fitted on; and the measured MPU6050 file
+//! of `../shared/data/measured/` when it is present.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -323,6 +324,80 @@ fn bad_input_is_named_and_nothing_is_written() {
         "{:?}",
         std::fs::read_dir(&campaign).map(|d| d.count())
     );
+}
+
+#[test]
+fn extra_columns_are_imported_as_named_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("env.csv");
+    let mut text = String::from("t_s,gx_dps,gy_dps,gz_dps,temp_c,rh,vbat\n");
+    for i in 0..300 {
+        let t = f64::from(i) / 100.0;
+        text.push_str(&format!(
+            "{t},0.01,0,0,30,{},{}\n",
+            40.0 + 0.5 * f64::from(i),
+            3.75 - f64::from(i % 4) / 8.0
+        ));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let campaign = dir.path().join("campaign");
+    let (c, s) = (csv.to_str().unwrap(), campaign.to_str().unwrap());
+    let base = [
+        "import",
+        "csv",
+        c,
+        "-o",
+        s,
+        "--rate-hz",
+        "100",
+        "--no-segment-column",
+        "--unit-id",
+        "ENV",
+    ];
+    let with = |aux: &[&str]| -> Vec<String> {
+        let mut args: Vec<String> = base.iter().map(|a| a.to_string()).collect();
+        for a in aux {
+            args.extend(["--aux".to_owned(), a.to_string()]);
+        }
+        args
+    };
+    let run = |args: Vec<String>| fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    // Bad mappings: named by option, nothing written.
+    let text = run(with(&["humidity"]));
+    assert!(
+        text.contains(
+            "option `--aux`: expected name=column or name=column:unit, got `humidity` (no `=`)"
+        ),
+        "{text}"
+    );
+    let text = run(with(&["rh/2=rh"]));
+    assert!(
+        text.contains(&format!(
+            "{c}: option `columns.aux`: auxiliary channel `rh/2` has `/` at byte 2"
+        )),
+        "{text}"
+    );
+    let text = run(with(&["humidity=humidity"]));
+    assert!(
+        text.contains(&format!("{c}: missing column `humidity`")),
+        "{text}"
+    );
+    assert!(!campaign.exists());
+
+    let args = with(&["humidity=rh:%RH", "battery=vbat:V"]);
+    ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let rec = read_recording(&campaign.join("recordings/ENV_env.mcap")).unwrap();
+    let aux = &rec.segments[0].aux;
+    assert_eq!(aux["humidity"].unit, "%RH");
+    let expected: Vec<f32> = (0..300).map(|i| 40.0 + 0.5 * i as f32).collect();
+    assert_eq!(aux["humidity"].values, expected);
+    assert_eq!(aux["battery"].unit, "V");
+    assert_eq!(aux["battery"].values[..4], [3.75, 3.625, 3.5, 3.375]);
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(campaign.join("import.json")).unwrap())
+            .unwrap();
+    assert_eq!(manifest["activations"][0]["aux"]["humidity"], 300);
+    assert_eq!(manifest["activations"][0]["aux"]["battery"], 300);
 }
 
 fn measured() -> Option<PathBuf> {

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use drift_recording::{
-    read_csv, write_recording, CsvColumns, CsvOptions, CsvTiming, RateUnit, SeriesKind, TimeUnit,
-    RECORDINGS_DIR,
+    read_csv, write_recording, CsvAuxColumn, CsvColumns, CsvOptions, CsvTiming, RateUnit,
+    SeriesKind, TimeUnit, RECORDINGS_DIR,
 };
 
 use crate::output::write_atomic;
@@ -71,6 +71,11 @@ pub struct CsvArgs {
     /// Supply-voltage column in V → the recording's `/aux/supply_voltage` channel (100 Hz).
     #[arg(long)]
     pub supply_column: Option<String>,
+    /// Any other column → a named auxiliary channel `/aux/<name>` (100 Hz), repeatable:
+    /// `name=column` or `name=column:unit` (the unit follows the last `:`). Names: ASCII letters,
+    /// digits, `_`, `.`, `-`, starting with a letter or digit.
+    #[arg(long = "aux", value_name = "NAME=COLUMN[:UNIT]")]
+    pub aux: Vec<String>,
     /// Sample rate of the recording's fixed grid, Hz (must divide 10⁹).
     #[arg(long, default_value_t = 1000)]
     pub rate_hz: u32,
@@ -136,6 +141,14 @@ impl CsvArgs {
                     .map(|names| three("accel-columns", names))
                     .transpose()?,
                 supply_voltage: self.supply_column.clone(),
+                aux: self
+                    .aux
+                    .iter()
+                    .map(|text| {
+                        CsvAuxColumn::parse(text)
+                            .map_err(|e| anyhow::anyhow!("option `--aux`: {e}"))
+                    })
+                    .collect::<anyhow::Result<_>>()?,
             },
             sample_rate_hz: self.rate_hz,
             timing,

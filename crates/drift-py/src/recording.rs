@@ -6,7 +6,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use drift_fit::pipeline::recording_files;
-use drift_recording::{read_metadata, read_recording, write_recording, Recording, AUX_RATE_HZ};
+use drift_recording::{
+    check_named_aux_channel, fixed_aux_unit, read_metadata, read_recording, write_recording,
+    Recording, AUX_RATE_HZ,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
@@ -14,7 +17,8 @@ use crate::args;
 use crate::errors::Error;
 use crate::segment::PySegment;
 
-/// The auxiliary channels the recording format stores (all at 100 Hz), and their topics' axes.
+/// The format's own auxiliary channels (all at 100 Hz), which every segment written needs; any
+/// other channel is written as a named channel of its own.
 pub const FORMAT_CHANNELS: [&str; 5] = [
     "accel_x",
     "accel_y",
@@ -65,27 +69,45 @@ pub fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyRecording> {
     PyRecording::wrap(py, recording)
 }
 
-/// Checks what the writer needs beyond a valid in-memory recording: the format's auxiliary
-/// channels, each at 100 Hz with one value per 10 ms of the activation.
+/// Checks what the writer needs beyond a valid in-memory recording, as `InputError`s naming segment
+/// and channel: the format's auxiliary channels, and any named ones (valid names, one unit per
+/// name across the recording), each at 100 Hz with one value per 10 ms of the activation. A
+/// channel then reads back exactly as it was built.
 fn check_writable(recording: &Recording) -> Result<(), Error> {
+    let mut units: BTreeMap<&str, (&str, usize)> = BTreeMap::new();
     for (i, segment) in recording.segments.iter().enumerate() {
         let every = (segment.sample_rate_hz / AUX_RATE_HZ).max(1) as usize;
         let expected = segment.len().div_ceil(every);
-        for name in segment.aux.keys() {
-            if !FORMAT_CHANNELS.contains(&name.as_str()) {
+        for (name, channel) in &segment.aux {
+            if let Some(unit) = fixed_aux_unit(name) {
+                if channel.unit != unit {
+                    return Err(Error::Input(format!(
+                        "segments[{i}]: channel {name:?} is in {:?}, the recording format stores it in {unit:?}",
+                        channel.unit
+                    )));
+                }
+                continue;
+            }
+            check_named_aux_channel(name)
+                .map_err(|reason| Error::Input(format!("segments[{i}]: {reason}")))?;
+            let (unit, first) = *units.entry(name).or_insert((&channel.unit, i));
+            if unit != channel.unit {
                 return Err(Error::Input(format!(
-                    "segments[{i}]: unknown channel {name:?}: the recording format stores {}",
-                    FORMAT_CHANNELS.join(", ")
+                    "segments[{i}]: channel {name:?} is in {:?}, segments[{first}] has it in {unit:?} \
+                     (a recording stores one unit per channel)",
+                    channel.unit
                 )));
             }
         }
         for name in FORMAT_CHANNELS {
-            let Some(channel) = segment.aux.get(name) else {
+            if !segment.aux.contains_key(name) {
                 return Err(Error::Input(format!(
                     "segments[{i}]: channel {name:?} is missing: the recording format stores {} at {AUX_RATE_HZ} Hz",
                     FORMAT_CHANNELS.join(", ")
                 )));
-            };
+            }
+        }
+        for (name, channel) in &segment.aux {
             if channel.sample_rate_hz != AUX_RATE_HZ || channel.values.len() != expected {
                 return Err(Error::Input(format!(
                     "segments[{i}]: channel {name:?} must hold {expected} values at {AUX_RATE_HZ} Hz \
@@ -235,7 +257,7 @@ impl PyRecording {
 
     /// Writes the recording as MCAP (temporary file, then rename); returns the bytes written.
     /// Every segment needs the format's auxiliary channels (accel_x/y/z, supply_voltage,
-    /// chamber_set_point at 100 Hz).
+    /// chamber_set_point at 100 Hz); any other channel is written as a named one (`/aux/<name>`).
     fn save(&self, py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<u64> {
         let path = args::path("path", path)?;
         let arcs = self.segment_arcs(py);

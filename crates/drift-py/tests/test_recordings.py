@@ -69,6 +69,42 @@ def test_build_write_and_read_back(tmp_path: Path) -> None:
         assert np.array_equal(read.aux["supply_voltage"].values, built.aux["supply_voltage"].values)
 
 
+def test_named_channels_round_trip_through_mcap(tmp_path: Path) -> None:
+    """Any valid name is written to its own /aux/<name> topic and read back with its unit, in the
+    segments that have it; the format's own channels are unchanged beside them."""
+    n = 2500
+    m = n // 10
+    rng = np.random.default_rng(7)
+    named = {
+        "humidity": (rng.normal(40.0, 2.0, m), "%RH"),
+        "v3.3": (rng.normal(3.3, 0.01, m).astype(np.float32), "V"),
+        "Board-Temp_2": (rng.normal(31.0, 0.5, m), "degC"),
+        "0": (np.zeros(m), ""),
+    }
+    first = make_segment(n)
+    base = {
+        name: (channel.values, channel.unit, channel.sample_rate_hz) for name, channel in first.aux.items()
+    }
+    aux = {**base, **{name: (values, unit, 100) for name, (values, unit) in named.items()}}
+    with_named = gyrodrift.Segment(first.labels, first.rate_dps, first.temperature_raw, aux=aux)
+    second = make_segment(1000, power_on_ns=10**10, activation=2)  # the format's channels only
+    gyrodrift.Recording([with_named, second]).save(tmp_path / "named.mcap")
+
+    back = gyrodrift.Recording.load(tmp_path / "named.mcap")
+    read = back.segments[0].aux
+    assert sorted(read) == sorted([*base, *named])
+    for name, (values, unit) in named.items():
+        channel = read[name]
+        assert channel.unit == unit and channel.sample_rate_hz == 100
+        assert np.array_equal(channel.values, np.asarray(values, dtype=np.float32)), name
+    for name in base:
+        assert (
+            np.array_equal(read[name].values, first.aux[name].values)
+            and read[name].unit == first.aux[name].unit
+        )
+    assert sorted(back.segments[1].aux) == sorted(base)
+
+
 def test_a_loaded_recording_writes_back_unchanged(campaign_dir: Path, tmp_path: Path) -> None:
     original = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0"))
     original.save(tmp_path / "copy.mcap")

@@ -4,6 +4,7 @@ says which argument (or file, topic, message) and what was expected; never a Pan
 from __future__ import annotations
 
 import errno
+import re
 from pathlib import Path
 from typing import Any
 
@@ -131,9 +132,34 @@ def test_saving_channels_the_format_does_not_store(tmp_path: Path) -> None:
     aux: dict[str, Any] = {**format_aux(N), "gps": (np.zeros(5), "deg", 1)}
     segment = gyrodrift.Segment(LABELS, RATE, RAW, aux=aux)
     with pytest.raises(
-        InputError, match='segments\\[0\\]: unknown channel "gps": the recording format stores'
+        InputError, match=r'channel "gps" must hold 100 values at 100 Hz .* got 5 values at 1 Hz'
     ):
         gyrodrift.Recording([segment]).save(tmp_path / "r.mcap")
+    for name, reason in [
+        ("gps/fix", "auxiliary channel `gps/fix` has `/` at byte 3"),
+        ("", "an empty auxiliary channel name"),
+        ("accel", "would be recorded on /aux/accel"),
+    ]:
+        named = gyrodrift.Segment(LABELS, RATE, RAW, aux={**format_aux(N), name: (np.zeros(100), "deg", 100)})
+        with pytest.raises(InputError, match=f"segments\\[0\\]: {re.escape(reason)}"):
+            gyrodrift.Recording([named]).save(tmp_path / "r.mcap")
+    relabelled = gyrodrift.Segment(
+        LABELS, RATE, RAW, aux={**format_aux(N), "supply_voltage": (np.ones(100), "mV", 100)}
+    )
+    with pytest.raises(
+        InputError, match='channel "supply_voltage" is in "mV", the recording format stores it in "V"'
+    ):
+        gyrodrift.Recording([relabelled]).save(tmp_path / "r.mcap")
+    first, second = (
+        gyrodrift.Segment(
+            LABELS, RATE, RAW, power_on_ns=on, aux={**format_aux(N), "rh": (np.ones(100), unit, 100)}
+        )
+        for on, unit in [(0, "%RH"), (10**10, "ppm")]
+    )
+    with pytest.raises(
+        InputError, match='segments\\[1\\]: channel "rh" is in "ppm", segments\\[0\\] has it in "%RH"'
+    ):
+        gyrodrift.Recording([first, second]).save(tmp_path / "r.mcap")
     bare = gyrodrift.Segment(LABELS, RATE, RAW)
     with pytest.raises(InputError, match='segments\\[0\\]: channel "accel_x" is missing'):
         gyrodrift.Recording([bare]).save(tmp_path / "r.mcap")

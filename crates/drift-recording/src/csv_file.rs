@@ -7,10 +7,11 @@
 //! single die sensor], and an optional activation column [`segment_id`]: consecutive rows with
 //! the same value are one activation. Temperatures become raw readings at 200 raw/°C (the
 //! recording format's scale), rounded. Optional auxiliary columns (accelerometer X, Y, Z in g,
-//! supply voltage in V) go to the format's auxiliary channels at its fixed 100 Hz
-//! ([`crate::AUX_RATE_HZ`]); the format has no other auxiliary channels, so any other column is
-//! ignored. Rates may be given in rad/s and times in ms ([`RateUnit`], [`TimeUnit`]). The defaults read the
-//! MPU6050 static recordings of `sunsided/sensor-fusion` (`../shared/data/measured/`).
+//! supply voltage in V) go to the format's auxiliary channels, and any other column mapped in
+//! [`CsvColumns::aux`] to a named channel of its own, all at the format's 100 Hz
+//! ([`crate::AUX_RATE_HZ`]); columns not mapped are ignored. Rates may be given in rad/s and times
+//! in ms ([`RateUnit`], [`TimeUnit`]). The defaults read the MPU6050 static recordings of
+//! `sunsided/sensor-fusion` (`../shared/data/measured/`).
 //!
 //! Timing ([`CsvTiming`]): `Strict` takes every row as one sample of a fixed-rate stream: times
 //! must sit on the grid, with no gap; `Resample` is for host-timestamped logs with jitter
@@ -19,6 +20,8 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+use crate::aux::check_named_aux_channel;
+use crate::csv_aux::CsvAuxColumn;
 use crate::layout::AUX_RATE_HZ;
 use crate::read::Recording;
 use crate::segment::{
@@ -42,6 +45,8 @@ pub struct CsvColumns {
     pub accel_g: Option<[String; 3]>,
     /// Supply voltage, V → the `/aux/supply_voltage` channel. `None`: not recorded.
     pub supply_voltage: Option<String>,
+    /// Any other columns, each → a named channel on `/aux/<channel>`.
+    pub aux: Vec<CsvAuxColumn>,
 }
 
 impl Default for CsvColumns {
@@ -54,6 +59,7 @@ impl Default for CsvColumns {
             segment: Some(s("segment_id")),
             accel_g: None,
             supply_voltage: None,
+            aux: Vec::new(),
         }
     }
 }
@@ -286,7 +292,7 @@ struct Columns {
     temperature: [usize; 3],
     segment: Option<usize>,
     /// Auxiliary columns: (index, column name, channel name, unit).
-    aux: Vec<(usize, String, &'static str, &'static str)>,
+    aux: Vec<(usize, String, String, String)>,
 }
 
 fn read_csv_from<R: Read>(
@@ -327,6 +333,7 @@ fn read_csv_from<R: Read>(
             })
     };
     let c = &options.columns;
+    check_named_columns(path, &c.aux)?;
     let columns = Columns {
         time: find(&c.time_s)?,
         rate: [
@@ -344,11 +351,25 @@ fn read_csv_from<R: Read>(
             let mut aux = Vec::new();
             if let Some(names) = &c.accel_g {
                 for (name, channel) in names.iter().zip(["accel_x", "accel_y", "accel_z"]) {
-                    aux.push((find(name)?, name.clone(), channel, "g"));
+                    aux.push((find(name)?, name.clone(), channel.into(), "g".into()));
                 }
             }
             if let Some(name) = &c.supply_voltage {
-                aux.push((find(name)?, name.clone(), "supply_voltage", "V"));
+                aux.push((
+                    find(name)?,
+                    name.clone(),
+                    "supply_voltage".into(),
+                    "V".into(),
+                ));
+            }
+            for named in &c.aux {
+                let index = find(&named.column)?;
+                aux.push((
+                    index,
+                    named.column.clone(),
+                    named.channel.clone(),
+                    named.unit.clone(),
+                ));
             }
             aux
         },
@@ -635,14 +656,34 @@ fn add_aux(segment: &mut Segment, rows: &Rows, columns: &Columns, options: &CsvO
             }
         };
         segment.aux.insert(
-            (*channel).to_owned(),
+            channel.clone(),
             AuxChannel {
-                unit: (*unit).to_owned(),
+                unit: unit.clone(),
                 sample_rate_hz: AUX_RATE_HZ,
                 values,
             },
         );
     }
+}
+
+/// The named channels must be ones the recording can hold, each once: checked before any row is
+/// read, so a bad name is not found after minutes of a large file.
+fn check_named_columns(path: &Path, named: &[CsvAuxColumn]) -> Result<(), CsvError> {
+    let error = |reason: String| CsvError::Options {
+        path: path.to_path_buf(),
+        field: "columns.aux",
+        reason,
+    };
+    for (k, aux) in named.iter().enumerate() {
+        check_named_aux_channel(&aux.channel).map_err(error)?;
+        if named[..k].iter().any(|a| a.channel == aux.channel) {
+            return Err(error(format!(
+                "auxiliary channel `{}` is mapped twice",
+                aux.channel
+            )));
+        }
+    }
+    Ok(())
 }
 
 fn row_error(path: &Path, e: &csv::Error, row: u64, line: u64) -> CsvError {

@@ -2,13 +2,16 @@
 //! corrector → residual → report.
 //!
 //! The format (specified in `docs/recording-format.md`): MCAP files with CDR-encoded (`ros2msg`)
-//! batches of samples, one topic per signal, zstd chunks. [`read_recording`] validates while it
-//! reads and yields [`Segment`]s, one per activation, with their protocol labels; it refuses
-//! simulator ground truth, so code that reads through it cannot see the truth.
+//! batches of samples, one topic per signal (and one per named auxiliary channel, `/aux/<name>`),
+//! zstd chunks. [`read_recording`] validates while it reads and yields [`Segment`]s, one per
+//! activation, with their protocol labels; it refuses simulator ground truth, so code that reads
+//! through it cannot see the truth.
 //! [`write_recording`] writes the same format from a real test bench's data, and [`read_csv`] reads
 //! measured data from CSV into the same segments.
 
+mod aux;
 pub mod cdr;
+mod csv_aux;
 mod csv_file;
 mod error;
 mod layout;
@@ -16,9 +19,12 @@ mod messages;
 mod read;
 pub mod schema;
 mod segment;
+mod writable;
 mod write;
 pub mod writer;
 
+pub use aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic, FIXED_AUX_CHANNELS};
+pub use csv_aux::CsvAuxColumn;
 pub use csv_file::{
     read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming, RateUnit, TimeUnit,
 };

@@ -6,7 +6,7 @@
 //! limit instead: an oversized declared length becomes an error naming the file. It also checks
 //! the chunk and data-section CRCs, which `MessageStream` does not by default.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -16,11 +16,25 @@ use mcap::McapError;
 /// (100 ms at 1 kHz) is 1.2 KB and a chunk 512 KiB; benches writing bigger batches have room.
 pub const RECORD_LENGTH_LIMIT: usize = 64 << 20;
 
-/// Calls `each(topic, log_time_ns, data)` for every message of the data section, in file order.
+/// A channel as the data section declares it.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ChannelInfo {
+    pub topic: String,
+    /// Name of its schema; `None` for a channel without one (schema id 0) or whose schema record
+    /// did not come before it.
+    pub schema: Option<String>,
+    /// Channel metadata (e.g. `unit`).
+    pub metadata: BTreeMap<String, String>,
+}
+
+/// Calls `each(channel, log_time_ns, data)` for every message of the data section, in file order.
 /// Errors of `each` are passed through; container errors come back as `Err(Ok(mcap error))`.
+///
+/// Channels and schemas are taken from the data section, not the summary: they are then covered
+/// by the same chunk CRCs as the messages.
 pub(crate) fn for_each_message<E>(
     buf: &[u8],
-    mut each: impl FnMut(&str, u64, &[u8]) -> Result<(), E>,
+    mut each: impl FnMut(&ChannelInfo, u64, &[u8]) -> Result<(), E>,
 ) -> Result<(), Result<McapError, E>> {
     // CRCs too: a flipped bit in a chunk or in the data section is then a CRC error naming the
     // file, not a plausible wrong sample (chunks are checked before any of their messages is used).
@@ -31,7 +45,8 @@ pub(crate) fn for_each_message<E>(
             .with_validate_data_section_crc(true),
     );
     let mut rest = buf;
-    let mut topics: HashMap<u16, String> = HashMap::new();
+    let mut schemas: HashMap<u16, String> = HashMap::new();
+    let mut channels: HashMap<u16, ChannelInfo> = HashMap::new();
     while let Some(event) = reader.next_event() {
         let (opcode, data) = match event.map_err(Ok)? {
             LinearReadEvent::ReadRequest(need) => {
@@ -44,22 +59,31 @@ pub(crate) fn for_each_message<E>(
             LinearReadEvent::Record { data, opcode } => (opcode, data),
         };
         match mcap::parse_record(opcode, data).map_err(Ok)? {
+            Record::Schema { header, .. } => {
+                schemas.insert(header.id, header.name);
+            }
             Record::Channel(channel) => {
-                if let Some(known) = topics.get(&channel.id) {
-                    if *known != channel.topic {
+                if let Some(known) = channels.get(&channel.id) {
+                    if known.topic != channel.topic {
                         return Err(Ok(McapError::ConflictingChannels(channel.topic)));
                     }
                 }
-                topics.insert(channel.id, channel.topic);
+                let info = ChannelInfo {
+                    schema: schemas.get(&channel.schema_id).cloned(),
+                    topic: channel.topic,
+                    metadata: channel.metadata,
+                };
+                channels.insert(channel.id, info);
             }
             Record::Message { header, data } => {
-                let topic = topics
-                    .get(&header.channel_id)
-                    .ok_or(Ok(McapError::UnknownChannel(
-                        header.sequence,
-                        header.channel_id,
-                    )))?;
-                each(topic, header.log_time, &data).map_err(Err)?;
+                let channel =
+                    channels
+                        .get(&header.channel_id)
+                        .ok_or(Ok(McapError::UnknownChannel(
+                            header.sequence,
+                            header.channel_id,
+                        )))?;
+                each(channel, header.log_time, &data).map_err(Err)?;
             }
             // The summary repeats channels; messages are all in the data section.
             Record::DataEnd(_) => break,

@@ -5,9 +5,17 @@
 //! it reads: missing topics, non-monotonic or duplicate timestamps, gaps or overlaps in the
 //! sample sequence, NaN/∞ values and unbalanced power events are errors naming the file,
 //! topic and the message's index within that topic.
+//!
+//! Every `/aux/<name>` topic besides the fixed ones is a named auxiliary channel (a `ScalarBatch`):
+//! it becomes channel `<name>` of the activations it has messages in. Any other schema there, or a
+//! name outside [`crate::check_named_aux_channel`]'s rule, is an error at its first message rather
+//! than a skip: a channel a bench meant to record would otherwise vanish from the diagnosis
+//! unnoticed. Topics outside `/aux/` that the format does not know are ignored.
 
+use crate::aux::check_named_aux_channel;
 use crate::error::ReadError;
-use crate::layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+use crate::layout::{aux_samples_covered, AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+use crate::messages::ChannelInfo;
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use crate::segment::{AuxChannel, Segment, SegmentLabels, SeriesKind};
 use std::collections::{BTreeMap, HashMap};
@@ -86,6 +94,8 @@ struct Open {
     accel: [Vec<f32>; 3],
     supply: Vec<f32>,
     set_point: Vec<f32>,
+    /// Named channels with a message in this activation.
+    named: BTreeMap<String, AuxChannel>,
 }
 
 /// Per-topic bookkeeping for messages: index and last log time.
@@ -261,9 +271,10 @@ fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
         open: None,
         segments: Vec::new(),
         topics: HashMap::new(),
+        named_units: HashMap::new(),
     };
-    crate::messages::for_each_message(&buf, |topic, log_ns, data| {
-        reader.message(topic, log_ns, data)
+    crate::messages::for_each_message(&buf, |channel, log_ns, data| {
+        reader.message(channel, log_ns, data)
     })
     .map_err(|e| e.map_or_else(|e| e, mcap_err))?;
     if reader.open.is_some() {
@@ -294,6 +305,8 @@ struct Reader<'p> {
     open: Option<Open>,
     segments: Vec<Segment>,
     topics: HashMap<String, TopicState>,
+    /// Unit of each named channel, from the first channel record it was read with.
+    named_units: HashMap<String, String>,
 }
 
 fn nan_free(values: &[f32], from: usize) -> Result<(), String> {
@@ -317,16 +330,24 @@ impl Reader<'_> {
         }
     }
 
-    fn message(&mut self, topic: &str, log_ns: u64, data: &[u8]) -> Result<(), ReadError> {
+    fn message(
+        &mut self,
+        channel: &ChannelInfo,
+        log_ns: u64,
+        data: &[u8],
+    ) -> Result<(), ReadError> {
+        let topic = channel.topic.as_str();
         if topic.starts_with(schema::TRUTH_PREFIX) {
             return Err(ReadError::GroundTruth {
                 path: self.path.to_path_buf(),
                 why: format!("topic {topic}"),
             });
         }
-        if !REQUIRED_TOPICS.contains(&topic) {
-            return Ok(()); // Extra topics a bench may add are allowed and ignored.
-        }
+        let named = match topic.strip_prefix(schema::AUX_PREFIX) {
+            _ if REQUIRED_TOPICS.contains(&topic) => None,
+            Some(name) => Some(name),
+            None => return Ok(()), // Extra topics a bench may add are allowed and ignored.
+        };
         let state = self.topics.entry(topic.to_owned()).or_default();
         let index = state.count;
         state.count += 1;
@@ -345,6 +366,8 @@ impl Reader<'_> {
         state.last_ns = Some(log_ns);
         let result = if topic == schema::TOPIC_POWER {
             self.power(log_ns, data)
+        } else if let Some(name) = named {
+            named_channel(name, channel).and_then(|unit| self.named(name, unit, data))
         } else {
             self.samples(topic, data)
         };
@@ -385,6 +408,7 @@ impl Reader<'_> {
                 accel: [v(), v(), v()],
                 supply: v(),
                 set_point: v(),
+                named: BTreeMap::new(),
             });
             return Ok(());
         }
@@ -427,13 +451,25 @@ impl Reader<'_> {
             values,
         };
         let [ax, ay, az] = open.accel;
-        let aux = BTreeMap::from([
+        let mut aux = BTreeMap::from([
             ("accel_x".to_owned(), aux(ax, "g")),
             ("accel_y".to_owned(), aux(ay, "g")),
             ("accel_z".to_owned(), aux(az, "g")),
             ("supply_voltage".to_owned(), aux(open.supply, "V")),
             ("chamber_set_point".to_owned(), aux(open.set_point, "degC")),
         ]);
+        // Named channels never shadow these: their names were checked at their first message.
+        aux.extend(open.named);
+        // Samples past the switch-off would be dropped by a write back (and be nonsense).
+        let covered = aux_samples_covered(n, self.rate_hz);
+        if let Some((name, c)) = aux.iter().find(|(_, c)| c.values.len() > covered) {
+            return Err(format!(
+                "auxiliary channel `{name}` has {} samples, but the activation ({n} samples at {} \
+                 Hz) covers {covered} at {AUX_RATE_HZ} Hz",
+                c.values.len(),
+                self.rate_hz
+            ));
+        }
         self.segments.push(Segment {
             labels: open.labels,
             sample_rate_hz: self.rate_hz,
@@ -446,13 +482,43 @@ impl Reader<'_> {
         Ok(())
     }
 
+    /// A batch of the named channel `name` (its unit from the channel metadata).
+    fn named(&mut self, name: &str, unit: &str, data: &[u8]) -> Result<(), String> {
+        // MCAP allows several channel records on one topic: a recording gives a name one unit.
+        let first_unit = self
+            .named_units
+            .entry(name.to_owned())
+            .or_insert_with(|| unit.to_owned());
+        if first_unit != unit {
+            return Err(format!(
+                "channel metadata unit `{unit}`, but an earlier channel on this topic has `{first_unit}`"
+            ));
+        }
+        let open = self
+            .open
+            .as_mut()
+            .ok_or("samples while the unit is off (no switch-on before)")?;
+        let channel = open
+            .named
+            .entry(name.to_owned())
+            .or_insert_with(|| AuxChannel {
+                unit: unit.to_owned(),
+                sample_rate_hz: AUX_RATE_HZ,
+                values: Vec::new(),
+            });
+        let before = channel.values.len();
+        let batch = ScalarBatch::decode_into(data, &mut channel.values)?;
+        nan_free(&channel.values, before)?;
+        check_batch(before, batch, AUX_RATE_HZ)
+    }
+
     fn samples(&mut self, topic: &str, data: &[u8]) -> Result<(), String> {
         let rate_hz = self.rate_hz;
         let open = self
             .open
             .as_mut()
             .ok_or("samples while the unit is off (no switch-on before)")?;
-        let (expected, (first, rate, _n)) = match topic {
+        let (expected, batch) = match topic {
             schema::TOPIC_RATE => {
                 let before = open.rate[0].len();
                 let r = Vector3Batch::decode_into(data, &mut open.rate)?;
@@ -491,17 +557,45 @@ impl Reader<'_> {
         } else {
             AUX_RATE_HZ
         };
-        if rate != expected_rate {
-            return Err(format!("sample_rate_hz {rate}, expected {expected_rate}"));
-        }
-        if first as usize != expected {
-            let what = if (first as usize) > expected {
-                "gap"
-            } else {
-                "overlap or duplicate"
-            };
-            return Err(format!("{what}: first_sample {first}, expected {expected}"));
-        }
-        Ok(())
+        check_batch(expected, batch, expected_rate)
     }
+}
+
+/// The unit of a named auxiliary channel's topic (empty if its metadata has none), or why the
+/// topic cannot be one.
+fn named_channel<'c>(name: &str, channel: &'c ChannelInfo) -> Result<&'c str, String> {
+    check_named_aux_channel(name)?;
+    let scalar = schema::SCHEMA_SCALAR.0;
+    match channel.schema.as_deref() {
+        Some(s) if s == scalar => {}
+        found => {
+            let found = found.map_or_else(|| "no schema".to_owned(), |s| format!("schema `{s}`"));
+            return Err(format!(
+                "{found}: an auxiliary topic other than {} is a named channel and must be {scalar}",
+                schema::TOPIC_ACCEL
+            ));
+        }
+    }
+    Ok(channel.metadata.get("unit").map_or("", String::as_str))
+}
+
+/// Checks a decoded batch `(first_sample, sample_rate_hz, count)` against where the topic's samples
+/// of the activation end (`expected`) and its rate.
+fn check_batch(
+    expected: usize,
+    (first, rate, _n): (u32, u32, usize),
+    expected_rate: u32,
+) -> Result<(), String> {
+    if rate != expected_rate {
+        return Err(format!("sample_rate_hz {rate}, expected {expected_rate}"));
+    }
+    if first as usize != expected {
+        let what = if (first as usize) > expected {
+            "gap"
+        } else {
+            "overlap or duplicate"
+        };
+        return Err(format!("{what}: first_sample {first}, expected {expected}"));
+    }
+    Ok(())
 }

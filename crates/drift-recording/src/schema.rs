@@ -12,6 +12,9 @@ use crate::cdr::{DecodeError, Decoder, Encoder};
 pub const TOPIC_RATE: &str = "/gyro/rate";
 /// Raw temperature-sensor readings per axis, 200 raw units per °C, per sample.
 pub const TOPIC_TEMPERATURE_RAW: &str = "/gyro/temperature_raw";
+/// Prefix of every auxiliary topic: the fixed ones below, and `/aux/<name>` for each named
+/// channel (a [`ScalarBatch`], unit in the channel metadata `unit`; see [`crate::check_named_aux_channel`]).
+pub const AUX_PREFIX: &str = "/aux/";
 /// Accelerometer, g, 100 Hz.
 pub const TOPIC_ACCEL: &str = "/aux/accel";
 /// Supply voltage, V, 100 Hz.

@@ -100,8 +100,9 @@ pub struct Segment {
     pub rate_dps: [Vec<f32>; 3],
     /// Per sample: raw temperature X, Y, Z (200 raw units per °C).
     pub temperature_raw: [Vec<i16>; 3],
-    /// Auxiliary channels by name: `accel_x`, `accel_y`, `accel_z` (g), `supply_voltage`
-    /// (V), `chamber_set_point` (°C).
+    /// Auxiliary channels by name: the format's own `accel_x`, `accel_y`, `accel_z` (g),
+    /// `supply_voltage` (V), `chamber_set_point` (°C), and any named ones (`/aux/<name>` in a
+    /// recording; [`crate::check_named_aux_channel`]).
     pub aux: BTreeMap<String, AuxChannel>,
 }
 

@@ -2,10 +2,11 @@
 //! converts real test-bench logs (give it [`Recording`] segments, get the same MCAP).
 
 use crate::error::WriteError;
-use crate::layout::AUX_RATE_HZ;
+use crate::layout::{aux_every, AUX_RATE_HZ};
 use crate::read::Recording;
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use crate::segment::Segment;
+use crate::writable::check_writable;
 use crate::writer::McapFile;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -69,9 +70,28 @@ fn event(segment: &Segment, powered: bool) -> PowerEvent {
 
 /// Writes a whole recording (metadata and segments) to `path` in batches of 100 ms.
 /// Reading the result with [`crate::read_recording`] gives back an identical [`Recording`]
-/// (apart from `path`).
+/// (apart from `path`, and the format's own auxiliary channels, which every segment read back
+/// has, empty if it had none).
+///
+/// Auxiliary channels other than the format's own are written as named channels, each a
+/// `ScalarBatch` on its own topic `/aux/<name>` with its unit in the channel metadata, in the
+/// activations that have them. Every channel must be at 100 Hz ([`AUX_RATE_HZ`]), finite, no
+/// longer than its activation, in the format's unit for its own channels and in one unit per
+/// named channel, with a name [`crate::check_named_aux_channel`] accepts; otherwise
+/// [`WriteError::Invalid`] names the segment and the channel, and nothing is written.
 pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteError> {
+    let named = check_writable(recording).map_err(|reason| WriteError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    })?;
     let mut f = create_recording(path, recording.metadata.clone())?;
+    for channel in &named {
+        f.add_topic(
+            &channel.topic,
+            schema::SCHEMA_SCALAR,
+            &[("unit", channel.unit.as_str())],
+        )?;
+    }
     for segment in &recording.segments {
         let fs = segment.sample_rate_hz;
         let period_ns = 1_000_000_000 / u64::from(fs.max(1));
@@ -88,7 +108,7 @@ pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteE
                 ),
             })?;
         let batch = (fs / 10).max(1) as usize;
-        let aux_every = (fs / AUX_RATE_HZ).max(1) as usize;
+        let aux_every = aux_every(fs);
         f.power(&event(segment, true), segment.power_on_ns)?;
         let n = segment.len();
         let mut first = 0usize;
@@ -141,6 +161,17 @@ pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteE
                 &mut f.enc,
             );
             f.write_encoded(schema::TOPIC_SET_POINT, log_ns)?;
+            // Only in the activations that have the channel: the reader then gives it back to
+            // exactly those (an empty channel still gets its empty batches).
+            for channel in named.iter().filter(|c| segment.aux.contains_key(&c.name)) {
+                ScalarBatch::encode(
+                    start(&channel.name) as u32,
+                    AUX_RATE_HZ,
+                    slice(&channel.name),
+                    &mut f.enc,
+                );
+                f.write_encoded(&channel.topic, log_ns)?;
+            }
             first = end;
         }
         f.power(&event(segment, false), off_ns)?;

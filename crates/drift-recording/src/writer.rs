@@ -18,7 +18,7 @@ pub struct McapFile {
     writer: Option<mcap::Writer<BufWriter<File>>>,
     temp: PathBuf,
     path: PathBuf,
-    channels: BTreeMap<&'static str, u16>,
+    channels: BTreeMap<String, u16>,
     sequence: u32,
     /// Reusable encode buffer.
     pub enc: Encoder,
@@ -70,7 +70,7 @@ impl McapFile {
     /// Registers a topic with a schema and channel metadata (e.g. `unit`).
     pub fn add_topic(
         &mut self,
-        topic: &'static str,
+        topic: &str,
         schema: (&str, &str),
         metadata: &[(&str, &str)],
     ) -> Result<(), WriteError> {
@@ -86,7 +86,7 @@ impl McapFile {
         let id = w
             .add_channel(schema_id, topic, "cdr", &meta)
             .map_err(|e| WriteError::mcap(&temp, e))?;
-        self.channels.insert(topic, id);
+        self.channels.insert(topic.to_owned(), id);
         Ok(())
     }
 
@@ -106,11 +106,7 @@ impl McapFile {
     }
 
     /// Writes the message currently in `self.enc` on `topic` at `log_time_ns`.
-    pub fn write_encoded(
-        &mut self,
-        topic: &'static str,
-        log_time_ns: u64,
-    ) -> Result<(), WriteError> {
+    pub fn write_encoded(&mut self, topic: &str, log_time_ns: u64) -> Result<(), WriteError> {
         let channel_id = *self
             .channels
             .get(topic)

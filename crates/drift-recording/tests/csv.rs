@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use drift_recording::{
-    read_csv, read_csv_bytes, read_recording, write_recording, CsvColumns, CsvError, CsvOptions,
-    CsvTiming, TEMPERATURE_MISSING_RAW,
+    read_csv, read_csv_bytes, read_recording, write_recording, CsvAuxColumn, CsvColumns, CsvError,
+    CsvOptions, CsvTiming, TEMPERATURE_MISSING_RAW,
 };
 
 const HEADER: &str = "segment_id,t_s,gx_dps,gy_dps,gz_dps,temp_c,extra\n";
@@ -93,6 +93,109 @@ fn a_custom_column_mapping_with_one_sensor_per_axis() {
     );
     assert_eq!(s.labels.set_point_celsius, 25.0);
     assert_eq!(rec.metadata["set_point_celsius"], "25");
+}
+
+fn named(channel: &str, column: &str, unit: &str) -> CsvAuxColumn {
+    CsvAuxColumn {
+        channel: channel.into(),
+        column: column.into(),
+        unit: unit.into(),
+    }
+}
+
+#[test]
+fn extra_columns_become_named_channels_and_reach_the_mcap() {
+    // 1 kHz rows: the named channels take every 10th row (the format's 100 Hz), like supply.
+    let header = "segment_id,t_s,gx_dps,gy_dps,gz_dps,temp_c,rh,v_bat,vin\n";
+    let text: String = (0..250)
+        .map(|i| {
+            let t = f64::from(i) / 1000.0;
+            format!(
+                "0,{t},0.01,0,0,30,{},{},{}\n",
+                40.0 + f64::from(i) * 0.01,
+                3.7 - f64::from(i) * 1e-4,
+                12.0 + f64::from(i % 7)
+            )
+        })
+        .collect();
+    let options = CsvOptions {
+        columns: CsvColumns {
+            supply_voltage: Some("vin".into()),
+            aux: vec![
+                named("humidity", "rh", "%RH"),
+                named("battery.v", "v_bat", ""),
+            ],
+            ..CsvColumns::default()
+        },
+        ..strict(1000)
+    };
+    let rec = read_csv_bytes(
+        Path::new("b.csv"),
+        format!("{header}{text}").as_bytes(),
+        &options,
+    )
+    .unwrap();
+    let s = &rec.segments[0];
+    let humidity = &s.aux["humidity"];
+    assert_eq!(
+        (humidity.unit.as_str(), humidity.sample_rate_hz),
+        ("%RH", 100)
+    );
+    let expected: Vec<f32> = (0..25)
+        .map(|j| (40.0 + f64::from(j * 10) * 0.01) as f32)
+        .collect();
+    assert_eq!(humidity.values, expected);
+    assert_eq!(s.aux["battery.v"].unit, "");
+    assert_eq!(s.aux["battery.v"].values[24], (3.7 - 240.0 * 1e-4) as f32);
+    assert_eq!(s.aux["supply_voltage"].values[1], 15.0); // row 10: 12 + 3
+                                                         // CSV → MCAP → the same channels, on their own topics.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("b.mcap");
+    write_recording(&rec, &path).unwrap();
+    let back = read_recording(&path).unwrap();
+    assert_eq!(back.segments[0].aux["humidity"], *humidity);
+    assert_eq!(back.segments[0].aux["battery.v"], s.aux["battery.v"]);
+}
+
+#[test]
+fn a_bad_named_column_mapping_is_refused_before_reading_rows() {
+    let text = format!("{HEADER}{}", rows(0, 5, 100.0));
+    let with = |aux: Vec<CsvAuxColumn>| CsvOptions {
+        columns: CsvColumns {
+            aux,
+            ..CsvColumns::default()
+        },
+        ..strict(100)
+    };
+    let cases: [(Vec<CsvAuxColumn>, &str); 4] = [
+        (
+            vec![named("rh 2", "extra", "")],
+            "bench.csv: option `columns.aux`: auxiliary channel `rh 2` has ` ` at byte 2",
+        ),
+        (
+            vec![named("supply_voltage", "extra", "V")],
+            "bench.csv: option `columns.aux`: auxiliary channel `supply_voltage` is one of the format's own channels",
+        ),
+        (
+            vec![named("a", "temp_c", "degC"), named("a", "gx_dps", "")],
+            "bench.csv: option `columns.aux`: auxiliary channel `a` is mapped twice",
+        ),
+        (
+            vec![named("humidity", "rh", "%RH")],
+            "bench.csv: missing column `rh` (the header has: segment_id,t_s,",
+        ),
+    ];
+    for (aux, expected) in cases {
+        let message = error(&text, &with(aux));
+        assert!(message.starts_with(expected), "{message}");
+    }
+    // A named column is a number like any other: the row and the column are named.
+    let text = format!("{HEADER}{}", rows(0, 5, 100.0));
+    let message = error(&text, &with(vec![named("note", "extra", "")]));
+    assert!(
+        message.starts_with("bench.csv: row 1 (line 2), column `extra`: `x` is not a number"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -451,9 +451,9 @@ class Segment:
         """An activation from arrays: `rate_dps` float32/float64 (n, 3) in °/s (finite; float64 is
         rounded to f32), `temperature_raw` int16 (n, 3), consecutive samples from switch-on at
         `sample_rate_hz` (default 1000; a multiple of 100 dividing 10**9); `power_on_ns` the
-        switch-on time on the recording clock (default 0); `aux` named auxiliary channels.
-        Raises `InputError` for a wrong dtype or shape, an empty or non-finite array, or lengths
-        that differ."""
+        switch-on time on the recording clock (default 0); `aux` auxiliary channels by name, any
+        names (`Recording.save` says which a recording stores). Raises `InputError` for a wrong
+        dtype or shape, an empty or non-finite array, or lengths that differ."""
     @property
     def labels(self) -> Labels:
         """The activation's labels."""
@@ -509,9 +509,13 @@ class Recording:
         """A recording's metadata record without decoding its messages."""
     def save(self, path: _Path) -> int:
         """Writes the recording as MCAP (temporary file, fsync, rename) and returns the bytes
-        written. Every segment needs the format's auxiliary channels — accel_x, accel_y, accel_z,
-        supply_voltage, chamber_set_point, at 100 Hz, one value per 10 ms — and no other (an
-        unknown channel raises `InputError`). Raises `FileError` or `RecordingError`."""
+        written. Every segment needs the format's auxiliary channels — accel_x, accel_y, accel_z
+        in "g", supply_voltage in "V", chamber_set_point in "degC" — and may have any other named
+        channels, each written to its own topic `/aux/<name>` and read back by `load`: names of
+        ASCII letters, digits, "_", "." and "-", starting with a letter or digit, one unit per
+        name across the recording. Every channel is at 100 Hz, one value per 10 ms. A channel
+        that breaks these raises `InputError` naming segment and channel; otherwise `FileError`
+        or `RecordingError`."""
     @property
     def path(self) -> Path | None:
         """The file it was read from (None if built in Python)."""
