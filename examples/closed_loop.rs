@@ -22,7 +22,7 @@ const EFFECTS: [&str; 8] = [
 
 fn print(r: &Row) {
     println!(
-        "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.1}× | {:.4} | {:.4} | {:.4} |",
+        "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {:.4} |",
         r.effect,
         r.seed,
         r.axis,
@@ -32,7 +32,11 @@ fn print(r: &Row) {
         r.before.1,
         r.after.1,
         r.floor.1,
-        r.excess_cut(),
+        if r.before.1 > r.floor.1 {
+            format!("{:.1}×", r.excess_cut())
+        } else {
+            "– (floor above)".to_owned()
+        },
         r.before.0,
         r.after.0,
         r.floor.0,
