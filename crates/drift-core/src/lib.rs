@@ -42,8 +42,7 @@ pub use polynomial::{
 };
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
-pub use stage::heating::BracketCache;
-pub use stage::since_power_on::{Segment, SegmentKind, TimePosition};
+pub use stage::since_power_on::{Moment, Segment, SegmentKind};
 pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedAxisState, ModifiedTables};
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.
