@@ -312,9 +312,12 @@ fn correct_axis<A: AxisModel>(
 ) -> AxisOutput {
     let mut flags = state.activation_flags | rate_flag(rate);
     let valid = raw.is_finite();
+    let mut stuck = false;
     if valid {
         if raw.to_bits() == state.last_raw.to_bits() {
             state.repeats = state.repeats.saturating_add(1);
+            stuck =
+                settings.stuck_after_samples != 0 && state.repeats >= settings.stuck_after_samples;
         } else {
             state.repeats = 0;
             state.last_raw = raw;
@@ -324,10 +327,12 @@ fn correct_axis<A: AxisModel>(
     // one, which the extension reads.
     let celsius = settings.celsius_with(state.last_raw, celsius_per_raw);
     let rise_celsius = (state.last_raw - state.switch_on_raw) * celsius_per_raw;
-    if !valid {
+    let bias_dps = if !valid {
         flags |= Flags::TEMPERATURE_INVALID;
-    } else if settings.stuck_after_samples != 0 && state.repeats >= settings.stuck_after_samples {
+        state.bias_dps
+    } else if stuck {
         flags |= Flags::TEMPERATURE_STUCK;
+        state.bias_dps
     } else {
         let (drift, model_flags) = axis.drift(
             settings,
@@ -342,8 +347,8 @@ fn correct_axis<A: AxisModel>(
         } else {
             flags |= Flags::MODEL_INVALID;
         }
-    }
-    let bias_dps = state.bias_dps;
+        state.bias_dps
+    };
     AxisOutput {
         corrected_dps: rate - bias_dps,
         bias_dps,

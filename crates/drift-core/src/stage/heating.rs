@@ -125,19 +125,21 @@ fn at_time(moment: Moment, [lo, change]: Knots) -> CurvePoint {
 /// interpolations, one division and no table access.
 #[inline(always)]
 pub(crate) fn cached_k(
-    knots: &[Knots; 2],
+    [lower_knots, upper_knots]: &[Knots; 2],
     curve: u8,
     moment: Moment,
     rise_celsius: f32,
     margin_celsius: f32,
 ) -> Option<(f32, bool)> {
-    let [lower, upper] = knots.map(|knots| at_time(moment, knots));
-    let top = curve == TOP;
-    let below = rise_celsius < lower.rise_celsius;
-    if (below && curve != 0) || !(top || rise_celsius < upper.rise_celsius) {
-        return None;
+    let lower = at_time(moment, *lower_knots);
+    if rise_celsius < lower.rise_celsius {
+        return (curve == 0).then(|| below_first(lower, rise_celsius, margin_celsius));
     }
-    Some(interpolate(lower, upper, top, rise_celsius, margin_celsius))
+    if curve == TOP {
+        return Some(above_last(lower, rise_celsius, margin_celsius));
+    }
+    let upper = at_time(moment, *upper_knots);
+    (rise_celsius < upper.rise_celsius).then(|| (between(lower, upper, rise_celsius), false))
 }
 
 /// The bracket for `rise_celsius` among `curves` at `moment`: the last curve whose rise does not
@@ -191,15 +193,33 @@ fn interpolate(
     margin_celsius: f32,
 ) -> (f32, bool) {
     if rise_celsius < lower.rise_celsius {
-        let beyond = rise_celsius < lower.rise_celsius - margin_celsius;
-        (lower.k_dps_per_celsius, beyond)
+        below_first(lower, rise_celsius, margin_celsius)
     } else if !top {
-        let fraction =
-            (rise_celsius - lower.rise_celsius) / (upper.rise_celsius - lower.rise_celsius);
-        let k = lerp(lower.k_dps_per_celsius, upper.k_dps_per_celsius, fraction);
-        (k, false)
+        (between(lower, upper, rise_celsius), false)
     } else {
-        let beyond = rise_celsius > lower.rise_celsius + margin_celsius;
-        (lower.k_dps_per_celsius, beyond)
+        above_last(lower, rise_celsius, margin_celsius)
     }
+}
+
+/// Below the first curve: its `k` (clamp), and whether the rise is below it by more than the
+/// margin.
+#[inline(always)]
+fn below_first(first: CurvePoint, rise_celsius: f32, margin_celsius: f32) -> (f32, bool) {
+    let beyond = rise_celsius < first.rise_celsius - margin_celsius;
+    (first.k_dps_per_celsius, beyond)
+}
+
+/// Above the last curve: its `k` (clamp), and whether the rise is above it by more than the
+/// margin.
+#[inline(always)]
+fn above_last(last: CurvePoint, rise_celsius: f32, margin_celsius: f32) -> (f32, bool) {
+    let beyond = rise_celsius > last.rise_celsius + margin_celsius;
+    (last.k_dps_per_celsius, beyond)
+}
+
+/// `k` interpolated by rise between two curves.
+#[inline(always)]
+fn between(lower: CurvePoint, upper: CurvePoint, rise_celsius: f32) -> f32 {
+    let fraction = (rise_celsius - lower.rise_celsius) / (upper.rise_celsius - lower.rise_celsius);
+    lerp(lower.k_dps_per_celsius, upper.k_dps_per_celsius, fraction)
 }
