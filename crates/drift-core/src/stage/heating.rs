@@ -145,8 +145,8 @@ pub(crate) fn cached_k(
 /// The bracket for `rise_celsius` among `curves` at `moment`: the last curve whose rise does not
 /// exceed it (the first one if none), walked to from the cached `curve` (which only saves work:
 /// any starting curve gives the same bracket). Refills the cache and returns what [`cached_k`]
-/// returns.
-#[inline(never)]
+/// returns. Inlined into the caller's out-of-line miss path: one call per miss, not two.
+#[inline(always)]
 pub(crate) fn search<const R: usize>(
     curves: &BlendedCurves<'_, R>,
     moment: Moment,
