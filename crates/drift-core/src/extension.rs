@@ -237,8 +237,8 @@ impl ExtensionState {
         let [mut x, mut y, mut z] = [0.0_f32; AXES];
         for term in &extension.terms {
             let ([cx, cy, cz], [mx, my, mz]) = (term.coefficient, term.centre);
-            // Summed in every arm rather than after the match: a shared sum made each arm copy
-            // its three values into common registers first.
+            // Summed in each arm rather than after a match that returns the values: measured 12
+            // instructions per sample fewer on the Cortex-M4 (docs/embedded.md).
             let mut add = |[vx, vy, vz]: [f32; AXES]| {
                 x += cx * (vx - mx);
                 y += cy * (vy - my);
