@@ -1,5 +1,7 @@
 //! The run-time corrector: immutable model (tables) + small per-unit state, one call per sample.
 
+mod block;
+
 use crate::error::{Error, Location, Problem};
 use crate::extension::{ExtensionState, AUX_INPUTS};
 use crate::flags::Flags;
@@ -299,7 +301,8 @@ struct AxisOutput {
     rise_celsius: f32,
 }
 
-/// The part every model shares: sensor-fault checks, rise, hold of the last good drift, flags.
+/// One axis of one sample through `axis`: the shared checks, the model where the reading allows,
+/// the hold.
 #[inline(always)]
 fn correct_axis<A: AxisModel>(
     axis: &A,
@@ -310,6 +313,43 @@ fn correct_axis<A: AxisModel>(
     rate: f32,
     raw: f32,
 ) -> AxisOutput {
+    let mut reading = read_axis(settings, celsius_per_raw, state, rate, raw);
+    if reading.healthy {
+        let (drift, model_flags) = axis.drift(
+            settings,
+            &mut state.model,
+            since_power_on_ms,
+            reading.celsius,
+            reading.rise_celsius,
+        );
+        hold_drift(state, &mut reading, drift, model_flags);
+    }
+    axis_output(state, &reading, rate)
+}
+
+/// What the shared checks found for one axis's reading.
+struct Reading {
+    flags: Flags,
+    /// Valid and not stuck: the model is asked, at `celsius` and `rise_celsius`.
+    healthy: bool,
+    /// The last good reading in °C: this sample's when it is valid (the same bits), else the held
+    /// one, which the extension reads.
+    celsius: f32,
+    /// Its rise since switch-on, °C.
+    rise_celsius: f32,
+}
+
+/// The checks every model shares, before the model: activation, rate and temperature faults, the
+/// stuck counter. The per-sample and the block path both go through `read_axis`, `hold_drift` and
+/// `axis_output`, so they give the same bits by construction.
+#[inline(always)]
+fn read_axis<S>(
+    settings: &Settings,
+    celsius_per_raw: f32,
+    state: &mut AxisState<S>,
+    rate: f32,
+    raw: f32,
+) -> Reading {
     let mut flags = state.activation_flags | rate_flag(rate);
     let valid = raw.is_finite();
     let mut stuck = false;
@@ -323,38 +363,40 @@ fn correct_axis<A: AxisModel>(
             state.last_raw = raw;
         }
     }
-    // From the last good reading: this sample's when it is valid (the same bits), else the held
-    // one, which the extension reads.
-    let celsius = settings.celsius_with(state.last_raw, celsius_per_raw);
-    let rise_celsius = (state.last_raw - state.switch_on_raw) * celsius_per_raw;
-    let bias_dps = if !valid {
+    if !valid {
         flags |= Flags::TEMPERATURE_INVALID;
-        state.bias_dps
     } else if stuck {
         flags |= Flags::TEMPERATURE_STUCK;
-        state.bias_dps
+    }
+    Reading {
+        flags,
+        healthy: valid && !stuck,
+        celsius: settings.celsius_with(state.last_raw, celsius_per_raw),
+        rise_celsius: (state.last_raw - state.switch_on_raw) * celsius_per_raw,
+    }
+}
+
+/// The model's answer for a healthy reading: its flags, and its drift held unless non-finite.
+#[inline(always)]
+fn hold_drift<S>(state: &mut AxisState<S>, reading: &mut Reading, drift: f32, model_flags: Flags) {
+    reading.flags |= model_flags;
+    if drift.is_finite() {
+        state.bias_dps = state.initial_bias_dps + drift;
     } else {
-        let (drift, model_flags) = axis.drift(
-            settings,
-            &mut state.model,
-            since_power_on_ms,
-            celsius,
-            rise_celsius,
-        );
-        flags |= model_flags;
-        if drift.is_finite() {
-            state.bias_dps = state.initial_bias_dps + drift;
-        } else {
-            flags |= Flags::MODEL_INVALID;
-        }
-        state.bias_dps
-    };
+        reading.flags |= Flags::MODEL_INVALID;
+    }
+}
+
+/// The axis's output from the held bias.
+#[inline(always)]
+fn axis_output<S>(state: &AxisState<S>, reading: &Reading, rate: f32) -> AxisOutput {
+    let bias_dps = state.bias_dps;
     AxisOutput {
         corrected_dps: rate - bias_dps,
         bias_dps,
-        flags,
-        celsius,
-        rise_celsius,
+        flags: reading.flags,
+        celsius: reading.celsius,
+        rise_celsius: reading.rise_celsius,
     }
 }
 
@@ -423,14 +465,8 @@ impl<'a, M: Model> Corrector<'a, M> {
         self.state.correct_with_aux(self.model, sample, aux)
     }
 
-    /// Corrects a block of samples into `outputs`; returns how many were corrected (the shorter of
-    /// the two lengths).
+    /// See [`CorrectorState::correct_block`].
     pub fn correct_block(&mut self, samples: &[Sample], outputs: &mut [Output]) -> usize {
-        let mut count = 0_usize;
-        for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
-            *output = self.correct(sample);
-            count = count.saturating_add(1);
-        }
-        count
+        self.state.correct_block(self.model, samples, outputs)
     }
 }

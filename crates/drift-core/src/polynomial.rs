@@ -8,7 +8,7 @@ use heapless::Vec;
 
 use crate::error::{check_finite, Error, Location, Problem};
 use crate::flags::Flags;
-use crate::model::{AxisModel, Model};
+use crate::model::{AxisModel, Model, BLOCK_SAMPLES};
 use crate::settings::Settings;
 use crate::AXES;
 
@@ -34,19 +34,14 @@ impl PolynomialAxis {
     /// The polynomial at `celsius` (clamped to the fitted range), and whether that clamp went beyond
     /// `margin_celsius`.
     pub fn evaluate(&self, celsius: f32, margin_celsius: f32) -> (f32, bool) {
-        let [low, high] = self.range_celsius;
-        // `max`/`min` rather than `clamp`: `clamp` panics on an inverted range.
-        let clamped = celsius.max(low).min(high);
-        let outside =
-            celsius.is_nan() || celsius < low - margin_celsius || celsius > high + margin_celsius;
-        let half_span = 0.5 * (high - low);
-        let x = (clamped - (low + half_span)) / half_span;
+        let span = Span::new(self.range_celsius, margin_celsius);
+        let x = span.normalised(celsius);
         let value = self
             .coefficients
             .iter()
             .rev()
             .fold(0.0_f32, |acc, &c| acc * x + c);
-        (value, outside)
+        (value, span.outside(celsius))
     }
 
     /// Checks this axis's polynomial; `at` names the axis in errors.
@@ -64,6 +59,58 @@ impl PolynomialAxis {
             return Err(Error::new("coefficients", at, Problem::Empty));
         }
         check_finite("coefficients", at, self.coefficients.iter().copied())
+    }
+}
+
+/// The fitted range and what `evaluate` derives from it. Shared by the per-sample and the block
+/// evaluation, so both give the same bits.
+#[derive(Clone, Copy)]
+struct Span {
+    low: f32,
+    high: f32,
+    mid: f32,
+    half_span: f32,
+    margin_celsius: f32,
+}
+
+impl Span {
+    #[inline(always)]
+    fn new([low, high]: [f32; 2], margin_celsius: f32) -> Self {
+        let half_span = 0.5 * (high - low);
+        Self {
+            low,
+            high,
+            mid: low + half_span,
+            half_span,
+            margin_celsius,
+        }
+    }
+
+    /// `celsius` clamped to the range and mapped onto [−1, 1]. The clamp compares rather than
+    /// calling `max`/`min`: the same value (NaN reads as the low end; only the sign of a zero
+    /// could differ, which the subtraction of `mid ≠ 0` erases), and it vectorises. (`clamp`
+    /// would panic on an inverted range.)
+    #[inline(always)]
+    fn normalised(&self, celsius: f32) -> f32 {
+        let above_low = if celsius > self.low {
+            celsius
+        } else {
+            self.low
+        };
+        let clamped = if above_low < self.high {
+            above_low
+        } else {
+            self.high
+        };
+        (clamped - self.mid) / self.half_span
+    }
+
+    /// Whether `celsius` lies outside the range by more than the margin (or is NaN).
+    #[inline(always)]
+    fn outside(&self, celsius: f32) -> bool {
+        celsius.is_nan()
+            || celsius < self.low - self.margin_celsius
+            || celsius > self.high + self.margin_celsius
     }
 }
 
@@ -109,6 +156,40 @@ impl AxisModel for PolynomialAxis {
         // Split as initial bias + drift since switch-on, like the modified model, so the two report
         // comparable quantities.
         (bias - state.at_switch_on_dps, flags)
+    }
+
+    /// `drift` for a block of temperatures, coefficient by coefficient over the block (the same
+    /// operations per temperature as [`PolynomialAxis::evaluate`], in the same order).
+    fn drift_of_temperatures(
+        &self,
+        settings: &Settings,
+        state: &Self::State,
+        celsius: &[f32; BLOCK_SAMPLES],
+        drift: &mut [f32; BLOCK_SAMPLES],
+        flags: &mut [Flags; BLOCK_SAMPLES],
+    ) -> bool {
+        let span = Span::new(self.range_celsius, settings.ambient_margin_celsius);
+        let mut x = [0.0_f32; BLOCK_SAMPLES];
+        for (x, &celsius) in x.iter_mut().zip(celsius) {
+            *x = span.normalised(celsius);
+        }
+        let mut value = [0.0_f32; BLOCK_SAMPLES];
+        for &c in self.coefficients.iter().rev() {
+            for (value, &x) in value.iter_mut().zip(&x) {
+                *value = *value * x + c;
+            }
+        }
+        for (drift, value) in drift.iter_mut().zip(value) {
+            *drift = value - state.at_switch_on_dps;
+        }
+        for (flags, &celsius) in flags.iter_mut().zip(celsius) {
+            *flags = if span.outside(celsius) {
+                Flags::TEMPERATURE_OUT_OF_RANGE
+            } else {
+                Flags::NONE
+            };
+        }
+        true
     }
 }
 

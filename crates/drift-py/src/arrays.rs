@@ -144,14 +144,6 @@ impl RowsView<'_> {
         self.shape().first().copied().unwrap_or(0)
     }
 
-    /// The rows as one flat slice, when they are float32 and C-contiguous (the fast path).
-    pub fn as_f32_slice(&self) -> Option<&[f32]> {
-        match self {
-            Self::F32(view) => view.as_slice(),
-            Self::F64(_) => None,
-        }
-    }
-
     /// Copies rows `start..` as f32 into `out`, as many as `out` yields (`N`: the column count).
     pub fn copy_rows<'o, const N: usize>(
         &self,
