@@ -3,13 +3,13 @@
 //! A model whose drift depends on the temperature alone (the polynomial baselines) is evaluated for
 //! [`BLOCK_SAMPLES`] readings per axis at once. Then, axis by axis, what `correct_axis` does around
 //! the model runs as loops over the block, with the same operations in the same order: the checks
-//! (the per-sample path's own [`read_axis`] when a reading is not finite, else a scan of the stuck
-//! counter alone), the model's flags, the hold of the last good drift, the output. Only the stuck
-//! counter and the hold are carried from sample to sample; everything else is a loop the compiler
-//! vectorises. Every other model, an extended model and a state that is not powered on go sample by
+//! (the per-sample path's own [`read_axis`] when a reading is not finite, else the stuck counter
+//! worked out run by run), the model's flags, the hold of the last good drift (run by run), the
+//! output. Everything else is a loop the compiler vectorises. Every other model, an extended model and a state that is not powered on go sample by
 //! sample.
 
 use super::{rate_flag, read_axis, AxisState, CorrectorState, Output, Sample};
+use crate::error::saturating_u16;
 use crate::flags::Flags;
 use crate::model::{AxisModel, Model, BLOCK_SAMPLES};
 use crate::settings::Settings;
@@ -100,21 +100,18 @@ impl<S: Copy + Default> CorrectorState<S> {
         let settings = model.settings();
         let celsius_per_raw = settings.celsius_per_raw();
         let [x, y, z] = lanes;
-        for (i, sample) in samples.iter().enumerate() {
-            let [rate_x, rate_y, rate_z] = sample.rate_dps;
-            let [raw_x, raw_y, raw_z] = sample.temperature_raw;
-            for (lane, rate, raw) in [
-                (&mut *x, rate_x, raw_x),
-                (&mut *y, rate_y, raw_y),
-                (&mut *z, rate_z, raw_z),
-            ] {
-                if let (Some(lane_rate), Some(lane_raw)) =
-                    (lane.rate.get_mut(i), lane.raw.get_mut(i))
-                {
-                    *lane_rate = rate;
-                    *lane_raw = raw;
-                }
-            }
+        // Zipped iterators rather than indices: no bounds check per value.
+        let rates = x
+            .rate
+            .iter_mut()
+            .zip(y.rate.iter_mut())
+            .zip(z.rate.iter_mut());
+        let raws = x.raw.iter_mut().zip(y.raw.iter_mut()).zip(z.raw.iter_mut());
+        for (sample, (((rate_x, rate_y), rate_z), ((raw_x, raw_y), raw_z))) in
+            samples.iter().zip(rates.zip(raws))
+        {
+            [*rate_x, *rate_y, *rate_z] = sample.rate_dps;
+            [*raw_x, *raw_y, *raw_z] = sample.temperature_raw;
         }
         // Every axis answers before any state changes.
         for ((lane, axis), state) in [&mut *x, &mut *y, &mut *z]
@@ -147,13 +144,16 @@ impl<S: Copy + Default> CorrectorState<S> {
             finish(state, lane, count);
         }
         // Sample by sample, so each output is written whole.
-        for (i, output) in outputs.iter_mut().enumerate() {
-            let at = |values: &[f32; BLOCK_SAMPLES]| values.get(i).copied().unwrap_or(f32::NAN);
-            let flags = |lane: &Lane| lane.flags.get(i).copied().unwrap_or(Flags::NONE);
+        let corrected = x.corrected.iter().zip(&y.corrected).zip(&z.corrected);
+        let bias = x.bias.iter().zip(&y.bias).zip(&z.bias);
+        let flags = x.flags.iter().zip(&y.flags).zip(&z.flags);
+        for (output, (((&cx, &cy), &cz), (((&bx, &by), &bz), ((&fx, &fy), &fz)))) in
+            outputs.iter_mut().zip(corrected.zip(bias.zip(flags)))
+        {
             *output = Output {
-                corrected_dps: [at(&x.corrected), at(&y.corrected), at(&z.corrected)],
-                bias_dps: [at(&x.bias), at(&y.bias), at(&z.bias)],
-                flags: [flags(x), flags(y), flags(z)],
+                corrected_dps: [cx, cy, cz],
+                bias_dps: [bx, by, bz],
+                flags: [fx, fy, fz],
             };
         }
         true
@@ -178,25 +178,54 @@ fn check_any<S>(
     }
 }
 
-/// [`check_any`] when all `count` readings are finite: then only the stuck counter goes from
-/// sample to sample (a reading repeats the last one exactly, or replaces it), and the flags are a
-/// loop over the block.
+/// [`check_any`] when all `count` readings are finite: then a reading either repeats the last
+/// one exactly (the stuck counter goes up) or replaces it (the counter restarts), and the counter
+/// is stuck from `stuck_after_samples` repeats on. Worked out run by run of repeats rather than
+/// sample by sample; the flags are a loop over the block.
 #[inline(always)]
 fn check_finite<S>(settings: &Settings, state: &mut AxisState<S>, lane: &mut Lane, count: usize) {
-    let after = settings.stuck_after_samples;
-    let mut last = state.last_raw.to_bits();
-    let mut repeats = state.repeats;
-    let readings = lane.raw.get(..count).unwrap_or_default();
-    let healthy = lane.healthy.get_mut(..count).unwrap_or_default();
-    // Branches rather than selects: readings repeat in runs, which the branch predictor follows
-    // (measured faster than a branch-free counter).
-    for (&raw, healthy) in readings.iter().zip(healthy) {
-        let same = raw.to_bits() == last;
-        repeats = if same { repeats.saturating_add(1) } else { 0 };
-        last = raw.to_bits();
-        *healthy = !(same && after != 0 && repeats >= after);
+    let after = usize::from(settings.stuck_after_samples);
+    let mut same = [false; BLOCK_SAMPLES];
+    let mut previous = state.last_raw.to_bits();
+    for (same, &raw) in same.iter_mut().zip(&lane.raw).take(count) {
+        *same = raw.to_bits() == previous;
+        previous = raw.to_bits();
     }
-    state.last_raw = f32::from_bits(last);
+    let same = same.get(..count).unwrap_or_default();
+    let healthy = lane.healthy.get_mut(..count).unwrap_or_default();
+    let mut repeats = state.repeats;
+    if after == 0 || usize::from(repeats).saturating_add(count) < after {
+        // No reading of this block can reach the threshold.
+        healthy.fill(true);
+        repeats = match same.iter().rposition(|&same| !same) {
+            Some(change) => saturating_u16(count.saturating_sub(change).saturating_sub(1)),
+            None => repeats.saturating_add(saturating_u16(count)),
+        };
+    } else {
+        let mut start = 0;
+        while let Some(run) = same.get(start..).filter(|run| !run.is_empty()) {
+            let repeating = run.first().copied().unwrap_or(false);
+            let len = run_length(run);
+            let end = start.saturating_add(len);
+            let run_healthy = healthy.get_mut(start..end).unwrap_or_default();
+            if repeating {
+                // The counter reaches `repeats + 1`, `repeats + 2`, ... over the run: stuck from
+                // the sample where it reaches `after` on.
+                let healthy_len = after.saturating_sub(usize::from(repeats).saturating_add(1));
+                let (fine, stuck) = run_healthy.split_at_mut(healthy_len.min(len));
+                fine.fill(true);
+                stuck.fill(false);
+                repeats = repeats.saturating_add(saturating_u16(len));
+            } else {
+                run_healthy.fill(true);
+                repeats = 0;
+            }
+            start = end;
+        }
+    }
+    if let Some(&last) = lane.raw.get(..count).and_then(<[f32]>::last) {
+        state.last_raw = last;
+    }
     state.repeats = repeats;
     for ((flags, &healthy), &rate) in lane.flags.iter_mut().zip(&lane.healthy).zip(&lane.rate) {
         *flags = state.activation_flags | rate_flag(rate);
@@ -230,13 +259,24 @@ fn finish<S>(state: &mut AxisState<S>, lane: &mut Lane, count: usize) {
         *take = healthy & finite;
         *candidate = state.initial_bias_dps + drift;
     }
+    // Run by run of held and not-held answers: a held run copies its candidates, a run that
+    // is not held repeats the last held bias.
     let mut held = state.bias_dps;
-    let chosen = lane.take.iter().zip(&lane.candidate).take(count);
-    for (bias, (&take, &candidate)) in lane.bias.iter_mut().zip(chosen) {
-        if take {
-            held = candidate;
+    let take = lane.take.get(..count).unwrap_or_default();
+    let mut start = 0;
+    while let Some(run) = take.get(start..).filter(|run| !run.is_empty()) {
+        let taking = run.first().copied().unwrap_or(false);
+        let len = run_length(run);
+        let end = start.saturating_add(len);
+        let bias = lane.bias.get_mut(start..end).unwrap_or_default();
+        match lane.candidate.get(start..end) {
+            Some(candidates) if taking => {
+                bias.copy_from_slice(candidates);
+                held = candidates.last().copied().unwrap_or(held);
+            }
+            _ => bias.fill(held),
         }
-        *bias = held;
+        start = end;
     }
     state.bias_dps = held;
     for (corrected, (&rate, &bias)) in lane
@@ -245,5 +285,43 @@ fn finish<S>(state: &mut AxisState<S>, lane: &mut Lane, count: usize) {
         .zip(lane.rate.iter().zip(&lane.bias))
     {
         *corrected = rate - bias;
+    }
+}
+
+/// How many values at the start of `values` equal the first. Eight at a time: the runs are long
+/// (a repeated reading, held answers) and one value at a time was a sixth of the block path.
+#[inline(always)]
+fn run_length(values: &[bool]) -> usize {
+    let Some(&first) = values.first() else {
+        return 0;
+    };
+    let mut len = 0_usize;
+    for word in values.chunks_exact(8) {
+        if <[bool; 8]>::try_from(word).ok() != Some([first; 8]) {
+            break;
+        }
+        len = len.saturating_add(8);
+    }
+    let rest = values.get(len..).unwrap_or_default();
+    let tail = rest.iter().position(|&value| value != first);
+    len.saturating_add(tail.unwrap_or(rest.len()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::run_length;
+
+    #[test]
+    fn run_length_counts_the_leading_equal_values() {
+        assert_eq!(run_length(&[]), 0);
+        for len in 1..40 {
+            for first in [false, true] {
+                for tail in 0..10 {
+                    let mut values = std::vec![first; len];
+                    values.extend(core::iter::repeat(!first).take(tail));
+                    assert_eq!(run_length(&values), len, "{len} {first} {tail}");
+                }
+            }
+        }
     }
 }
