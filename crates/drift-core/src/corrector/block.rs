@@ -318,7 +318,7 @@ mod tests {
             for first in [false, true] {
                 for tail in 0..10 {
                     let mut values = std::vec![first; len];
-                    values.extend(core::iter::repeat(!first).take(tail));
+                    values.extend(core::iter::repeat_n(!first, tail));
                     assert_eq!(run_length(&values), len, "{len} {first} {tail}");
                 }
             }
