@@ -470,3 +470,16 @@ impl<'a, M: Model> Corrector<'a, M> {
         self.state.correct_block(self.model, samples, outputs)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::CorrectorState;
+    use crate::ModifiedAxisState;
+
+    /// Issue 2's floor for a unit's run-time state, extension included (docs/embedded.md). The
+    /// layout has no pointers, so the host's size is the Cortex-M4's (which the firmware prints).
+    #[test]
+    fn state_fits_issue_2s_floor() {
+        assert!(core::mem::size_of::<CorrectorState<ModifiedAxisState>>() <= 256);
+    }
+}
