@@ -205,7 +205,12 @@ pub fn copy_times<'o>(
     start: usize,
     out: impl Iterator<Item = &'o mut u32>,
 ) {
-    if start < view.len() {
+    if let Some(times) = view.as_slice() {
+        // Contiguous: a plain copy from the caller's buffer rather than ndarray's strided iterator.
+        for (d, s) in out.zip(times.get(start..).unwrap_or_default()) {
+            *d = *s;
+        }
+    } else if start < view.len() {
         let rest = view.slice_axis(Axis(0), Slice::from(start..));
         for (d, s) in out.zip(rest.iter()) {
             *d = *s;

@@ -5,8 +5,8 @@
 //! the model runs as loops over the block, with the same operations in the same order: the checks
 //! (the per-sample path's own [`read_axis`] when a reading is not finite, else the stuck counter
 //! worked out run by run), the model's flags, the hold of the last good drift (run by run), the
-//! output. Everything else is a loop the compiler vectorises. Every other model, an extended model and a state that is not powered on go sample by
-//! sample.
+//! output. Everything else is a loop the compiler vectorises. Every other model, an extended model
+//! and a state that is not powered on go sample by sample.
 
 use super::{rate_flag, read_axis, AxisState, CorrectorState, Output, Sample};
 use crate::error::saturating_u16;
@@ -212,9 +212,11 @@ fn check_finite<S>(settings: &Settings, state: &mut AxisState<S>, lane: &mut Lan
                 // The counter reaches `repeats + 1`, `repeats + 2`, ... over the run: stuck from
                 // the sample where it reaches `after` on.
                 let healthy_len = after.saturating_sub(usize::from(repeats).saturating_add(1));
-                let (fine, stuck) = run_healthy.split_at_mut(healthy_len.min(len));
-                fine.fill(true);
-                stuck.fill(false);
+                let split = run_healthy.split_at_mut_checked(healthy_len.min(len));
+                if let Some((fine, stuck)) = split {
+                    fine.fill(true);
+                    stuck.fill(false);
+                }
                 repeats = repeats.saturating_add(saturating_u16(len));
             } else {
                 run_healthy.fill(true);
@@ -271,7 +273,9 @@ fn finish<S>(state: &mut AxisState<S>, lane: &mut Lane, count: usize) {
         let bias = lane.bias.get_mut(start..end).unwrap_or_default();
         match lane.candidate.get(start..end) {
             Some(candidates) if taking => {
-                bias.copy_from_slice(candidates);
+                for (bias, &candidate) in bias.iter_mut().zip(candidates) {
+                    *bias = candidate;
+                }
                 held = candidates.last().copied().unwrap_or(held);
             }
             _ => bias.fill(held),
