@@ -99,6 +99,9 @@ fn bench(c: &mut Criterion) {
     group.bench_function(BenchmarkId::new("per_block", "standard"), |b| {
         b.iter(|| per_block(&standard, &samples, &mut out))
     });
+    group.bench_function(BenchmarkId::new("per_block", "third_order"), |b| {
+        b.iter(|| per_block(&third_order, &samples, &mut out))
+    });
     group.finish();
 }
 

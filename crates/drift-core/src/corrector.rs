@@ -1,7 +1,9 @@
 //! The run-time corrector: immutable model (tables) + small per-unit state, one call per sample.
 
+mod block;
+
 use crate::error::{Error, Location, Problem};
-use crate::extension::{ExtensionState, TermInputs, AUX_INPUTS};
+use crate::extension::{ExtensionState, AUX_INPUTS};
 use crate::flags::Flags;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
@@ -33,20 +35,37 @@ pub struct Output {
 }
 
 /// Run-time state of one axis. Plain data: copy it to persist, restore it to resume.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AxisState<S> {
     switch_on_raw: f32,
     initial_bias_dps: f32,
-    /// Last good drift estimate, held through sensor faults.
-    drift_dps: f32,
+    /// Initial bias plus the last good drift estimate, held through sensor faults. Kept as the sum,
+    /// the bias every sample reports, so a sample adds nothing.
+    bias_dps: f32,
     last_raw: f32,
     /// How many samples in a row repeated `last_raw` exactly.
     repeats: u16,
-    /// Flags that hold for the whole activation (from switch-on).
+    /// Flags that hold for the whole activation (from switch-on); `NOT_POWERED_ON` while there is
+    /// no activation, which makes a separate "powered on" field unnecessary.
     activation_flags: Flags,
     /// Last good contribution of the extended model's extra terms, held through input faults.
     extension_dps: f32,
     model: S,
+}
+
+impl<S: Default> Default for AxisState<S> {
+    fn default() -> Self {
+        Self {
+            switch_on_raw: 0.0,
+            initial_bias_dps: 0.0,
+            bias_dps: 0.0,
+            last_raw: 0.0,
+            repeats: 0,
+            activation_flags: Flags::NOT_POWERED_ON,
+            extension_dps: 0.0,
+            model: S::default(),
+        }
+    }
 }
 
 impl<S> AxisState<S> {
@@ -72,7 +91,6 @@ impl<S> AxisState<S> {
 pub struct CorrectorState<S> {
     axes: [AxisState<S>; AXES],
     extension: ExtensionState,
-    powered_on: bool,
 }
 
 impl<S: Copy + Default> CorrectorState<S> {
@@ -88,7 +106,8 @@ impl<S: Copy + Default> CorrectorState<S> {
 
     /// Whether `power_on` has succeeded since the last `power_off`.
     pub fn is_powered_on(&self) -> bool {
-        self.powered_on
+        let [x, ..] = &self.axes;
+        !x.activation_flags.contains(Flags::NOT_POWERED_ON)
     }
 
     /// Starts an activation from the raw temperature readings at switch-on.
@@ -132,17 +151,20 @@ impl<S: Copy + Default> CorrectorState<S> {
             } else {
                 activation |= Flags::MODEL_INVALID;
             }
+            // The same sum as after a good drift estimate (with no drift yet): the same bits.
+            state.bias_dps = state.initial_bias_dps + 0.0;
             state.activation_flags = activation;
             *flags = activation;
         }
         self.extension = ExtensionState::power_on(switch_on_raw.map(|raw| settings.celsius(raw)));
-        self.powered_on = true;
         Ok(flags)
     }
 
     /// Ends the activation: further samples pass through, flagged, until the next `power_on`.
     pub fn power_off(&mut self) {
-        self.powered_on = false;
+        for axis in &mut self.axes {
+            axis.activation_flags |= Flags::NOT_POWERED_ON;
+        }
     }
 
     /// Corrects one sample without auxiliary inputs. Total: never panics, never allocates; every
@@ -168,7 +190,7 @@ impl<S: Copy + Default> CorrectorState<S> {
         M: Model,
         M::Axis: AxisModel<State = S>,
     {
-        if !self.powered_on {
+        if !self.is_powered_on() {
             return not_powered_on(sample);
         }
         let settings = model.settings();
@@ -208,29 +230,21 @@ impl<S: Copy + Default> CorrectorState<S> {
             raw_z,
         );
         let mut output = Output {
-            corrected_dps: [x.0, y.0, z.0],
-            bias_dps: [x.1, y.1, z.1],
-            flags: [x.2, y.2, z.2],
+            corrected_dps: [x.corrected_dps, y.corrected_dps, z.corrected_dps],
+            bias_dps: [x.bias_dps, y.bias_dps, z.bias_dps],
+            flags: [x.flags, y.flags, z.flags],
         };
         let extension = model.extension();
         if !extension.is_empty() {
             // The extra terms read the last good temperature of every axis (a faulty reading is
             // held there, like the paper's drift).
-            let mut inputs = TermInputs {
-                since_power_on_ms: sample.since_power_on_ms,
-                aux: *aux,
-                ..TermInputs::default()
-            };
-            for ((state, celsius), rise) in self
-                .axes
-                .iter()
-                .zip(&mut inputs.celsius)
-                .zip(&mut inputs.rise_celsius)
-            {
-                *celsius = settings.celsius_with(state.last_raw, celsius_per_raw);
-                *rise = (state.last_raw - state.switch_on_raw) * celsius_per_raw;
-            }
-            let extra = self.extension.bias(extension, &inputs);
+            let extra = self.extension.bias(
+                extension,
+                ms,
+                &[x.celsius, y.celsius, z.celsius],
+                &[x.rise_celsius, y.rise_celsius, z.rise_celsius],
+                aux,
+            );
             for (((state, extra), corrected), (bias, flags)) in self
                 .axes
                 .iter_mut()
@@ -277,7 +291,18 @@ fn rate_flag(rate: f32) -> Flags {
     }
 }
 
-/// The part every model shares: sensor-fault checks, rise, hold of the last good drift, flags.
+/// One axis of one sample after the shared part: the output, and the last good temperature with
+/// its rise, which the extended model's terms read.
+struct AxisOutput {
+    corrected_dps: f32,
+    bias_dps: f32,
+    flags: Flags,
+    celsius: f32,
+    rise_celsius: f32,
+}
+
+/// One axis of one sample through `axis`: the shared checks, the model where the reading allows,
+/// the hold.
 #[inline(always)]
 fn correct_axis<A: AxisModel>(
     axis: &A,
@@ -287,40 +312,92 @@ fn correct_axis<A: AxisModel>(
     since_power_on_ms: u32,
     rate: f32,
     raw: f32,
-) -> (f32, f32, Flags) {
+) -> AxisOutput {
+    let mut reading = read_axis(settings, celsius_per_raw, state, rate, raw);
+    if reading.healthy {
+        let (drift, model_flags) = axis.drift(
+            settings,
+            &mut state.model,
+            since_power_on_ms,
+            reading.celsius,
+            reading.rise_celsius,
+        );
+        hold_drift(state, &mut reading, drift, model_flags);
+    }
+    axis_output(state, &reading, rate)
+}
+
+/// What the shared checks found for one axis's reading.
+struct Reading {
+    flags: Flags,
+    /// Valid and not stuck: the model is asked, at `celsius` and `rise_celsius`.
+    healthy: bool,
+    /// The last good reading in °C: this sample's when it is valid (the same bits), else the held
+    /// one, which the extension reads.
+    celsius: f32,
+    /// Its rise since switch-on, °C.
+    rise_celsius: f32,
+}
+
+/// The checks every model shares, before the model: activation, rate and temperature faults, the
+/// stuck counter. The per-sample and the block path both go through `read_axis`, `hold_drift` and
+/// `axis_output`, so they give the same bits by construction.
+#[inline(always)]
+fn read_axis<S>(
+    settings: &Settings,
+    celsius_per_raw: f32,
+    state: &mut AxisState<S>,
+    rate: f32,
+    raw: f32,
+) -> Reading {
     let mut flags = state.activation_flags | rate_flag(rate);
-    if raw.is_finite() {
+    let valid = raw.is_finite();
+    let mut stuck = false;
+    if valid {
         if raw.to_bits() == state.last_raw.to_bits() {
             state.repeats = state.repeats.saturating_add(1);
+            stuck =
+                settings.stuck_after_samples != 0 && state.repeats >= settings.stuck_after_samples;
         } else {
             state.repeats = 0;
             state.last_raw = raw;
         }
-        let stuck =
-            settings.stuck_after_samples != 0 && state.repeats >= settings.stuck_after_samples;
-        if stuck {
-            flags |= Flags::TEMPERATURE_STUCK;
-        } else {
-            let rise = (raw - state.switch_on_raw) * celsius_per_raw;
-            let (drift, model_flags) = axis.drift(
-                settings,
-                &mut state.model,
-                since_power_on_ms,
-                settings.celsius_with(raw, celsius_per_raw),
-                rise,
-            );
-            flags |= model_flags;
-            if drift.is_finite() {
-                state.drift_dps = drift;
-            } else {
-                flags |= Flags::MODEL_INVALID;
-            }
-        }
-    } else {
-        flags |= Flags::TEMPERATURE_INVALID;
     }
-    let bias = state.initial_bias_dps + state.drift_dps;
-    (rate - bias, bias, flags)
+    if !valid {
+        flags |= Flags::TEMPERATURE_INVALID;
+    } else if stuck {
+        flags |= Flags::TEMPERATURE_STUCK;
+    }
+    Reading {
+        flags,
+        healthy: valid && !stuck,
+        celsius: settings.celsius_with(state.last_raw, celsius_per_raw),
+        rise_celsius: (state.last_raw - state.switch_on_raw) * celsius_per_raw,
+    }
+}
+
+/// The model's answer for a healthy reading: its flags, and its drift held unless non-finite.
+#[inline(always)]
+fn hold_drift<S>(state: &mut AxisState<S>, reading: &mut Reading, drift: f32, model_flags: Flags) {
+    reading.flags |= model_flags;
+    if drift.is_finite() {
+        state.bias_dps = state.initial_bias_dps + drift;
+    } else {
+        reading.flags |= Flags::MODEL_INVALID;
+    }
+}
+
+/// The axis's output from the held bias.
+#[inline(always)]
+fn axis_output<S>(state: &AxisState<S>, reading: &Reading, rate: f32) -> AxisOutput {
+    let bias_dps = state.bias_dps;
+    AxisOutput {
+        corrected_dps: rate - bias_dps,
+        bias_dps,
+        flags: reading.flags,
+        celsius: reading.celsius,
+        rise_celsius: reading.rise_celsius,
+    }
 }
 
 /// A model together with one unit's state: the convenient way to run a corrector.
@@ -388,14 +465,21 @@ impl<'a, M: Model> Corrector<'a, M> {
         self.state.correct_with_aux(self.model, sample, aux)
     }
 
-    /// Corrects a block of samples into `outputs`; returns how many were corrected (the shorter of
-    /// the two lengths).
+    /// See [`CorrectorState::correct_block`].
     pub fn correct_block(&mut self, samples: &[Sample], outputs: &mut [Output]) -> usize {
-        let mut count = 0_usize;
-        for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
-            *output = self.correct(sample);
-            count = count.saturating_add(1);
-        }
-        count
+        self.state.correct_block(self.model, samples, outputs)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CorrectorState;
+    use crate::ModifiedAxisState;
+
+    /// Issue 2's floor for a unit's run-time state, extension included (docs/embedded.md). The
+    /// layout has no pointers, so the host's size is the Cortex-M4's (which the firmware prints).
+    #[test]
+    fn state_fits_issue_2s_floor() {
+        assert!(core::mem::size_of::<CorrectorState<ModifiedAxisState>>() <= 256);
     }
 }

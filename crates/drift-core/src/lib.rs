@@ -36,14 +36,13 @@ pub use extension::{
     Extension, ExtensionState, ExtraTerm, Term, TermInputs, TermValues, AUX_INPUTS, MAX_TERMS,
 };
 pub use flags::Flags;
-pub use model::{AxisModel, Model};
+pub use model::{AxisModel, Model, BLOCK_SAMPLES};
 pub use polynomial::{
     PolynomialAxis, PolynomialAxisState, PolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
 };
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
-pub use stage::heating::BracketCache;
-pub use stage::since_power_on::{Segment, SegmentKind, TimePosition};
+pub use stage::since_power_on::{Moment, Segment, SegmentKind};
 pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedAxisState, ModifiedTables};
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.

@@ -36,7 +36,27 @@ pub trait AxisModel {
         temperature_celsius: f32,
         rise_celsius: f32,
     ) -> (f32, Flags);
+
+    /// The block path's form of [`Self::drift`]: fills `drift` and `flags` with what `drift` returns
+    /// for each temperature of `celsius` (°C), for a model whose drift depends on the temperature
+    /// alone (not on time, rise or a state that changes per sample), and returns `true`. The
+    /// corrector then evaluates [`BLOCK_SAMPLES`] readings at once, which the compiler vectorises
+    /// (the polynomial baselines). The default returns `false`: the corrector goes sample by sample.
+    fn drift_of_temperatures(
+        &self,
+        _settings: &Settings,
+        _state: &Self::State,
+        _celsius: &[f32; BLOCK_SAMPLES],
+        _drift: &mut [f32; BLOCK_SAMPLES],
+        _flags: &mut [Flags; BLOCK_SAMPLES],
+    ) -> bool {
+        false
+    }
 }
+
+/// Samples the block path evaluates at once (see [`AxisModel::drift_of_temperatures`]): enough for
+/// the vector loops to amortise their set-up, few enough for the stack (~1 KiB per axis).
+pub const BLOCK_SAMPLES: usize = 64;
 
 /// A drift model for a whole unit: settings plus one [`AxisModel`] per axis.
 pub trait Model {

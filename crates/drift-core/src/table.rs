@@ -8,8 +8,8 @@ use crate::flags::Flags;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
 use crate::stage::ambient::AmbientPosition;
-use crate::stage::heating::{k_at, BracketCache};
-use crate::stage::since_power_on::{Segment, TimePosition};
+use crate::stage::heating::{cached_k, search, BlendedCurves, Knots};
+use crate::stage::since_power_on::{Moment, Segment, SegmentKind};
 use crate::AXES;
 
 /// One point of a heating-dynamics curve: where the curve stood at one reference time.
@@ -181,19 +181,65 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
 }
 
 /// Per-axis run-time state of the modified model: where the switch-on temperature fell among the
-/// calibration ambients (fixed for the activation), and where the previous sample's searches ended.
+/// calibration ambients (fixed for the activation), the current reference-time segment (stage 1)
+/// and stage 3's bracket with its knots for that segment.
 ///
-/// The hints and the cache only make the next sample cheaper; they never change a result.
+/// The segment and the bracket only make the next sample cheaper; they never change a result.
+/// Kept field by field rather than as an [`AmbientPosition`] and a [`Segment`], so that the
+/// one-byte indices share one word: a unit's state stays within 256 bytes (issue 2).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ModifiedAxisState {
-    /// Stage 2's position, located at switch-on.
-    pub ambient: AmbientPosition,
-    /// Stage 1's last reference-time segment (where a search starts).
-    pub segment_hint: u8,
-    /// Stage 1's current segment, located when time entered it.
-    pub segment: Segment,
-    /// Stage 3's last bracket and its knots.
-    pub bracket: BracketCache,
+    ambient_weight: f32,
+    ambient_lo: u8,
+    segment_start_ms: u32,
+    segment_len_ms: u32,
+    segment_per_ms: f32,
+    segment_lo: u8,
+    segment_kind: SegmentKind,
+    knots: [Knots; 2],
+    curve: u8,
+}
+
+impl ModifiedAxisState {
+    /// The state of an activation that switched on at `ambient` (stage 2's position), with no
+    /// segment and the searches starting at the first reference time and the first curve.
+    pub fn new(ambient: &AmbientPosition) -> Self {
+        Self {
+            ambient_weight: ambient.weight,
+            ambient_lo: ambient.lo,
+            ..Self::default()
+        }
+    }
+
+    /// The same state with its searches starting at reference time `segment` and curve `curve`
+    /// (while no segment is cached): for tests that hints never change a result.
+    #[must_use]
+    pub fn with_hints(self, segment: u8, curve: u8) -> Self {
+        Self {
+            segment_lo: segment,
+            curve,
+            ..self
+        }
+    }
+
+    /// The reference-time segment of the last sample (empty before the first one).
+    pub fn segment(&self) -> Segment {
+        Segment {
+            start_ms: self.segment_start_ms,
+            len_ms: self.segment_len_ms,
+            per_ms: self.segment_per_ms,
+            lo: self.segment_lo,
+            kind: self.segment_kind,
+        }
+    }
+
+    fn set_segment(&mut self, segment: Segment) {
+        self.segment_start_ms = segment.start_ms;
+        self.segment_len_ms = segment.len_ms;
+        self.segment_per_ms = segment.per_ms;
+        self.segment_lo = segment.lo;
+        self.segment_kind = segment.kind;
+    }
 }
 
 impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, A, C> {
@@ -211,10 +257,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
             settings.ambient_margin_celsius,
             |a| a.ambient_celsius,
         );
-        *state = ModifiedAxisState {
-            ambient,
-            ..ModifiedAxisState::default()
-        };
+        *state = ModifiedAxisState::new(&ambient);
         let bias_at = |i: u8| {
             self.ambients
                 .get(usize::from(i))
@@ -229,6 +272,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         (initial_bias, flags)
     }
 
+    #[inline(always)]
     fn drift(
         &self,
         settings: &Settings,
@@ -248,9 +292,10 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
     /// blended curve by curve), heating dynamics (stage 3: the blended curves whose rises bracket the
     /// current rise). The drift is `k · rise`.
     ///
-    /// `state` comes from this axis's power-on (its ambient position); its search hints and caches
-    /// are updated.
-    #[inline]
+    /// `state` comes from this axis's power-on (its ambient position); its segment and bracket are
+    /// updated. While the time stays in the segment and the rise in the bracket (almost every
+    /// sample), no table is read.
+    #[inline(always)]
     pub fn correlation(
         &self,
         settings: &Settings,
@@ -258,33 +303,67 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         since_power_on_ms: u32,
         rise_celsius: f32,
     ) -> (f32, Flags) {
-        let (time, new_segment) = TimePosition::locate_cached(
-            &self.reference_ms,
-            since_power_on_ms,
-            &mut state.segment_hint,
-            &mut state.segment,
-        );
-        if new_segment {
-            // The cached knots were read at the old segment's reference times.
-            state.bracket.valid = false;
+        let segment = state.segment();
+        if let Some(moment) = segment.moment(since_power_on_ms) {
+            let margin = settings.rise_margin_celsius;
+            if let Some((k, beyond)) =
+                cached_k(&state.knots, state.curve, moment, rise_celsius, margin)
+            {
+                return (k, flags(beyond, segment.kind));
+            }
         }
-        let (k, out_of_span) = k_at(
+        self.correlation_searched(settings, state, since_power_on_ms, rise_celsius)
+    }
+
+    /// [`Self::correlation`] when the time left the cached segment or the rise left the bracket:
+    /// locates the segment if needed and searches the blended curves. Out of line: a few samples
+    /// per segment.
+    #[inline(never)]
+    fn correlation_searched(
+        &self,
+        settings: &Settings,
+        state: &mut ModifiedAxisState,
+        since_power_on_ms: u32,
+        rise_celsius: f32,
+    ) -> (f32, Flags) {
+        let mut segment = state.segment();
+        let moment = segment.moment(since_power_on_ms).unwrap_or_else(|| {
+            segment = Segment::locate(&self.reference_ms, since_power_on_ms, segment.lo);
+            state.set_segment(segment);
+            segment.moment(since_power_on_ms).unwrap_or(Moment {
+                fraction: f32::NAN,
+                before_first: false,
+            })
+        });
+        let curves = BlendedCurves::new(
             &self.ambients,
-            &state.ambient,
-            time,
+            state.ambient_lo,
+            state.ambient_weight,
+            &segment,
+        );
+        let (k, beyond) = search(
+            &curves,
+            moment,
             rise_celsius,
             settings.rise_margin_celsius,
-            &mut state.bracket,
+            &mut state.knots,
+            &mut state.curve,
         );
-        let mut flags = Flags::NONE;
-        if out_of_span {
-            flags |= Flags::RISE_OUT_OF_SPAN;
-        }
-        if time.past_last {
-            flags |= Flags::PAST_LAST_REFERENCE;
-        }
-        (k, flags)
+        (k, flags(beyond, segment.kind))
     }
+}
+
+/// The modified model's envelope flags for one sample.
+#[inline(always)]
+fn flags(rise_out_of_span: bool, kind: SegmentKind) -> Flags {
+    let mut flags = Flags::NONE;
+    if rise_out_of_span {
+        flags |= Flags::RISE_OUT_OF_SPAN;
+    }
+    if kind == SegmentKind::PastLast {
+        flags |= Flags::PAST_LAST_REFERENCE;
+    }
+    flags
 }
 
 impl<const R: usize, const A: usize, const C: usize> Model for ModifiedTables<R, A, C> {

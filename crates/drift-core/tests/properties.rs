@@ -15,8 +15,7 @@
 )]
 
 use drift_core::{
-    AmbientCurves, AmbientPosition, AxisTable, BracketCache, Curve, CurvePoint, ModifiedAxisState,
-    Settings,
+    AmbientCurves, AmbientPosition, AxisTable, Curve, CurvePoint, ModifiedAxisState, Settings,
 };
 use proptest::prelude::*;
 
@@ -91,22 +90,12 @@ fn position(table: &Table, celsius: f32) -> AmbientPosition {
 /// hints point elsewhere and from a state warmed up on other samples of the same activation: the
 /// hints and the bracket cache may only save work.
 fn k(table: &Table, celsius: f32, ms: u32, rise: f32) -> f32 {
-    let fresh = ModifiedAxisState {
-        ambient: position(table, celsius),
-        ..ModifiedAxisState::default()
-    };
+    let fresh = ModifiedAxisState::new(&position(table, celsius));
     let fresh_k = table
         .correlation(&settings(), &mut fresh.clone(), ms, rise)
         .0;
     for hint in [1, 4, 255] {
-        let mut hinted = ModifiedAxisState {
-            segment_hint: hint,
-            bracket: BracketCache {
-                curve: hint,
-                ..BracketCache::default()
-            },
-            ..fresh
-        };
+        let mut hinted = fresh.with_hints(hint, hint);
         let hinted_k = table.correlation(&settings(), &mut hinted, ms, rise).0;
         assert_eq!(
             hinted_k.to_bits(),

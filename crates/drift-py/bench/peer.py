@@ -202,7 +202,7 @@ class PeerCorrector:
     def _drift_modified(
         self, axis: _ModifiedAxis, times: NDArray[np.uint32], rise: F32Array
     ) -> tuple[F32Array, NDArray[np.uint16]]:
-        """Stages 1 and 3 (`TimePosition::locate`, `BlendedCurves::k_at`), block by block."""
+        """Stages 1 and 3 (`Segment::locate`, `heating::cached_k` and `search`), block by block."""
         refs = axis.reference_ms
         last_ref = len(refs) - 1
         first = refs[0]

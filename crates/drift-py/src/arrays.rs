@@ -144,14 +144,6 @@ impl RowsView<'_> {
         self.shape().first().copied().unwrap_or(0)
     }
 
-    /// The rows as one flat slice, when they are float32 and C-contiguous (the fast path).
-    pub fn as_f32_slice(&self) -> Option<&[f32]> {
-        match self {
-            Self::F32(view) => view.as_slice(),
-            Self::F64(_) => None,
-        }
-    }
-
     /// Copies rows `start..` as f32 into `out`, as many as `out` yields (`N`: the column count).
     pub fn copy_rows<'o, const N: usize>(
         &self,
@@ -213,7 +205,12 @@ pub fn copy_times<'o>(
     start: usize,
     out: impl Iterator<Item = &'o mut u32>,
 ) {
-    if start < view.len() {
+    if let Some(times) = view.as_slice() {
+        // Contiguous: a plain copy from the caller's buffer rather than ndarray's strided iterator.
+        for (d, s) in out.zip(times.get(start..).unwrap_or_default()) {
+            *d = *s;
+        }
+    } else if start < view.len() {
         let rest = view.slice_axis(Axis(0), Slice::from(start..));
         for (d, s) in out.zip(rest.iter()) {
             *d = *s;

@@ -1,7 +1,7 @@
 //! `gyrodrift.Corrector`: a model plus one unit's run-time state, correcting one sample at a time
-//! or whole numpy arrays. Every sample goes through drift-core's `CorrectorState::correct`, or
-//! `CorrectorState::correct_with_aux` when the caller passes auxiliary inputs: the code the firmware
-//! runs.
+//! or whole numpy arrays. Every sample goes through drift-core: `CorrectorState::correct` (one at a
+//! time) or `correct_block` (arrays; the same bits), or `CorrectorState::correct_with_aux` when the
+//! caller passes auxiliary inputs: the code the firmware runs.
 
 use std::sync::Arc;
 
@@ -20,6 +20,9 @@ use crate::tables::{PyModifiedTables, PyPolynomialTables};
 
 /// Samples staged at a time between the caller's arrays and the corrector (on the stack).
 const BLOCK: usize = 512;
+
+/// Values in `BLOCK` rows of an `(n, 3)` output array.
+const BLOCK_VALUES: usize = BLOCK * 3;
 
 /// A model and its state; the model kind decides the state type.
 #[derive(Debug)]
@@ -72,6 +75,9 @@ where
     }
 }
 
+/// The batch through drift-core, staged [`BLOCK`] samples at a time: `correct_block` without
+/// auxiliary inputs (drift-core's block path: the polynomial baselines evaluate many samples at
+/// once), `correct_with_aux` per sample with them.
 fn correct_all<M, S>(
     model: &M,
     state: &mut CorrectorState<S>,
@@ -82,66 +88,16 @@ fn correct_all<M, S>(
     M::Axis: AxisModel<State = S>,
     S: Copy + Default,
 {
-    let mut outputs = out
-        .corrected_dps
-        .chunks_exact_mut(3)
-        .zip(out.bias_dps.chunks_exact_mut(3))
-        .zip(out.flags.chunks_exact_mut(3));
-    let mut store = |output: Output| {
-        if let Some(((corrected, bias), flags)) = outputs.next() {
-            for (dst, src) in corrected.iter_mut().zip(output.corrected_dps) {
-                *dst = src;
-            }
-            for (dst, src) in bias.iter_mut().zip(output.bias_dps) {
-                *dst = src;
-            }
-            for (dst, src) in flags.iter_mut().zip(output.flags) {
-                *dst = src.0;
-            }
-        }
-    };
-    // `Some(None)`: no auxiliary inputs; `Some(Some(rows))`: float32 C-contiguous ones.
-    let aux = match &batch.aux {
-        None => Some(None),
-        Some(view) => view.as_f32_slice().map(Some),
-    };
-    let contiguous = (
-        batch.times.as_slice(),
-        batch.rates.as_f32_slice(),
-        batch.temperatures.as_f32_slice(),
-        aux,
-    );
-    if let (Some(times), Some(rates), Some(temperatures), Some(aux)) = contiguous {
-        // The usual case, float32 C-contiguous inputs: samples straight from the caller's buffers.
-        let rows = times
-            .iter()
-            .zip(rates.chunks_exact(3))
-            .zip(temperatures.chunks_exact(3));
-        let mut aux_rows = aux.map(|aux| aux.chunks_exact(AUX_INPUTS));
-        for ((&since_power_on_ms, rate), temperature) in rows {
-            let mut sample = Sample {
-                since_power_on_ms,
-                ..Sample::default()
-            };
-            for (dst, src) in sample.rate_dps.iter_mut().zip(rate) {
-                *dst = *src;
-            }
-            for (dst, src) in sample.temperature_raw.iter_mut().zip(temperature) {
-                *dst = *src;
-            }
-            let aux = aux_rows
-                .as_mut()
-                .and_then(Iterator::next)
-                .and_then(|row| <&[f32; AUX_INPUTS]>::try_from(row).ok());
-            store(correct_one(model, state, &sample, aux));
-        }
-        return;
-    }
-    // Any other layout or float64: staged through small buffers, converted per value.
     let n = batch.times.len();
     let mut staged = [Sample::default(); BLOCK];
     let mut staged_aux = [[0.0_f32; AUX_INPUTS]; BLOCK];
-    for start in (0..n).step_by(BLOCK) {
+    let mut corrected = [Output::default(); BLOCK];
+    let rows = out
+        .corrected_dps
+        .chunks_mut(BLOCK_VALUES)
+        .zip(out.bias_dps.chunks_mut(BLOCK_VALUES))
+        .zip(out.flags.chunks_mut(BLOCK_VALUES));
+    for (start, ((corrected_rows, bias_rows), flags_rows)) in (0..n).step_by(BLOCK).zip(rows) {
         let count = BLOCK.min(n.saturating_sub(start));
         let block = staged.get_mut(..count).unwrap_or_default();
         copy_times(
@@ -155,13 +111,35 @@ fn correct_all<M, S>(
         batch
             .temperatures
             .copy_rows(start, block.iter_mut().map(|s| &mut s.temperature_raw));
-        let aux_block = staged_aux.get_mut(..count).unwrap_or_default();
-        if let Some(aux) = &batch.aux {
-            aux.copy_rows(start, aux_block.iter_mut());
+        let outputs = corrected.get_mut(..count).unwrap_or_default();
+        match &batch.aux {
+            None => {
+                state.correct_block(model, block, outputs);
+            }
+            Some(aux) => {
+                let aux_block = staged_aux.get_mut(..count).unwrap_or_default();
+                aux.copy_rows(start, aux_block.iter_mut());
+                for ((sample, aux), output) in
+                    block.iter().zip(aux_block.iter()).zip(outputs.iter_mut())
+                {
+                    *output = state.correct_with_aux(model, sample, aux);
+                }
+            }
         }
-        for (sample, aux) in block.iter().zip(aux_block.iter()) {
-            let aux = batch.aux.as_ref().map(|_| aux);
-            store(correct_one(model, state, sample, aux));
+        let destinations = corrected_rows
+            .chunks_exact_mut(3)
+            .zip(bias_rows.chunks_exact_mut(3))
+            .zip(flags_rows.chunks_exact_mut(3));
+        for (output, ((corrected, bias), flags)) in outputs.iter().zip(destinations) {
+            for (dst, src) in corrected.iter_mut().zip(output.corrected_dps) {
+                *dst = src;
+            }
+            for (dst, src) in bias.iter_mut().zip(output.bias_dps) {
+                *dst = src;
+            }
+            for (dst, src) in flags.iter_mut().zip(output.flags) {
+                *dst = src.0;
+            }
         }
     }
 }

@@ -4,35 +4,50 @@
 
 use crate::error::saturating_u8;
 use crate::interp::lerp;
-use crate::stage::ambient::AmbientPosition;
-use crate::stage::since_power_on::TimePosition;
+use crate::stage::since_power_on::{Moment, Segment};
 use crate::table::{AmbientCurves, Curve, CurvePoint};
-
-/// The curves of the two bracketing calibration ambients, blended curve by curve (stage 2), read at
-/// the current time (stage 1).
-///
-/// Curve `c` of one ambient corresponds to curve `c` of every other (same count, each ordered by
-/// rise), so a blend of two ordered sets is ordered too and stage 3 can search it.
-pub struct BlendedCurves<'a, const R: usize> {
-    lower: &'a [Curve<R>],
-    upper: &'a [Curve<R>],
-    weight: f32,
-    time: TimePosition,
-}
 
 /// One curve around the current time: its blended point at the segment's low reference time and
 /// the change from there to the high one. Kept as a change rather than as the second point
 /// because every sample needs `lo + (hi − lo) · fraction`: the subtraction is done once per
 /// segment, with the same bits.
-type Knots = [CurvePoint; 2];
+pub(crate) type Knots = [CurvePoint; 2];
+
+/// Stage 3's cache, kept per axis between samples, is the knots of the bracket's two curves for the
+/// current segment (`[lower, upper]`) and the bracket's lower curve, or this value when the rise is
+/// above the last curve (no upper curve: `k` is clamped). A sentinel rather than a flag of its own:
+/// a unit's state stays within 256 bytes.
+/// Capacities above 255 are unsupported anyway; a lower curve at 255 or beyond is cached as 254,
+/// which only makes the next search start lower.
+pub(crate) const TOP: u8 = u8::MAX;
+
+const MISSING: CurvePoint = CurvePoint {
+    rise_celsius: f32::NAN,
+    k_dps_per_celsius: f32::NAN,
+};
+
+/// The curves of the two bracketing calibration ambients, blended curve by curve (stage 2), read
+/// around the current segment's reference times (stage 1).
+///
+/// Curve `c` of one ambient corresponds to curve `c` of every other (same count, each ordered by
+/// rise), so a blend of two ordered sets is ordered too and stage 3 can search it.
+pub(crate) struct BlendedCurves<'a, const R: usize> {
+    lower: &'a [Curve<R>],
+    upper: &'a [Curve<R>],
+    weight: f32,
+    time_lo: usize,
+    time_hi: usize,
+}
 
 impl<'a, const R: usize> BlendedCurves<'a, R> {
-    /// The blend at `ambient` of `ambients`, read at `time`. Missing ambients read as no curves.
+    /// The blend of ambients `ambient_lo` and the next one by `weight` (0: `ambient_lo` alone), read
+    /// at `segment`'s reference times. Missing ambients read as no curves.
     #[inline(always)]
-    pub fn new<const C: usize>(
+    pub(crate) fn new<const C: usize>(
         ambients: &'a [AmbientCurves<R, C>],
-        ambient: &AmbientPosition,
-        time: TimePosition,
+        ambient_lo: u8,
+        weight: f32,
+        segment: &Segment,
     ) -> Self {
         let curves = |i: u8| {
             ambients
@@ -40,20 +55,23 @@ impl<'a, const R: usize> BlendedCurves<'a, R> {
                 .map_or(&[][..], |a| a.curves.as_slice())
         };
         Self {
-            lower: curves(ambient.lo),
-            upper: curves(ambient.hi),
-            weight: ambient.weight,
-            time,
+            lower: curves(ambient_lo),
+            upper: curves(ambient_lo.saturating_add(1)),
+            weight,
+            time_lo: usize::from(segment.lo),
+            time_hi: usize::from(segment.hi()),
         }
     }
 
-    /// Curve `c` blended between the two ambients (stage 2) at reference-time index `j`; NaN if
-    /// missing (only for tables that skipped validation).
+    /// Curve `c`'s blended knots around the current time; NaN where missing (only for tables that
+    /// skipped validation).
     #[inline(always)]
-    fn knot(&self, c: usize, j: usize) -> CurvePoint {
-        let at = |curves: &[Curve<R>]| curves.get(c).and_then(|curve| curve.points.get(j)).copied();
-        match at(self.lower) {
-            Some(lower) if self.weight > 0.0 => match at(self.upper) {
+    fn knots(&self, c: usize) -> Knots {
+        let points =
+            |curves: &'a [Curve<R>]| curves.get(c).map_or(&[][..], |k| k.points.as_slice());
+        let (lower, upper) = (points(self.lower), points(self.upper));
+        let blend = |j: usize| match lower.get(j) {
+            Some(lower) if self.weight > 0.0 => match upper.get(j) {
                 Some(upper) => CurvePoint {
                     rise_celsius: lerp(lower.rise_celsius, upper.rise_celsius, self.weight),
                     k_dps_per_celsius: lerp(
@@ -64,16 +82,11 @@ impl<'a, const R: usize> BlendedCurves<'a, R> {
                 },
                 None => MISSING,
             },
-            Some(lower) => lower,
+            Some(lower) => *lower,
             None => MISSING,
-        }
-    }
-
-    /// Curve `c`'s blended knots around the current time.
-    #[inline(always)]
-    fn knots(&self, c: usize) -> Knots {
-        let lo = self.knot(c, self.time.lo);
-        let hi = self.knot(c, self.time.hi);
+        };
+        let lo = blend(self.time_lo);
+        let hi = blend(self.time_hi);
         [
             lo,
             CurvePoint {
@@ -82,54 +95,91 @@ impl<'a, const R: usize> BlendedCurves<'a, R> {
             },
         ]
     }
+
+    fn count(&self) -> usize {
+        self.lower.len()
+    }
 }
 
-/// A curve's point at the current time from its knots (stage 1), the rise scaled before the first
-/// reference time: `lerp` with the change precomputed. The only place a point is made, so cached
-/// and fresh knots give the same bits.
+/// A curve's point at `moment` from its knots (stage 1): `lerp` with the change precomputed, the
+/// rise scaled before the first reference time. The only place a point is made, so cached and
+/// fresh knots give the same bits.
 #[inline(always)]
-fn at_time(time: &TimePosition, [lo, change]: Knots) -> CurvePoint {
-    let fraction = time.fraction;
+fn at_time(moment: Moment, [lo, change]: Knots) -> CurvePoint {
+    let fraction = moment.fraction;
+    let rise = lo.rise_celsius + change.rise_celsius * fraction;
     CurvePoint {
-        rise_celsius: time.rise_scale * (lo.rise_celsius + change.rise_celsius * fraction),
+        rise_celsius: if moment.before_first {
+            fraction * rise
+        } else {
+            rise
+        },
         k_dps_per_celsius: lo.k_dps_per_celsius + change.k_dps_per_celsius * fraction,
     }
 }
 
-/// The correlation `k` at `rise_celsius` for the blend at `ambient` of `ambients`, read at `time`,
+/// `k` at `rise_celsius` from the cached bracket (`knots`, `curve`), if the rise still lies in it,
 /// and whether the rise lies beyond the curves' span by more than `margin_celsius` (then the
-/// nearest curve's `k` is used: clamp).
-///
-/// The bracket is the last curve whose rise does not exceed the current one. `cache` keeps the
-/// previous sample's bracket with its two curves' knots for the current reference-time segment
-/// (the caller empties it when the segment changes):
-/// while time stays in the segment and the rise in the bracket (almost every sample), a sample
-/// costs two time interpolations, one division and no table access. Otherwise the search walks
-/// the blended curves from the cached bracket and refills the cache. The cache only saves work: a
-/// fresh or any valid cache gives the same bits.
+/// nearest curve's `k` is used: clamp). Valid only for the segment the bracket was filled in; the
+/// caller searches again when the segment changes. Almost every sample ends here: two time
+/// interpolations, one division and no table access.
 #[inline(always)]
-pub fn k_at<const R: usize, const C: usize>(
-    ambients: &[AmbientCurves<R, C>],
-    ambient: &AmbientPosition,
-    time: TimePosition,
+pub(crate) fn cached_k(
+    [lower_knots, upper_knots]: &[Knots; 2],
+    curve: u8,
+    moment: Moment,
     rise_celsius: f32,
     margin_celsius: f32,
-    cache: &mut BracketCache,
-) -> (f32, bool) {
-    if cache.valid {
-        let lower = at_time(&time, cache.knots[0]);
-        let upper = at_time(&time, cache.knots[1]);
-        let below = rise_celsius < lower.rise_celsius;
-        if (!below || cache.curve == 0) && (cache.top || rise_celsius < upper.rise_celsius) {
-            return interpolate(lower, upper, cache.top, rise_celsius, margin_celsius);
-        }
+) -> Option<(f32, bool)> {
+    let lower = at_time(moment, *lower_knots);
+    if rise_celsius < lower.rise_celsius {
+        return (curve == 0).then(|| below_first(lower, rise_celsius, margin_celsius));
     }
-    search(
-        &BlendedCurves::new(ambients, ambient, time),
-        rise_celsius,
-        margin_celsius,
-        cache,
-    )
+    if curve == TOP {
+        return Some(above_last(lower, rise_celsius, margin_celsius));
+    }
+    let upper = at_time(moment, *upper_knots);
+    (rise_celsius < upper.rise_celsius).then(|| (between(lower, upper, rise_celsius), false))
+}
+
+/// The bracket for `rise_celsius` among `curves` at `moment`: the last curve whose rise does not
+/// exceed it (the first one if none), walked to from the cached `curve` (which only saves work:
+/// any starting curve gives the same bracket). Refills the cache and returns what [`cached_k`]
+/// returns. Inlined into the caller's out-of-line miss path: one call per miss, not two.
+#[inline(always)]
+pub(crate) fn search<const R: usize>(
+    curves: &BlendedCurves<'_, R>,
+    moment: Moment,
+    rise_celsius: f32,
+    margin_celsius: f32,
+    knots: &mut [Knots; 2],
+    curve: &mut u8,
+) -> (f32, bool) {
+    let last = curves.count().saturating_sub(1);
+    let mut lo = usize::from(*curve).min(last);
+    let mut lower_knots = curves.knots(lo);
+    let mut lower = at_time(moment, lower_knots);
+    while lower.rise_celsius > rise_celsius && lo > 0 {
+        lo = lo.saturating_sub(1);
+        lower_knots = curves.knots(lo);
+        lower = at_time(moment, lower_knots);
+    }
+    let mut upper_knots = curves.knots(lo.saturating_add(1));
+    let mut upper = at_time(moment, upper_knots);
+    while lo < last && upper.rise_celsius <= rise_celsius {
+        lo = lo.saturating_add(1);
+        (lower_knots, lower) = (upper_knots, upper);
+        upper_knots = curves.knots(lo.saturating_add(1));
+        upper = at_time(moment, upper_knots);
+    }
+    let top = lo >= last;
+    *knots = [lower_knots, upper_knots];
+    *curve = if top {
+        TOP
+    } else {
+        saturating_u8(lo).min(TOP - 1)
+    };
+    interpolate(lower, upper, top, rise_celsius, margin_celsius)
 }
 
 /// `k` inside the bracket `lower`..`upper` (`top`: `lower` is the last curve, no upper), clamped
@@ -143,76 +193,33 @@ fn interpolate(
     margin_celsius: f32,
 ) -> (f32, bool) {
     if rise_celsius < lower.rise_celsius {
-        let beyond = rise_celsius < lower.rise_celsius - margin_celsius;
-        (lower.k_dps_per_celsius, beyond)
+        below_first(lower, rise_celsius, margin_celsius)
     } else if !top {
-        let fraction =
-            (rise_celsius - lower.rise_celsius) / (upper.rise_celsius - lower.rise_celsius);
-        let k = lerp(lower.k_dps_per_celsius, upper.k_dps_per_celsius, fraction);
-        (k, false)
+        (between(lower, upper, rise_celsius), false)
     } else {
-        let beyond = rise_celsius > lower.rise_celsius + margin_celsius;
-        (lower.k_dps_per_celsius, beyond)
+        above_last(lower, rise_celsius, margin_celsius)
     }
 }
 
-/// The cache-miss path of [`k_at`]: walks the blended curves from the cached bracket to the one
-/// that holds the rise, keeps its knots, and interpolates.
-#[inline(never)]
-fn search<const R: usize>(
-    curves: &BlendedCurves<'_, R>,
-    rise_celsius: f32,
-    margin_celsius: f32,
-    cache: &mut BracketCache,
-) -> (f32, bool) {
-    let time = &curves.time;
-    let count = curves.lower.len();
-    let last = count.saturating_sub(1);
-    let mut lo = usize::from(cache.curve).min(last);
-    let mut lower_knots = curves.knots(lo);
-    let mut lower = at_time(time, lower_knots);
-    while lower.rise_celsius > rise_celsius && lo > 0 {
-        lo = lo.saturating_sub(1);
-        lower_knots = curves.knots(lo);
-        lower = at_time(time, lower_knots);
-    }
-    let mut upper_knots = curves.knots(lo.saturating_add(1));
-    let mut upper = at_time(time, upper_knots);
-    while lo < last && upper.rise_celsius <= rise_celsius {
-        lo = lo.saturating_add(1);
-        (lower_knots, lower) = (upper_knots, upper);
-        upper_knots = curves.knots(lo.saturating_add(1));
-        upper = at_time(time, upper_knots);
-    }
-    let top = lo >= last;
-    *cache = BracketCache {
-        valid: true,
-        curve: saturating_u8(lo),
-        top,
-        knots: [lower_knots, upper_knots],
-    };
-    interpolate(lower, upper, top, rise_celsius, margin_celsius)
+/// Below the first curve: its `k` (clamp), and whether the rise is below it by more than the
+/// margin.
+#[inline(always)]
+fn below_first(first: CurvePoint, rise_celsius: f32, margin_celsius: f32) -> (f32, bool) {
+    let beyond = rise_celsius < first.rise_celsius - margin_celsius;
+    (first.k_dps_per_celsius, beyond)
 }
 
-const MISSING: CurvePoint = CurvePoint {
-    rise_celsius: f32::NAN,
-    k_dps_per_celsius: f32::NAN,
-};
+/// Above the last curve: its `k` (clamp), and whether the rise is above it by more than the
+/// margin.
+#[inline(always)]
+fn above_last(last: CurvePoint, rise_celsius: f32, margin_celsius: f32) -> (f32, bool) {
+    let beyond = rise_celsius > last.rise_celsius + margin_celsius;
+    (last.k_dps_per_celsius, beyond)
+}
 
-/// Stage 3's search state, kept per axis between samples: the bracketing curve and its blended
-/// knots for the current reference-time segment.
-///
-/// Belongs to the tables, ambient and reference-time segment it was filled with; `power_on` and
-/// a change of segment empty it.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BracketCache {
-    /// Whether the knots below were filled (for the current segment).
-    pub valid: bool,
-    /// Lower curve of the bracket.
-    pub curve: u8,
-    /// The lower curve is the last one (there is no upper curve; the rise is clamped above it).
-    pub top: bool,
-    /// Per curve of the bracket (`curve`, `curve + 1`): the blended point at the segment's low
-    /// reference time, and its change to the high one.
-    pub knots: [[CurvePoint; 2]; 2],
+/// `k` interpolated by rise between two curves.
+#[inline(always)]
+fn between(lower: CurvePoint, upper: CurvePoint, rise_celsius: f32) -> f32 {
+    let fraction = (rise_celsius - lower.rise_celsius) / (upper.rise_celsius - lower.rise_celsius);
+    lerp(lower.k_dps_per_celsius, upper.k_dps_per_celsius, fraction)
 }
