@@ -4,7 +4,7 @@
 use drift_recording::{Segment, SegmentLabels, RAW_PER_CELSIUS};
 
 use crate::error::FitError;
-use crate::lowpass::CentredAverages;
+use crate::lowpass::{for_each_window, Windows};
 use crate::settings::FitSettings;
 
 /// The curves of one activation, per axis, every `grid_ms` from switch-on.
@@ -56,6 +56,27 @@ fn intercept(x: &[f64], y: &[f64]) -> f64 {
     my - sxy / sxx * mx
 }
 
+/// Adds the raw temperature readings `range` of each axis to `totals` and stores the totals as f64
+/// in `sums`.
+///
+/// Integer readings add exactly in i64, and the f64 running sum of the same readings is exact too
+/// (every partial sum is an integer far below 2^53), so the totals are the f64 running sums' bits,
+/// without a conversion per reading or a chain of f64 additions.
+fn add_readings(
+    raw: &[Vec<i16>; 3],
+    range: std::ops::Range<usize>,
+    totals: &mut [i64; 3],
+    sums: &mut [f64; 3],
+) {
+    for ((readings, total), sum) in raw.iter().zip(totals.iter_mut()).zip(sums) {
+        *total += readings[range.clone()]
+            .iter()
+            .map(|&r| i64::from(r))
+            .sum::<i64>();
+        *sum = *total as f64;
+    }
+}
+
 /// Analyses one activation.
 pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, FitError> {
     let rate_hz = f64::from(segment.sample_rate_hz.max(1));
@@ -101,6 +122,7 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         });
     }
     let step = ((f64::from(settings.grid_ms) * samples_per_ms).round() as usize).max(1);
+    let window = settings.lowpass_window_samples;
     let mut out = Analysed {
         labels: segment.labels.clone(),
         grid_ms: settings.grid_ms,
@@ -110,46 +132,96 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         drift_dps: Default::default(),
         rise_celsius: Default::default(),
     };
-    // The low-passed temperature and rate of every axis, from one pass over the samples; evaluated
-    // only where they are used (the initial-bias window and the grid).
-    let [t0, t1, t2] = &segment.temperature_raw;
+    let raw = &segment.temperature_raw;
     let [r0, r1, r2] = &segment.rate_dps;
-    let samples = t0
-        .iter()
-        .zip(t1)
-        .zip(t2)
-        .zip(r0.iter().zip(r1).zip(r2))
-        .map(|(((&t0, &t1), &t2), ((&r0, &r1), &r2))| {
-            [
-                f64::from(t0),
-                f64::from(t1),
-                f64::from(t2),
-                f64::from(r0),
-                f64::from(r1),
-                f64::from(r2),
-            ]
-        });
-    let averages = CentredAverages::new(samples, settings.lowpass_window_samples);
+    let mut on_raw = [0.0; 3];
     for axis in 0..3 {
-        let raw = &segment.temperature_raw[axis];
-        let rate = &segment.rate_dps[axis];
-        let on_raw = raw[..switch_on].iter().map(|&r| f64::from(r)).sum::<f64>() / switch_on as f64;
-        out.switch_on_raw[axis] = on_raw as f32;
-        out.switch_on_celsius[axis] = on_raw / RAW_PER_CELSIUS;
-        let rise = |i: usize| (averages.at(i, axis) - on_raw) / RAW_PER_CELSIUS;
-        let rate_lf = |i: usize| averages.at(i, 3 + axis);
-        // The initial bias is where the rate would be at zero rise: the intercept of rate against
-        // rise over the first seconds, which uses thousands of samples instead of the few
-        // around t = 0.
-        let rise_head: Vec<f64> = (0..initial).map(rise).collect();
-        let raw_rate: Vec<f64> = rate[..initial].iter().map(|&r| f64::from(r)).collect();
-        let bias0 = intercept(&rise_head, &raw_rate);
-        out.initial_bias_dps[axis] = bias0;
-        out.drift_dps[axis] = (0..n)
-            .step_by(step)
-            .map(|i| (rate_lf(i) - bias0) as f32)
-            .collect();
-        out.rise_celsius[axis] = (0..n).step_by(step).map(|i| rise(i) as f32).collect();
+        on_raw[axis] = raw[axis][..switch_on]
+            .iter()
+            .map(|&r| f64::from(r))
+            .sum::<f64>()
+            / switch_on as f64;
+        out.switch_on_raw[axis] = on_raw[axis] as f32;
+        out.switch_on_celsius[axis] = on_raw[axis] / RAW_PER_CELSIUS;
     }
+    let rise = |average: f64, axis: usize| (average - on_raw[axis]) / RAW_PER_CELSIUS;
+    // The initial bias is where the rate would be at zero rise: the intercept of rate against
+    // rise over the first seconds, which uses thousands of samples instead of the few around
+    // t = 0. Its low-passed temperatures come from a short pass of their own over the first
+    // seconds, so that the grid's values are final as soon as the main pass computes them.
+    let mut rise_head: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(initial));
+    let mut totals = [0_i64; 3];
+    for_each_window(
+        &Windows::new(n, window, (initial, 1)),
+        |range, sums: &mut [f64; 3]| add_readings(raw, range, &mut totals, sums),
+        |_, sums, samples| {
+            for (axis, head) in rise_head.iter_mut().enumerate() {
+                head.push(rise(sums[axis] / samples, axis));
+            }
+        },
+    );
+    for (axis, head) in rise_head.iter().enumerate() {
+        let raw_rate: Vec<f64> = segment.rate_dps[axis][..initial]
+            .iter()
+            .map(|&r| f64::from(r))
+            .collect();
+        out.initial_bias_dps[axis] = intercept(head, &raw_rate);
+    }
+    // Every channel's low-pass on the grid, from one pass over the samples.
+    let bias = out.initial_bias_dps;
+    let windows = Windows::new(n, window, (n, step));
+    let mut window_sums: [Vec<f64>; 6] = std::array::from_fn(|_| Vec::with_capacity(windows.len()));
+    let mut counts = Vec::with_capacity(windows.len());
+    let [t0, t1, t2] = raw;
+    let mut totals = [0_i64; 3];
+    for_each_window(
+        &windows,
+        |range, sums: &mut [f64; 6]| {
+            let [mut s0, mut s1, mut s2] = [sums[3], sums[4], sums[5]];
+            let [mut i0, mut i1, mut i2] = totals;
+            // One loop over the six channels: the three chains of f64 additions (the rates)
+            // overlap, and the integer additions (see `add_readings`) hide in their latency.
+            let temperatures = t0[range.clone()]
+                .iter()
+                .zip(&t1[range.clone()])
+                .zip(&t2[range.clone()]);
+            let rates = r0[range.clone()]
+                .iter()
+                .zip(&r1[range.clone()])
+                .zip(&r2[range]);
+            for (((&a, &b), &c), ((&x, &y), &z)) in temperatures.zip(rates) {
+                i0 += i64::from(a);
+                i1 += i64::from(b);
+                i2 += i64::from(c);
+                s0 += f64::from(x);
+                s1 += f64::from(y);
+                s2 += f64::from(z);
+            }
+            totals = [i0, i1, i2];
+            *sums = [i0 as f64, i1 as f64, i2 as f64, s0, s1, s2];
+        },
+        |_, sums, samples| {
+            for (channel, sum) in window_sums.iter_mut().zip(sums) {
+                channel.push(sum);
+            }
+            counts.push(samples);
+        },
+    );
+    let [temperature_sums @ .., _, _, _] = &window_sums;
+    let [_, _, _, rate_sums @ ..] = &window_sums;
+    let drift: [Vec<f32>; 3] = std::array::from_fn(|axis| {
+        let bias = bias[axis];
+        (rate_sums[axis].iter().zip(&counts))
+            .map(|(&sum, &count)| (sum / count - bias) as f32)
+            .collect()
+    });
+    let rise_grid: [Vec<f32>; 3] = std::array::from_fn(|axis| {
+        let on_raw = on_raw[axis];
+        (temperature_sums[axis].iter().zip(&counts))
+            .map(|(&sum, &count)| ((sum / count - on_raw) / RAW_PER_CELSIUS) as f32)
+            .collect()
+    });
+    out.drift_dps = drift;
+    out.rise_celsius = rise_grid;
     Ok(out)
 }

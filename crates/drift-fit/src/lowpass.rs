@@ -22,56 +22,158 @@ pub fn centred_moving_average<T: Copy + Into<f64>>(input: &[T], window: usize) -
         .collect()
 }
 
-/// [`centred_moving_average`] of `K` channels at once, evaluated only at the indices asked for.
-///
-/// One pass keeps a running sum per channel (`K` independent additions per sample, which the CPU
-/// overlaps, instead of one dependent chain per channel); [`Self::at`] then costs one subtraction
-/// and one division. Each channel is summed in the same order and averaged with the same formula
-/// as [`centred_moving_average`], so the values are the same bits.
-#[derive(Debug, Clone)]
-pub struct CentredAverages<const K: usize> {
-    prefix: Vec<[f64; K]>,
-    half_before: usize,
-    half_after: usize,
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
 }
 
-impl<const K: usize> CentredAverages<K> {
-    /// Running sums of `samples`, each holding one value per channel.
-    pub fn new(samples: impl ExactSizeIterator<Item = [f64; K]>, window: usize) -> Self {
+/// Where [`centred_moving_average`]'s windows around the samples `(0..end).step_by(step)` start
+/// and end, so that a pass over the samples can record its running sums only there (see
+/// [`for_each_window`]).
+///
+/// Away from the ends, windows start at `i − window/2` for `i` a multiple of `step` and end a
+/// window's length later, so every boundary lies on one lattice, of spacing gcd(`step`, `window`)
+/// (10 samples for the defaults: one record per grid point instead of one per sample). Windows
+/// that reach past an end are cut there: they start at sample 0 or end at the last window's end,
+/// which are recorded too.
+#[derive(Debug, Clone, Copy)]
+pub struct Windows {
+    n: usize,
+    half_before: usize,
+    half_after: usize,
+    step: usize,
+    queries: usize,
+    spacing: usize,
+    offset: usize,
+    /// The last window's end: where the pass stops.
+    last: usize,
+    /// Records of lattice points up to `last`.
+    lattice_points: usize,
+    /// Lattice points from one window's start to the next one's, and to its end.
+    per_query: usize,
+    cells: usize,
+    /// Lattice point of the (unclamped) start of window 0, negated.
+    first: usize,
+}
+
+impl Windows {
+    /// The windows of `window` samples (the low-pass's) around `(0..end).step_by(step)` among `n`
+    /// samples (`end` is capped at `n`).
+    pub fn new(n: usize, window: usize, (end, step): (usize, usize)) -> Self {
         let half_before = window / 2;
         let half_after = window.saturating_sub(1) - half_before.min(window.saturating_sub(1));
-        let mut prefix = Vec::with_capacity(samples.len() + 1);
-        let mut sum = [0.0_f64; K];
-        prefix.push(sum);
-        prefix.extend(samples.map(|x| {
-            for (s, x) in sum.iter_mut().zip(x) {
-                *s += x;
-            }
-            sum
-        }));
+        let step = step.max(1);
+        let queries = end.min(n).div_ceil(step);
+        let spacing = gcd(step, half_before + half_after + 1);
+        let offset = (spacing - half_before % spacing) % spacing;
+        let last = match queries {
+            0 => 0,
+            q => ((q - 1) * step + half_after + 1).min(n),
+        };
+        let lattice_points = if queries == 0 || offset > last {
+            0
+        } else {
+            (last - offset) / spacing + 1
+        };
         Self {
-            prefix,
+            n,
             half_before,
             half_after,
+            step,
+            queries,
+            spacing,
+            offset,
+            last,
+            lattice_points,
+            per_query: step / spacing,
+            cells: (half_before + half_after + 1) / spacing,
+            first: (half_before + offset) / spacing,
         }
     }
 
-    /// Number of samples.
+    /// Number of windows.
     pub fn len(&self) -> usize {
-        self.prefix.len() - 1
+        self.queries
     }
 
-    /// Whether there are no samples.
+    /// Whether there are no windows.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.queries == 0
     }
 
-    /// The centred average of channel `k` around sample `i` (`i < len`, `k < K`).
+    /// Where the running sums are recorded, ascending: record `r` is the sum of the samples before
+    /// the `r`-th position. Sample 0 first, the lattice points, then the last window's end.
+    pub fn records(&self) -> impl Iterator<Item = usize> {
+        let (offset, spacing) = (self.offset, self.spacing);
+        let lattice = (0..self.lattice_points).map(move |j| offset + j * spacing);
+        std::iter::once(0)
+            .chain(lattice)
+            .chain(std::iter::once(self.last))
+    }
+
+    /// Window `q`: the records at its start and at its end, and its number of samples (as f64,
+    /// the divisor of the average).
     #[inline]
-    pub fn at(&self, i: usize, k: usize) -> f64 {
-        let lo = i.saturating_sub(self.half_before);
-        let hi = (i + self.half_after + 1).min(self.len());
-        (self.prefix[hi][k] - self.prefix[lo][k]) / (hi - lo) as f64
+    pub fn window(&self, q: usize) -> (usize, usize, f64) {
+        let i = q * self.step;
+        let start = i.saturating_sub(self.half_before);
+        let end = (i + self.half_after + 1).min(self.n);
+        // An unclamped start `q·step − half_before` is lattice point `(start − offset) / spacing`
+        // (record + 1), and its end `cells` lattice points later: computed without a division.
+        let record = (1 + q * self.per_query).wrapping_sub(self.first);
+        let from = if start == 0 { 0 } else { record };
+        let to = if end == self.last {
+            self.lattice_points + 1
+        } else {
+            record.wrapping_add(self.cells)
+        };
+        (from, to, (end - start) as f64)
+    }
+}
+
+/// One pass of [`centred_moving_average`] over `K` channels, for the windows of `windows` only:
+/// `add(range, sums)` adds samples `range` to the `K` running sums in order, and
+/// `window(q, sums, samples)` receives each window's sums as soon as its last sample is added, in
+/// order. `sums[k] / samples` is then channel `k`'s average, the same bits as
+/// [`centred_moving_average`]'s (each channel is summed in the same order, and a window's sum is
+/// the same difference of running sums).
+///
+/// The running sums are recorded only at window boundaries, never per sample: a full-length running
+/// sum of six channels (48 bytes a sample, written and read back) cost more than the additions. A
+/// window is finished (its sums and the caller's division) right after its last cell is added,
+/// where the divisions overlap the next cell's additions instead of needing a pass of their own.
+/// Inlined, so that `add` and `window` are too and the sums stay in registers.
+#[inline(always)]
+pub fn for_each_window<const K: usize>(
+    windows: &Windows,
+    mut add: impl FnMut(std::ops::Range<usize>, &mut [f64; K]),
+    mut window: impl FnMut(usize, [f64; K], f64),
+) {
+    if windows.is_empty() {
+        return;
+    }
+    let mut records: Vec<[f64; K]> = Vec::with_capacity(windows.lattice_points + 2);
+    let mut running = [0.0_f64; K];
+    let (mut added, mut next) = (0, 0);
+    for (record, position) in windows.records().enumerate() {
+        add(added..position, &mut running);
+        added = position;
+        records.push(running);
+        while next < windows.queries {
+            let (from, to, samples) = windows.window(next);
+            if to != record {
+                break;
+            }
+            let mut sums = running;
+            for (sum, start) in sums.iter_mut().zip(records[from]) {
+                *sum -= start;
+            }
+            window(next, sums, samples);
+            next += 1;
+        }
     }
 }
 
@@ -94,25 +196,81 @@ mod tests {
         assert_eq!(centred_moving_average(&[2.0_f32], 1000), vec![2.0]);
     }
 
-    #[test]
-    fn several_channels_at_chosen_indices_are_the_same_bits() {
-        let a: Vec<f32> = (0..5000)
+    /// Two channels of `n` samples, one f32-like and one integer-like.
+    fn channels(n: usize) -> (Vec<f32>, Vec<i16>) {
+        let a = (0..n)
             .map(|i| ((i * 37 % 101) as f32 - 50.0) * 0.013)
             .collect();
-        let b: Vec<i16> = (0..5000).map(|i| (6000 + i / 7) as i16).collect();
+        let b = (0..n).map(|i| (6000 + i / 7) as i16).collect();
+        (a, b)
+    }
+
+    /// Averages of both channels at `(0..end).step_by(step)`.
+    fn sparse(a: &[f32], b: &[i16], window: usize, end: usize, step: usize) -> Vec<[f64; 2]> {
+        let windows = Windows::new(a.len(), window, (end, step));
+        let (mut added, mut out) = (0, Vec::new());
+        for_each_window(
+            &windows,
+            |range, sum: &mut [f64; 2]| {
+                assert_eq!(range.start, added, "samples are added in order, each once");
+                added = range.end;
+                for (x, y) in a[range.clone()].iter().zip(&b[range]) {
+                    sum[0] += f64::from(*x);
+                    sum[1] += f64::from(*y);
+                }
+            },
+            |q, sums, samples| {
+                assert_eq!(q, out.len(), "windows come in order");
+                out.push(sums.map(|sum| sum / samples));
+            },
+        );
+        assert_eq!(out.len(), windows.len());
+        out
+    }
+
+    #[test]
+    fn several_channels_at_chosen_indices_are_the_same_bits() {
+        let (a, b) = channels(5000);
         for window in [1, 2, 999, 1000, 7000] {
-            let samples = a
-                .iter()
-                .zip(&b)
-                .map(|(&x, &y)| [f64::from(x), f64::from(y)]);
-            let both = CentredAverages::new(samples, window);
             let (wa, wb) = (
                 centred_moving_average(&a, window),
                 centred_moving_average(&b, window),
             );
-            for i in 0..a.len() {
-                assert_eq!(both.at(i, 0).to_bits(), wa[i].to_bits());
-                assert_eq!(both.at(i, 1).to_bits(), wb[i].to_bits());
+            for (end, step) in [
+                (5000, 1),
+                (5000, 10),
+                (5000, 997),
+                (4000, 1),
+                (1, 3),
+                (0, 1),
+            ] {
+                let both = sparse(&a, &b, window, end, step);
+                let at: Vec<usize> = (0..end).step_by(step).collect();
+                assert_eq!(both.len(), at.len());
+                for (&i, got) in at.iter().zip(&both) {
+                    assert_eq!(got[0].to_bits(), wa[i].to_bits());
+                    assert_eq!(got[1].to_bits(), wb[i].to_bits());
+                }
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn any_window_step_and_end_give_the_full_average_s_bits(
+            n in 1_usize..3000,
+            window in 1_usize..4000,
+            step in 1_usize..50,
+            end in 0_usize..3500,
+        ) {
+            let (a, b) = channels(n);
+            let at: Vec<usize> = (0..end.min(n)).step_by(step).collect();
+            let (wa, wb) = (centred_moving_average(&a, window), centred_moving_average(&b, window));
+            let both = sparse(&a, &b, window, end, step);
+            proptest::prop_assert_eq!(both.len(), at.len());
+            for (&i, got) in at.iter().zip(&both) {
+                proptest::prop_assert_eq!(got[0].to_bits(), wa[i].to_bits());
+                proptest::prop_assert_eq!(got[1].to_bits(), wb[i].to_bits());
             }
         }
     }
