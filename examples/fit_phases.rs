@@ -49,7 +49,9 @@ fn best<T>(repeats: usize, mut run: impl FnMut() -> T) -> ((f64, f64), T) {
 
 fn main() -> Result<()> {
     let mut args = std::env::args().skip(1);
-    let folder = args.next().context("usage: fit_phases <campaign folder> [repeats]")?;
+    let folder = args
+        .next()
+        .context("usage: fit_phases <campaign folder> [repeats]")?;
     let repeats: usize = args.next().map_or(Ok(5), |r| r.parse())?;
     let only = args.next();
     let run = |phase: &str| only.as_deref().is_none_or(|o| o == phase);
@@ -96,8 +98,18 @@ fn main() -> Result<()> {
             let total = segments
                 .iter()
                 .map(|s| {
-                    let t: i64 = s.temperature_raw.iter().flatten().map(|&r| i64::from(r)).sum();
-                    let r: u64 = s.rate_dps.iter().flatten().map(|&r| u64::from(r.to_bits())).sum();
+                    let t: i64 = s
+                        .temperature_raw
+                        .iter()
+                        .flatten()
+                        .map(|&r| i64::from(r))
+                        .sum();
+                    let r: u64 = s
+                        .rate_dps
+                        .iter()
+                        .flatten()
+                        .map(|&r| u64::from(r.to_bits()))
+                        .sum();
                     t.wrapping_add(r as i64)
                 })
                 .fold(0_i64, i64::wrapping_add);

@@ -5,6 +5,7 @@ use drift_core::{PolynomialAxis, PolynomialTables, Settings, MAX_POLYNOMIAL_COEF
 use nalgebra::{DMatrix, DVector};
 
 use crate::analyse::Analysed;
+use crate::parallel::per_axis;
 
 /// The normalised variable `x = (T − mid) / half_span` over a temperature range.
 #[derive(Debug, Clone, Copy)]
@@ -152,7 +153,7 @@ fn solve(xs: &[f64], ys: &[f64], degree: usize) -> Vec<f64> {
 /// The paper's "standard" calibration: per set point one calibration point (mean sensor temperature,
 /// mean bias over its activations), and the Lagrange polynomial through them (degree = points − 1).
 pub fn standard(by_set_point: &[Vec<&Analysed>], settings: Settings) -> PolynomialTables {
-    let axes = [0, 1, 2].map(|axis| {
+    let axes = per_axis(|axis| {
         let all: Vec<&Analysed> = by_set_point.iter().flatten().copied().collect();
         let range = range_of(&all, axis);
         let points: Vec<(f64, f64)> = by_set_point
@@ -189,7 +190,7 @@ pub fn least_squares(
     degree: usize,
     settings: Settings,
 ) -> PolynomialTables {
-    let axes = [0, 1, 2].map(|axis| {
+    let axes = per_axis(|axis| {
         let range = range_of(activations, axis);
         let normalise = Normalise::over(range);
         let mut equations = NormalEquations::new(degree.min(MAX_POLYNOMIAL_COEFFICIENTS - 1));

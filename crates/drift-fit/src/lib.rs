@@ -18,6 +18,7 @@ pub mod fit;
 pub mod knots;
 pub mod lowpass;
 pub mod measured;
+pub mod parallel;
 pub mod pipeline;
 pub mod settings;
 pub mod summary;
