@@ -4,8 +4,8 @@
 use drift_recording::{Segment, SegmentLabels, RAW_PER_CELSIUS};
 
 use crate::error::FitError;
-use crate::lowpass::{for_each_window, Windows};
 use crate::settings::FitSettings;
+use crate::windows::Windows;
 
 /// The curves of one activation, per axis, every `grid_ms` from switch-on.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,36 +45,90 @@ impl Analysed {
 }
 
 /// Ordinary least-squares intercept of `y` against `x`.
-fn intercept(x: &[f64], y: &[f64]) -> f64 {
+///
+/// The four sums in two loops of two (independent chains that overlap), each accumulated in the
+/// data's order from −0.0 as `Iterator::sum` does.
+fn intercept(x: &[f64], y: &[f32]) -> f64 {
     let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    let (mut sx, mut sy) = (-0.0_f64, -0.0_f64);
+    for (&a, &b) in x.iter().zip(y) {
+        sx += a;
+        sy += f64::from(b);
+    }
+    let (mx, my) = (sx / n, sy / n);
+    let (mut sxx, mut sxy) = (-0.0_f64, -0.0_f64);
+    for (&a, &b) in x.iter().zip(y) {
+        sxx += (a - mx).powi(2);
+        sxy += (a - mx) * (f64::from(b) - my);
+    }
     if sxx <= f64::EPSILON {
         return my;
     }
-    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
     my - sxy / sxx * mx
 }
 
-/// Adds the raw temperature readings `range` of each axis to `totals` and stores the totals as f64
-/// in `sums`.
+/// The running sums of the raw temperatures of every axis at `windows`' records.
 ///
 /// Integer readings add exactly in i64, and the f64 running sum of the same readings is exact too
 /// (every partial sum is an integer far below 2^53), so the totals are the f64 running sums' bits,
 /// without a conversion per reading or a chain of f64 additions.
-fn add_readings(
-    raw: &[Vec<i16>; 3],
-    range: std::ops::Range<usize>,
-    totals: &mut [i64; 3],
-    sums: &mut [f64; 3],
-) {
-    for ((readings, total), sum) in raw.iter().zip(totals.iter_mut()).zip(sums) {
-        *total += readings[range.clone()]
-            .iter()
-            .map(|&r| i64::from(r))
-            .sum::<i64>();
-        *sum = *total as f64;
+fn temperature_records(raw: &[Vec<i16>; 3], windows: &Windows) -> [Vec<f64>; 3] {
+    let mut records: [Vec<f64>; 3] =
+        std::array::from_fn(|_| Vec::with_capacity(windows.record_count()));
+    let mut totals = [0_i64; 3];
+    let mut added = 0;
+    for position in windows.records() {
+        for (total, readings) in totals.iter_mut().zip(raw) {
+            *total += readings[added..position]
+                .iter()
+                .map(|&r| i64::from(r))
+                .sum::<i64>();
+        }
+        added = position;
+        for (record, &total) in records.iter_mut().zip(&totals) {
+            record.push(total as f64);
+        }
     }
+    records
+}
+
+/// The running sums of every channel (raw temperatures, then rates, per axis) at `windows'`
+/// records, from one pass over the samples.
+fn running_sums(segment: &Segment, windows: &Windows) -> [Vec<f64>; 6] {
+    let [t0, t1, t2] = &segment.temperature_raw;
+    let [r0, r1, r2] = &segment.rate_dps;
+    let mut records: [Vec<f64>; 6] =
+        std::array::from_fn(|_| Vec::with_capacity(windows.record_count()));
+    let [mut i0, mut i1, mut i2] = [0_i64; 3];
+    let [mut s0, mut s1, mut s2] = [0.0_f64; 3];
+    let mut added = 0;
+    for position in windows.records() {
+        let range = added..position;
+        // One loop over the six channels: the three chains of f64 additions (the rates) overlap,
+        // and the integer additions (exact, see `temperature_records`) hide in their latency.
+        let temperatures = t0[range.clone()]
+            .iter()
+            .zip(&t1[range.clone()])
+            .zip(&t2[range.clone()]);
+        let rates = r0[range.clone()]
+            .iter()
+            .zip(&r1[range.clone()])
+            .zip(&r2[range]);
+        for (((&a, &b), &c), ((&x, &y), &z)) in temperatures.zip(rates) {
+            i0 += i64::from(a);
+            i1 += i64::from(b);
+            i2 += i64::from(c);
+            s0 += f64::from(x);
+            s1 += f64::from(y);
+            s2 += f64::from(z);
+        }
+        added = position;
+        let sums = [i0 as f64, i1 as f64, i2 as f64, s0, s1, s2];
+        for (record, sum) in records.iter_mut().zip(sums) {
+            record.push(sum);
+        }
+    }
+    records
 }
 
 /// Analyses one activation.
@@ -133,7 +187,6 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         rise_celsius: Default::default(),
     };
     let raw = &segment.temperature_raw;
-    let [r0, r1, r2] = &segment.rate_dps;
     let mut on_raw = [0.0; 3];
     for axis in 0..3 {
         on_raw[axis] = raw[axis][..switch_on]
@@ -144,84 +197,25 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         out.switch_on_raw[axis] = on_raw[axis] as f32;
         out.switch_on_celsius[axis] = on_raw[axis] / RAW_PER_CELSIUS;
     }
-    let rise = |average: f64, axis: usize| (average - on_raw[axis]) / RAW_PER_CELSIUS;
     // The initial bias is where the rate would be at zero rise: the intercept of rate against
     // rise over the first seconds, which uses thousands of samples instead of the few around
-    // t = 0. Its low-passed temperatures come from a short pass of their own over the first
-    // seconds, so that the grid's values are final as soon as the main pass computes them.
-    let mut rise_head: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(initial));
-    let mut totals = [0_i64; 3];
-    for_each_window(
-        &Windows::new(n, window, (initial, 1)),
-        |range, sums: &mut [f64; 3]| add_readings(raw, range, &mut totals, sums),
-        |_, sums, samples| {
-            for (axis, head) in rise_head.iter_mut().enumerate() {
-                head.push(rise(sums[axis] / samples, axis));
-            }
-        },
-    );
-    for (axis, head) in rise_head.iter().enumerate() {
-        let raw_rate: Vec<f64> = segment.rate_dps[axis][..initial]
-            .iter()
-            .map(|&r| f64::from(r))
-            .collect();
-        out.initial_bias_dps[axis] = intercept(head, &raw_rate);
+    // t = 0. Its low-passed temperatures (every sample's) come from a short pass of their own.
+    let head = Windows::new(n, window, (initial, 1));
+    let records = temperature_records(raw, &head);
+    for axis in 0..3 {
+        let on_raw = on_raw[axis];
+        let rise_head = head.averages(&records[axis], move |t| (t - on_raw) / RAW_PER_CELSIUS);
+        out.initial_bias_dps[axis] = intercept(&rise_head, &segment.rate_dps[axis][..initial]);
     }
     // Every channel's low-pass on the grid, from one pass over the samples.
-    let bias = out.initial_bias_dps;
-    let windows = Windows::new(n, window, (n, step));
-    let mut window_sums: [Vec<f64>; 6] = std::array::from_fn(|_| Vec::with_capacity(windows.len()));
-    let mut counts = Vec::with_capacity(windows.len());
-    let [t0, t1, t2] = raw;
-    let mut totals = [0_i64; 3];
-    for_each_window(
-        &windows,
-        |range, sums: &mut [f64; 6]| {
-            let [mut s0, mut s1, mut s2] = [sums[3], sums[4], sums[5]];
-            let [mut i0, mut i1, mut i2] = totals;
-            // One loop over the six channels: the three chains of f64 additions (the rates)
-            // overlap, and the integer additions (see `add_readings`) hide in their latency.
-            let temperatures = t0[range.clone()]
-                .iter()
-                .zip(&t1[range.clone()])
-                .zip(&t2[range.clone()]);
-            let rates = r0[range.clone()]
-                .iter()
-                .zip(&r1[range.clone()])
-                .zip(&r2[range]);
-            for (((&a, &b), &c), ((&x, &y), &z)) in temperatures.zip(rates) {
-                i0 += i64::from(a);
-                i1 += i64::from(b);
-                i2 += i64::from(c);
-                s0 += f64::from(x);
-                s1 += f64::from(y);
-                s2 += f64::from(z);
-            }
-            totals = [i0, i1, i2];
-            *sums = [i0 as f64, i1 as f64, i2 as f64, s0, s1, s2];
-        },
-        |_, sums, samples| {
-            for (channel, sum) in window_sums.iter_mut().zip(sums) {
-                channel.push(sum);
-            }
-            counts.push(samples);
-        },
-    );
-    let [temperature_sums @ .., _, _, _] = &window_sums;
-    let [_, _, _, rate_sums @ ..] = &window_sums;
-    let drift: [Vec<f32>; 3] = std::array::from_fn(|axis| {
-        let bias = bias[axis];
-        (rate_sums[axis].iter().zip(&counts))
-            .map(|(&sum, &count)| (sum / count - bias) as f32)
-            .collect()
-    });
-    let rise_grid: [Vec<f32>; 3] = std::array::from_fn(|axis| {
-        let on_raw = on_raw[axis];
-        (temperature_sums[axis].iter().zip(&counts))
-            .map(|(&sum, &count)| ((sum / count - on_raw) / RAW_PER_CELSIUS) as f32)
-            .collect()
-    });
-    out.drift_dps = drift;
-    out.rise_celsius = rise_grid;
+    let grid = Windows::new(n, window, (n, step));
+    let records = running_sums(segment, &grid);
+    for axis in 0..3 {
+        let (on_raw, bias) = (on_raw[axis], out.initial_bias_dps[axis]);
+        out.rise_celsius[axis] = grid.averages(&records[axis], move |t| {
+            ((t - on_raw) / RAW_PER_CELSIUS) as f32
+        });
+        out.drift_dps[axis] = grid.averages(&records[3 + axis], move |rate| (rate - bias) as f32);
+    }
     Ok(out)
 }

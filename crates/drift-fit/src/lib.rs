@@ -22,6 +22,7 @@ pub mod parallel;
 pub mod pipeline;
 pub mod settings;
 pub mod summary;
+pub mod windows;
 
 pub use error::FitError;
 pub use fit::{fit_unit, FittedUnit};
