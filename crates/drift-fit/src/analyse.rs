@@ -4,8 +4,8 @@
 use drift_recording::{Segment, SegmentLabels, RAW_PER_CELSIUS};
 
 use crate::error::FitError;
-use crate::lowpass::CentredAverages;
 use crate::settings::FitSettings;
+use crate::windows::Windows;
 
 /// The curves of one activation, per axis, every `grid_ms` from switch-on.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,15 +45,90 @@ impl Analysed {
 }
 
 /// Ordinary least-squares intercept of `y` against `x`.
-fn intercept(x: &[f64], y: &[f64]) -> f64 {
+///
+/// The four sums in two loops of two (independent chains that overlap), each accumulated in the
+/// data's order from −0.0 as `Iterator::sum` does.
+fn intercept(x: &[f64], y: &[f32]) -> f64 {
     let n = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    let (mut sx, mut sy) = (-0.0_f64, -0.0_f64);
+    for (&a, &b) in x.iter().zip(y) {
+        sx += a;
+        sy += f64::from(b);
+    }
+    let (mx, my) = (sx / n, sy / n);
+    let (mut sxx, mut sxy) = (-0.0_f64, -0.0_f64);
+    for (&a, &b) in x.iter().zip(y) {
+        sxx += (a - mx).powi(2);
+        sxy += (a - mx) * (f64::from(b) - my);
+    }
     if sxx <= f64::EPSILON {
         return my;
     }
-    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
     my - sxy / sxx * mx
+}
+
+/// The running sums of the raw temperatures of every axis at `windows`' records.
+///
+/// Integer readings add exactly in i64, and the f64 running sum of the same readings is exact too
+/// (every partial sum is an integer far below 2^53), so the totals are the f64 running sums' bits,
+/// without a conversion per reading or a chain of f64 additions.
+fn temperature_records(raw: &[Vec<i16>; 3], windows: &Windows) -> [Vec<f64>; 3] {
+    let mut records: [Vec<f64>; 3] =
+        std::array::from_fn(|_| Vec::with_capacity(windows.record_count()));
+    let mut totals = [0_i64; 3];
+    let mut added = 0;
+    for position in windows.records() {
+        for (total, readings) in totals.iter_mut().zip(raw) {
+            *total += readings[added..position]
+                .iter()
+                .map(|&r| i64::from(r))
+                .sum::<i64>();
+        }
+        added = position;
+        for (record, &total) in records.iter_mut().zip(&totals) {
+            record.push(total as f64);
+        }
+    }
+    records
+}
+
+/// The running sums of every channel (raw temperatures, then rates, per axis) at `windows'`
+/// records, from one pass over the samples.
+fn running_sums(segment: &Segment, windows: &Windows) -> [Vec<f64>; 6] {
+    let [t0, t1, t2] = &segment.temperature_raw;
+    let [r0, r1, r2] = &segment.rate_dps;
+    let mut records: [Vec<f64>; 6] =
+        std::array::from_fn(|_| Vec::with_capacity(windows.record_count()));
+    let [mut i0, mut i1, mut i2] = [0_i64; 3];
+    let [mut s0, mut s1, mut s2] = [0.0_f64; 3];
+    let mut added = 0;
+    for position in windows.records() {
+        let range = added..position;
+        // One loop over the six channels: the three chains of f64 additions (the rates) overlap,
+        // and the integer additions (exact, see `temperature_records`) hide in their latency.
+        let temperatures = t0[range.clone()]
+            .iter()
+            .zip(&t1[range.clone()])
+            .zip(&t2[range.clone()]);
+        let rates = r0[range.clone()]
+            .iter()
+            .zip(&r1[range.clone()])
+            .zip(&r2[range]);
+        for (((&a, &b), &c), ((&x, &y), &z)) in temperatures.zip(rates) {
+            i0 += i64::from(a);
+            i1 += i64::from(b);
+            i2 += i64::from(c);
+            s0 += f64::from(x);
+            s1 += f64::from(y);
+            s2 += f64::from(z);
+        }
+        added = position;
+        let sums = [i0 as f64, i1 as f64, i2 as f64, s0, s1, s2];
+        for (record, sum) in records.iter_mut().zip(sums) {
+            record.push(sum);
+        }
+    }
+    records
 }
 
 /// Analyses one activation.
@@ -101,6 +176,7 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         });
     }
     let step = ((f64::from(settings.grid_ms) * samples_per_ms).round() as usize).max(1);
+    let window = settings.lowpass_window_samples;
     let mut out = Analysed {
         labels: segment.labels.clone(),
         grid_ms: settings.grid_ms,
@@ -110,46 +186,36 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         drift_dps: Default::default(),
         rise_celsius: Default::default(),
     };
-    // The low-passed temperature and rate of every axis, from one pass over the samples; evaluated
-    // only where they are used (the initial-bias window and the grid).
-    let [t0, t1, t2] = &segment.temperature_raw;
-    let [r0, r1, r2] = &segment.rate_dps;
-    let samples = t0
-        .iter()
-        .zip(t1)
-        .zip(t2)
-        .zip(r0.iter().zip(r1).zip(r2))
-        .map(|(((&t0, &t1), &t2), ((&r0, &r1), &r2))| {
-            [
-                f64::from(t0),
-                f64::from(t1),
-                f64::from(t2),
-                f64::from(r0),
-                f64::from(r1),
-                f64::from(r2),
-            ]
-        });
-    let averages = CentredAverages::new(samples, settings.lowpass_window_samples);
+    let raw = &segment.temperature_raw;
+    let mut on_raw = [0.0; 3];
     for axis in 0..3 {
-        let raw = &segment.temperature_raw[axis];
-        let rate = &segment.rate_dps[axis];
-        let on_raw = raw[..switch_on].iter().map(|&r| f64::from(r)).sum::<f64>() / switch_on as f64;
-        out.switch_on_raw[axis] = on_raw as f32;
-        out.switch_on_celsius[axis] = on_raw / RAW_PER_CELSIUS;
-        let rise = |i: usize| (averages.at(i, axis) - on_raw) / RAW_PER_CELSIUS;
-        let rate_lf = |i: usize| averages.at(i, 3 + axis);
-        // The initial bias is where the rate would be at zero rise: the intercept of rate against
-        // rise over the first seconds, which uses thousands of samples instead of the few
-        // around t = 0.
-        let rise_head: Vec<f64> = (0..initial).map(rise).collect();
-        let raw_rate: Vec<f64> = rate[..initial].iter().map(|&r| f64::from(r)).collect();
-        let bias0 = intercept(&rise_head, &raw_rate);
-        out.initial_bias_dps[axis] = bias0;
-        out.drift_dps[axis] = (0..n)
-            .step_by(step)
-            .map(|i| (rate_lf(i) - bias0) as f32)
-            .collect();
-        out.rise_celsius[axis] = (0..n).step_by(step).map(|i| rise(i) as f32).collect();
+        on_raw[axis] = raw[axis][..switch_on]
+            .iter()
+            .map(|&r| f64::from(r))
+            .sum::<f64>()
+            / switch_on as f64;
+        out.switch_on_raw[axis] = on_raw[axis] as f32;
+        out.switch_on_celsius[axis] = on_raw[axis] / RAW_PER_CELSIUS;
+    }
+    // The initial bias is where the rate would be at zero rise: the intercept of rate against
+    // rise over the first seconds, which uses thousands of samples instead of the few around
+    // t = 0. Its low-passed temperatures (every sample's) come from a short pass of their own.
+    let head = Windows::new(n, window, (initial, 1));
+    let records = temperature_records(raw, &head);
+    for axis in 0..3 {
+        let on_raw = on_raw[axis];
+        let rise_head = head.averages(&records[axis], move |t| (t - on_raw) / RAW_PER_CELSIUS);
+        out.initial_bias_dps[axis] = intercept(&rise_head, &segment.rate_dps[axis][..initial]);
+    }
+    // Every channel's low-pass on the grid, from one pass over the samples.
+    let grid = Windows::new(n, window, (n, step));
+    let records = running_sums(segment, &grid);
+    for axis in 0..3 {
+        let (on_raw, bias) = (on_raw[axis], out.initial_bias_dps[axis]);
+        out.rise_celsius[axis] = grid.averages(&records[axis], move |t| {
+            ((t - on_raw) / RAW_PER_CELSIUS) as f32
+        });
+        out.drift_dps[axis] = grid.averages(&records[3 + axis], move |rate| (rate - bias) as f32);
     }
     Ok(out)
 }

@@ -110,20 +110,33 @@ fn mean_of(members: &[&Analysed], value: impl Fn(&Analysed) -> [f64; 3]) -> [f64
     sum.map(|s| s / members.len().max(1) as f64)
 }
 
+/// Mean over `members` of the first `len` values of `pick(member)`, member after member.
+///
+/// Accumulated row by row (each member's values added to the running sums in one contiguous pass)
+/// rather than point by point across members: the same additions in the same order per point —
+/// from −0.0, as `Iterator::sum` starts — so the same bits, without striding through every
+/// member's array for each point.
+fn mean(members: &[&Analysed], len: usize, pick: impl Fn(&Analysed) -> &[f32]) -> Vec<f64> {
+    let mut sums = vec![-0.0_f64; len];
+    for member in members {
+        for (sum, &value) in sums.iter_mut().zip(&pick(member)[..len]) {
+            *sum += f64::from(value);
+        }
+    }
+    let count = members.len() as f64;
+    for sum in &mut sums {
+        *sum /= count;
+    }
+    sums
+}
+
 fn average(key: CurveKey, members: &[&Analysed]) -> AveragedCurve {
     let len = members.iter().map(|m| m.len()).min().unwrap_or(0);
-    let mean = |pick: &dyn Fn(&Analysed) -> &Vec<f32>| -> Vec<f64> {
-        (0..len)
-            .map(|i| {
-                members.iter().map(|m| f64::from(pick(m)[i])).sum::<f64>() / members.len() as f64
-            })
-            .collect()
-    };
     AveragedCurve {
         key,
         members: members.len(),
-        drift_dps: [0, 1, 2].map(|axis| mean(&|m| &m.drift_dps[axis])),
-        rise_celsius: [0, 1, 2].map(|axis| mean(&|m| &m.rise_celsius[axis])),
+        drift_dps: [0, 1, 2].map(|axis| mean(members, len, |m| &m.drift_dps[axis])),
+        rise_celsius: [0, 1, 2].map(|axis| mean(members, len, |m| &m.rise_celsius[axis])),
     }
 }
 

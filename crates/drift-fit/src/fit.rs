@@ -11,12 +11,14 @@ use crate::baselines;
 use crate::curves::{group, CurveKey, SetPointCurves};
 use crate::error::FitError;
 use crate::knots::{choose, k_window, mean_window};
+use crate::parallel::per_axis;
 use crate::settings::FitSettings;
 
 /// Capacities of the host table type (`ModifiedTables`'s defaults).
 const MAX_REFERENCES: usize = 16;
 const MAX_AMBIENTS: usize = 12;
 const MAX_CURVES: usize = 32;
+type Table = AxisTable<MAX_REFERENCES, MAX_AMBIENTS, MAX_CURVES>;
 /// Smallest temperature rise (°C) that counts as heating: ten raw sensor steps.
 const MIN_RISE_CELSIUS: f64 = 0.05;
 
@@ -90,6 +92,83 @@ fn strictly_increasing(values: &mut [f32]) -> usize {
     nudged
 }
 
+/// The paper's table of one axis (reference times, then per set point the curves' rise and `k`
+/// there, sorted by rise) and the notes it leaves; the error says why there is none.
+///
+/// Boxed: the table (~50 KB) crosses rayon's join, whose frames hold its result, and rayon's
+/// worker threads have 2 MiB stacks.
+fn axis_table(
+    set_points: &[SetPointCurves],
+    axis: usize,
+    first: usize,
+    settings: &FitSettings,
+) -> Result<(Box<Table>, Vec<String>), String> {
+    let window = settings.reference_window_points;
+    let mut table = Box::<Table>::default();
+    let mut notes = Vec::new();
+    let knots = choose(set_points, axis, first, settings.reference_count, window);
+    for &j in &knots {
+        let _ = table.reference_ms.push(j as u32 * settings.grid_ms);
+    }
+    let mut last_ambient = f32::NEG_INFINITY;
+    for sp in set_points {
+        let mut ambient = AmbientCurves {
+            ambient_celsius: sp.ambient_celsius[axis] as f32,
+            initial_bias_dps: sp.initial_bias_dps[axis] as f32,
+            curves: heapless::Vec::new(),
+        };
+        if ambient.ambient_celsius <= last_ambient {
+            return Err(format!(
+                "axis {axis}: switch-on temperature at {} °C ({:.3} °C) is not above the previous set point's",
+                sp.set_point_celsius, ambient.ambient_celsius
+            ));
+        }
+        last_ambient = ambient.ambient_celsius;
+        // Points per reference time, then sorted by rise there (stage 3 needs them ordered).
+        let mut columns: Vec<Vec<(f32, f32)>> = knots
+            .iter()
+            .map(|&j| {
+                sp.curves
+                    .iter()
+                    .map(|c| {
+                        (
+                            mean_window(&c.rise_celsius[axis], j, window) as f32,
+                            k_window(&c.drift_dps[axis], &c.rise_celsius[axis], j, window) as f32,
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        for (j, column) in columns.iter_mut().enumerate() {
+            column.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut rises: Vec<f32> = column.iter().map(|p| p.0).collect();
+            let nudged = strictly_increasing(&mut rises);
+            if nudged > 0 {
+                notes.push(format!(
+                    "axis {axis}, {} °C, reference {j}: {nudged} tied rises nudged",
+                    sp.set_point_celsius
+                ));
+            }
+            for (point, rise) in column.iter_mut().zip(rises) {
+                point.0 = rise;
+            }
+        }
+        for c in 0..sp.curves.len() {
+            let mut curve = Curve::default();
+            for column in &columns {
+                let (rise, k) = column[c];
+                let _ = curve.points.push(CurvePoint {
+                    rise_celsius: rise,
+                    k_dps_per_celsius: k,
+                });
+            }
+            let _ = ambient.curves.push(curve);
+        }
+        let _ = table.ambients.push(ambient);
+    }
+    Ok((table, notes))
+}
+
 /// Fits one unit from its analysed activations (calibration set points only: the caller keeps the
 /// validation data out).
 pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<FittedUnit, FitError> {
@@ -161,7 +240,6 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
             settings.first_reference_s
         )));
     }
-    let window = settings.reference_window_points;
     // Without heating there is nothing to correlate the drift with: say so instead of fitting k = 0.
     for axis in 0..3 {
         let heated = set_points.iter().flat_map(|sp| sp.curves.iter()).any(|c| {
@@ -176,82 +254,6 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
             )));
         }
     }
-    let mut axes: [AxisTable<MAX_REFERENCES, MAX_AMBIENTS, MAX_CURVES>; 3] = Default::default();
-    for (axis, table) in axes.iter_mut().enumerate() {
-        let knots = choose(&set_points, axis, first, settings.reference_count, window);
-        for &j in &knots {
-            let _ = table.reference_ms.push(j as u32 * grid_ms);
-        }
-        let mut last_ambient = f32::NEG_INFINITY;
-        for sp in &set_points {
-            let mut ambient = AmbientCurves {
-                ambient_celsius: sp.ambient_celsius[axis] as f32,
-                initial_bias_dps: sp.initial_bias_dps[axis] as f32,
-                curves: heapless::Vec::new(),
-            };
-            if ambient.ambient_celsius <= last_ambient {
-                return Err(insufficient(format!(
-                    "axis {axis}: switch-on temperature at {} °C ({:.3} °C) is not above the previous set point's",
-                    sp.set_point_celsius, ambient.ambient_celsius
-                )));
-            }
-            last_ambient = ambient.ambient_celsius;
-            // Points per reference time, then sorted by rise there (stage 3 needs them ordered).
-            let mut columns: Vec<Vec<(f32, f32)>> = knots
-                .iter()
-                .map(|&j| {
-                    sp.curves
-                        .iter()
-                        .map(|c| {
-                            (
-                                mean_window(&c.rise_celsius[axis], j, window) as f32,
-                                k_window(&c.drift_dps[axis], &c.rise_celsius[axis], j, window)
-                                    as f32,
-                            )
-                        })
-                        .collect()
-                })
-                .collect();
-            for (j, column) in columns.iter_mut().enumerate() {
-                column.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let mut rises: Vec<f32> = column.iter().map(|p| p.0).collect();
-                let nudged = strictly_increasing(&mut rises);
-                if nudged > 0 {
-                    notes.push(format!(
-                        "axis {axis}, {} °C, reference {j}: {nudged} tied rises nudged",
-                        sp.set_point_celsius
-                    ));
-                }
-                for (point, rise) in column.iter_mut().zip(rises) {
-                    point.0 = rise;
-                }
-            }
-            for c in 0..sp.curves.len() {
-                let mut curve = Curve::default();
-                for column in &columns {
-                    let (rise, k) = column[c];
-                    let _ = curve.points.push(CurvePoint {
-                        rise_celsius: rise,
-                        k_dps_per_celsius: k,
-                    });
-                }
-                let _ = ambient.curves.push(curve);
-            }
-            let _ = table.ambients.push(ambient);
-        }
-    }
-    let core_settings = Settings::default();
-    let modified = ModifiedTables {
-        settings: core_settings,
-        axes,
-        extension: drift_core::Extension::NONE,
-    };
-    modified.validate().map_err(|source| FitError::Table {
-        unit: unit_id.clone(),
-        model: "modified",
-        source,
-    })?;
-
     let protocol: Vec<&Analysed> = activations
         .iter()
         .filter(|a| CurveKey::of(a, settings).is_some())
@@ -266,9 +268,34 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
                 .collect()
         })
         .collect();
-    let standard = baselines::standard(&by_set_point, core_settings);
-    let third_order =
-        baselines::least_squares(&protocol, settings.polynomial_degree, core_settings);
+    let core_settings = Settings::default();
+    // The axes' tables and the baselines are independent: all on rayon's threads at once.
+    let (tables, (standard, third_order)) = rayon::join(
+        || per_axis(|axis| axis_table(&set_points, axis, first, settings)),
+        || {
+            rayon::join(
+                || baselines::standard(&by_set_point, core_settings),
+                || baselines::least_squares(&protocol, settings.polynomial_degree, core_settings),
+            )
+        },
+    );
+    let mut axes: [Table; 3] = Default::default();
+    for (table, fitted) in axes.iter_mut().zip(tables) {
+        let (fitted, axis_notes) = fitted.map_err(insufficient)?;
+        *table = *fitted;
+        notes.extend(axis_notes);
+    }
+    let modified = ModifiedTables {
+        settings: core_settings,
+        axes,
+        extension: drift_core::Extension::NONE,
+    };
+    modified.validate().map_err(|source| FitError::Table {
+        unit: unit_id.clone(),
+        model: "modified",
+        source,
+    })?;
+
     for (model, tables) in [("standard", &standard), ("third_order", &third_order)] {
         tables.validate().map_err(|source| FitError::Table {
             unit: unit_id.clone(),

@@ -21,10 +21,12 @@ pub mod fit;
 pub mod knots;
 pub mod lowpass;
 pub mod measured;
+pub mod parallel;
 pub mod pipeline;
 pub mod roles;
 pub mod settings;
 pub mod summary;
+pub mod windows;
 
 pub use error::FitError;
 pub use fit::{fit_unit, FittedUnit};
