@@ -138,7 +138,7 @@ def test_saving_channels_the_format_does_not_store(tmp_path: Path) -> None:
     for name, reason in [
         ("gps/fix", "auxiliary channel `gps/fix` has `/` at byte 3"),
         ("", "an empty auxiliary channel name"),
-        ("accel", "would be recorded on /aux/accel"),
+        ("accel", "auxiliary channel `accel` would be recorded on /aux/accel, the accelerometer's topic"),
     ]:
         named = gyrodrift.Segment(LABELS, RATE, RAW, aux={**format_aux(N), name: (np.zeros(100), "deg", 100)})
         with pytest.raises(InputError, match=f"segments\\[0\\]: {re.escape(reason)}"):
