@@ -146,7 +146,7 @@ impl<S: Copy + Default> CorrectorState<S> {
             };
             let (initial_bias, mut activation) =
                 axis.power_on(settings, settings.celsius(raw), &mut state.model);
-            if initial_bias.is_finite() {
+            if plausible(initial_bias) {
                 state.initial_bias_dps = initial_bias;
             } else {
                 activation |= Flags::MODEL_INVALID;
@@ -254,7 +254,7 @@ impl<S: Copy + Default> CorrectorState<S> {
             {
                 // A non-finite term value makes the sum non-finite (even times a zero
                 // coefficient), so this one check covers every term.
-                if extra.is_finite() {
+                if plausible(extra) {
                     state.extension_dps = extra;
                 } else {
                     *flags |= Flags::EXTENSION_INPUT_INVALID;
@@ -280,6 +280,21 @@ fn not_powered_on(sample: &Sample) -> Output {
         *flags = Flags::NOT_POWERED_ON | rate_flag(rate);
     }
     output
+}
+
+/// The largest drift, initial bias or extra-term contribution (°/s) the corrector believes; a
+/// larger one (an extreme but finite temperature or auxiliary reading, corrupt tables) is treated
+/// like a non-finite one: flagged and the last good value held. No gyro's range comes near it, and
+/// it keeps `rate − bias` finite for every finite rate: the spacing of f32 near `f32::MAX` is
+/// 2·10³¹, so a bias of a few 10⁴ °/s cannot carry a rate over it (finding F3,
+/// docs/reliability.md).
+pub const MAX_PLAUSIBLE_DRIFT_DPS: f32 = 1.0e4;
+
+/// Finite and within [`MAX_PLAUSIBLE_DRIFT_DPS`]: the same two instructions as `is_finite`
+/// (NaN compares false).
+#[inline(always)]
+pub(crate) fn plausible(dps: f32) -> bool {
+    dps.abs() <= MAX_PLAUSIBLE_DRIFT_DPS
 }
 
 #[inline(always)]
@@ -380,7 +395,7 @@ fn read_axis<S>(
 #[inline(always)]
 fn hold_drift<S>(state: &mut AxisState<S>, reading: &mut Reading, drift: f32, model_flags: Flags) {
     reading.flags |= model_flags;
-    if drift.is_finite() {
+    if plausible(drift) {
         state.bias_dps = state.initial_bias_dps + drift;
     } else {
         reading.flags |= Flags::MODEL_INVALID;

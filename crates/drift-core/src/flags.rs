@@ -35,10 +35,12 @@ impl Flags {
     pub const RATE_INVALID: Self = Self(1 << 6);
     /// `correct` was called before a successful `power_on`: the rate passes through uncorrected.
     pub const NOT_POWERED_ON: Self = Self(1 << 7);
-    /// The model produced a non-finite drift (for example from an extreme but finite input); the last
-    /// good drift estimate is held.
+    /// The model produced a non-finite or implausible drift or initial bias (beyond
+    /// [`MAX_PLAUSIBLE_DRIFT_DPS`](crate::MAX_PLAUSIBLE_DRIFT_DPS), for example from a temperature
+    /// reading far outside any sensor's range): the last good drift estimate is held.
     pub const MODEL_INVALID: Self = Self(1 << 8);
-    /// Extended model: an auxiliary input an extra term reads is NaN, infinite or was not passed:
+    /// Extended model: an auxiliary input an extra term reads is NaN, infinite or was not passed, or
+    /// the terms' contribution is beyond [`MAX_PLAUSIBLE_DRIFT_DPS`](crate::MAX_PLAUSIBLE_DRIFT_DPS):
     /// the extra terms' last good contribution is held. (Temperature faults hold the temperature
     /// the terms read, under the flags above.)
     pub const EXTENSION_INPUT_INVALID: Self = Self(1 << 9);

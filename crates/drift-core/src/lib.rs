@@ -30,7 +30,9 @@ mod settings;
 mod stage;
 mod table;
 
-pub use corrector::{AxisState, Corrector, CorrectorState, Output, Sample};
+pub use corrector::{
+    AxisState, Corrector, CorrectorState, Output, Sample, MAX_PLAUSIBLE_DRIFT_DPS,
+};
 pub use error::{Error, Location, Problem};
 pub use extension::{
     Extension, ExtensionState, ExtraTerm, Term, TermInputs, TermValues, AUX_INPUTS, MAX_TERMS,

@@ -212,3 +212,37 @@ fn hours_of_operation_keep_integer_time() {
     assert_eq!(at_end.bias_dps, after_hours.bias_dps);
     assert!(after_hours.flags[0].contains(Flags::PAST_LAST_REFERENCE));
 }
+
+/// Finding F3: a temperature reading far outside any sensor (finite, so not `TEMPERATURE_INVALID`)
+/// made the bias ~1e33 °/s, and `rate − bias` overflowed for rates near `f32::MAX` with only clamp
+/// flags set. Such a drift is now implausible: flagged `MODEL_INVALID` and the last good one held,
+/// in the per-sample and the block path alike.
+#[test]
+fn an_absurd_temperature_reading_is_flagged_and_never_overflows_the_output() {
+    let model = fixture::modified();
+    let mut per_sample = Corrector::new(&model).unwrap();
+    per_sample.power_on([6600.0; 3]).unwrap();
+    let good = per_sample.correct(&sample(30_000, 2.0));
+    let mut block = per_sample.clone();
+    let mut inputs = Vec::new();
+    for (i, raw) in [1.0e20_f32, -1.0e20, 3.0e38, -3.0e38]
+        .into_iter()
+        .enumerate()
+    {
+        let mut s = sample(31_000 + i as u32, 2.5);
+        s.temperature_raw[0] = raw;
+        s.rate_dps[0] = if i % 2 == 0 { f32::MAX } else { -f32::MAX };
+        inputs.push(s);
+    }
+    let mut from_block = vec![drift_core::Output::default(); inputs.len()];
+    block.correct_block(&inputs, &mut from_block);
+    for (s, blocked) in inputs.iter().zip(&from_block) {
+        let out = per_sample.correct(s);
+        assert!(out.flags[0].contains(Flags::MODEL_INVALID), "{out:?}");
+        assert_eq!(out.bias_dps[0], good.bias_dps[0], "held bias");
+        assert!(out.corrected_dps[0].is_finite(), "{out:?}");
+        assert_eq!(out, *blocked, "block path");
+        // The other axes are corrected normally.
+        assert!(!out.flags[1].contains(Flags::MODEL_INVALID));
+    }
+}

@@ -133,12 +133,14 @@ fn check_axis(sample: &Sample, out: &drift_core::Output, axis: usize, powered: b
         "non-finite bias: {}",
         context()
     );
-    // Finding F3 (docs/reliability.md, for drift-core): `rate − bias` overflows to ±∞ when the
-    // rate is within a bias of f32::MAX (≥ 3.38e38 °/s, 10³⁶ × any gyro's range) and a temperature
-    // reading far outside any sensor's range makes the bias ~1e33; only clamp flags are set then.
-    // Everything below that rate must hold the invariant.
-    let overflow = rate.is_finite() && rate.abs() > f32::MAX / 2.0;
-    if !out.corrected_dps[axis].is_finite() && !overflow {
+    // Finding F3 (docs/reliability.md) is fixed: drift-core refuses a bias beyond
+    // MAX_PLAUSIBLE_DRIFT_DPS, so `rate − bias` is finite for every finite rate, up to f32::MAX.
+    assert!(
+        out.bias_dps[axis].abs() <= 3.0 * drift_core::MAX_PLAUSIBLE_DRIFT_DPS,
+        "implausible bias: {}",
+        context()
+    );
+    if !out.corrected_dps[axis].is_finite() {
         assert!(
             flags.intersects(Flags::RATE_INVALID | Flags::NOT_POWERED_ON),
             "non-finite output without a flag that says so: {}",

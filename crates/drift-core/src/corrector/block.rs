@@ -250,8 +250,8 @@ fn finish<S>(state: &mut AxisState<S>, lane: &mut Lane, count: usize) {
         .zip(held.zip(answers))
     {
         // Branch-free, so the loop vectorises: a healthy reading takes the model's flags and,
-        // for a non-finite drift, MODEL_INVALID.
-        let finite = drift.is_finite();
+        // for an implausible (or non-finite) drift, MODEL_INVALID.
+        let finite = super::plausible(drift);
         let answered = if finite {
             model_flags
         } else {

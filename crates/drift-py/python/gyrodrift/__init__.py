@@ -118,7 +118,8 @@ class Flags(enum.IntFlag):
     NOT_POWERED_ON = _gyrodrift.NOT_POWERED_ON
     """No successful power_on: rate passed through uncorrected."""
     MODEL_INVALID = _gyrodrift.MODEL_INVALID
-    """The tables produced a non-finite drift (corrupt tables only): last good drift held."""
+    """The tables produced a non-finite or implausible drift (beyond 1e4 deg/s: corrupt tables, or a
+    temperature reading far outside any sensor): last good drift held."""
     EXTENSION_INPUT_INVALID = _gyrodrift.EXTENSION_INPUT_INVALID
     """Extended model: an auxiliary input an extra term reads is NaN/inf or was not passed
     (`aux=None`): the extra terms' last good contribution held."""
