@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 mod campaign_args;
+pub mod check;
 pub mod demo;
 pub mod diagnose;
 mod extend;
@@ -33,6 +34,8 @@ pub enum Command {
     Fit(fit::Args),
     /// Fit, evaluate on data the fit did not see, and write the report.
     Report(report::Args),
+    /// Check a unit's stored tables on new recordings: is the calibration still valid?
+    Check(check::Args),
     /// Rank what explains the residual the paper's model leaves.
     Diagnose(diagnose::Args),
     /// Convert measured data (CSV) into a recording the other commands read.
@@ -46,6 +49,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Simulate(args) => simulate::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Report(args) => report::run(&args),
+        Command::Check(args) => check::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
         Command::Import(args) => import::run(&args),
     }

@@ -11,6 +11,7 @@ pub mod absorb;
 pub mod analyse;
 pub mod baselines;
 pub mod candidates;
+pub mod check;
 pub mod closing;
 pub mod curves;
 pub mod diagnose;

@@ -1,0 +1,175 @@
+//! `gyrodrift check`: a unit's stored tables pass on its own recordings, fail on another unit's or
+//! against tight limits (exit status 1, the report still written), and missing tables are named.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn gyrodrift(args: &[&str]) -> (Output, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
+        .args(args)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out, text)
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn verdicts(json: &Path) -> Vec<(String, bool)> {
+    let value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    value["units"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|unit| {
+            let id = unit["unit_id"].as_str().unwrap().to_owned();
+            unit["axes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(move |axis| (id.clone(), axis["failures"].as_array().unwrap().is_empty()))
+        })
+        .collect()
+}
+
+#[test]
+fn stored_tables_pass_on_their_unit_and_fail_on_another() {
+    let dir = tempfile::tempdir().unwrap();
+    let campaign = dir.path().join("campaign");
+    let (out, text) = gyrodrift(&[
+        "simulate",
+        "-q",
+        "-o",
+        path(&campaign),
+        "--units",
+        "2",
+        "--set-points",
+        "30,40",
+        "--intervals",
+        "1,30",
+        "--repeats",
+        "2",
+        "--seed",
+        "5",
+    ]);
+    assert!(out.status.success(), "{text}");
+    let tables = dir.path().join("tables");
+    let (out, text) = gyrodrift(&["fit", path(&campaign), "-q", "-o", path(&tables)]);
+    assert!(out.status.success(), "{text}");
+
+    // Each unit's own tables on its own recordings.
+    let report = dir.path().join("check");
+    let (out, text) = gyrodrift(&[
+        "check",
+        path(&campaign),
+        "--tables",
+        path(&tables),
+        "-q",
+        "-o",
+        path(&report),
+    ]);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("| GIU-02 | Z | 40 |"), "{text}");
+    let own = verdicts(&report.join("check.json"));
+    assert_eq!(own.len(), 6);
+    assert!(own.iter().all(|(_, passed)| *passed), "{own:?}");
+
+    // The same, with a drift limit no unit can meet: exit status 1, report written, axes named.
+    let tight = dir.path().join("tight");
+    let (out, text) = gyrodrift(&[
+        "check",
+        path(&campaign),
+        "--tables",
+        path(&tables),
+        "--max-drift",
+        "0.0001",
+        "-q",
+        "-o",
+        path(&tight),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("misses the limits on 6 of 6 unit × axis: GIU-01 X, GIU-01 Y"),
+        "{text}"
+    );
+    let md = std::fs::read_to_string(tight.join("check.md")).unwrap();
+    assert!(md.contains("**fail**: drift left"), "{md}");
+
+    // GIU-01's tables flashed into GIU-02: GIU-02 fails, GIU-01 still passes.
+    let swapped = dir.path().join("swapped");
+    for unit in ["GIU-01", "GIU-02"] {
+        std::fs::create_dir_all(swapped.join(unit)).unwrap();
+        std::fs::copy(
+            tables.join("GIU-01/modified.bin"),
+            swapped.join(unit).join("modified.bin"),
+        )
+        .unwrap();
+    }
+    let wrong = dir.path().join("wrong");
+    let (out, text) = gyrodrift(&[
+        "check",
+        path(&campaign),
+        "--tables",
+        path(&swapped),
+        "-q",
+        "-o",
+        path(&wrong),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(text.contains(": GIU-02 "), "{text}");
+    let swapped_verdicts = verdicts(&wrong.join("check.json"));
+    let failed = |unit: &str| {
+        swapped_verdicts
+            .iter()
+            .filter(|(u, passed)| u == unit && !passed)
+            .count()
+    };
+    // Units differ most in their offsets and temperature coefficients; at least two of GIU-02's
+    // axes are far off with GIU-01's tables (seed 5: RMS 0.18 and 0.25 °/s on Y and Z).
+    assert_eq!(failed("GIU-01"), 0, "{swapped_verdicts:?}");
+    assert!(failed("GIU-02") >= 2, "{swapped_verdicts:?}");
+
+    // A unit without stored tables: the error names the file it looked for; nothing written.
+    std::fs::remove_dir_all(swapped.join("GIU-02")).unwrap();
+    let missing = dir.path().join("missing");
+    let (out, text) = gyrodrift(&[
+        "check",
+        path(&campaign),
+        "--tables",
+        path(&swapped),
+        "-q",
+        "-o",
+        path(&missing),
+    ]);
+    assert!(!out.status.success());
+    assert!(text.contains("GIU-02/modified.bin"), "{text}");
+    assert!(!missing.exists());
+
+    // The baselines are checked the same way (the standard one removes less: a looser limit).
+    let standard = dir.path().join("standard");
+    let (out, text) = gyrodrift(&[
+        "check",
+        path(&campaign),
+        "--tables",
+        path(&tables),
+        "--model",
+        "standard",
+        "--max-drift",
+        "1",
+        "--max-rms",
+        "1",
+        "--min-removed",
+        "0",
+        "-q",
+        "-o",
+        path(&standard),
+    ]);
+    assert!(out.status.success(), "{text}");
+}
