@@ -2,23 +2,33 @@
 //! against tight limits (exit status 1, the report still written), and missing tables are named.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn gyrodrift(args: &[&str]) -> (Output, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
-        .args(args)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    (out, text)
-}
+mod common;
+
+use common::{gyrodrift, ok};
 
 fn path(p: &Path) -> &str {
     p.to_str().unwrap()
+}
+
+/// `gyrodrift check <campaign> --tables <tables> -q -o <out> <extra…>`.
+fn check(
+    campaign: &Path,
+    tables: &Path,
+    out: &Path,
+    extra: &[&str],
+) -> (std::process::Output, String) {
+    let mut args = vec![
+        "check",
+        path(campaign),
+        "--tables",
+        path(tables),
+        "-q",
+        "-o",
+        path(out),
+    ];
+    args.extend_from_slice(extra);
+    gyrodrift(&args)
 }
 
 fn verdicts(json: &Path) -> Vec<(String, bool)> {
@@ -43,7 +53,7 @@ fn verdicts(json: &Path) -> Vec<(String, bool)> {
 fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     let dir = tempfile::tempdir().unwrap();
     let campaign = dir.path().join("campaign");
-    let (out, text) = gyrodrift(&[
+    ok(&[
         "simulate",
         "-q",
         "-o",
@@ -59,22 +69,12 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
         "--seed",
         "5",
     ]);
-    assert!(out.status.success(), "{text}");
     let tables = dir.path().join("tables");
-    let (out, text) = gyrodrift(&["fit", path(&campaign), "-q", "-o", path(&tables)]);
-    assert!(out.status.success(), "{text}");
+    ok(&["fit", path(&campaign), "-q", "-o", path(&tables)]);
 
     // Each unit's own tables on its own recordings.
     let report = dir.path().join("check");
-    let (out, text) = gyrodrift(&[
-        "check",
-        path(&campaign),
-        "--tables",
-        path(&tables),
-        "-q",
-        "-o",
-        path(&report),
-    ]);
+    let (out, text) = check(&campaign, &tables, &report, &[]);
     assert!(out.status.success(), "{text}");
     assert!(text.contains("| GIU-02 | Z | 40 |"), "{text}");
     let own = verdicts(&report.join("check.json"));
@@ -83,17 +83,7 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
 
     // The same, with a drift limit no unit can meet: exit status 1, report written, axes named.
     let tight = dir.path().join("tight");
-    let (out, text) = gyrodrift(&[
-        "check",
-        path(&campaign),
-        "--tables",
-        path(&tables),
-        "--max-drift",
-        "0.0001",
-        "-q",
-        "-o",
-        path(&tight),
-    ]);
+    let (out, text) = check(&campaign, &tables, &tight, &["--max-drift", "0.0001"]);
     assert_eq!(out.status.code(), Some(1), "{text}");
     assert!(
         text.contains("misses the limits on 6 of 6 unit × axis: GIU-01 X, GIU-01 Y"),
@@ -113,15 +103,7 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
         .unwrap();
     }
     let wrong = dir.path().join("wrong");
-    let (out, text) = gyrodrift(&[
-        "check",
-        path(&campaign),
-        "--tables",
-        path(&swapped),
-        "-q",
-        "-o",
-        path(&wrong),
-    ]);
+    let (out, text) = check(&campaign, &swapped, &wrong, &[]);
     assert_eq!(out.status.code(), Some(1), "{text}");
     assert!(text.contains(": GIU-02 "), "{text}");
     let swapped_verdicts = verdicts(&wrong.join("check.json"));
@@ -139,26 +121,14 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     // A unit without stored tables: the error names the file it looked for; nothing written.
     std::fs::remove_dir_all(swapped.join("GIU-02")).unwrap();
     let missing = dir.path().join("missing");
-    let (out, text) = gyrodrift(&[
-        "check",
-        path(&campaign),
-        "--tables",
-        path(&swapped),
-        "-q",
-        "-o",
-        path(&missing),
-    ]);
+    let (out, text) = check(&campaign, &swapped, &missing, &[]);
     assert!(!out.status.success());
     assert!(text.contains("GIU-02/modified.bin"), "{text}");
     assert!(!missing.exists());
 
     // The baselines are checked the same way (the standard one removes less: a looser limit).
     let standard = dir.path().join("standard");
-    let (out, text) = gyrodrift(&[
-        "check",
-        path(&campaign),
-        "--tables",
-        path(&tables),
+    let loose = [
         "--model",
         "standard",
         "--max-drift",
@@ -167,9 +137,7 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
         "1",
         "--min-removed",
         "0",
-        "-q",
-        "-o",
-        path(&standard),
-    ]);
+    ];
+    let (out, text) = check(&campaign, &tables, &standard, &loose);
     assert!(out.status.success(), "{text}");
 }

@@ -5,28 +5,12 @@
 //! of `../shared/data/measured/` when it is present.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use drift_recording::{read_campaign_dir, read_recording, RAW_PER_CELSIUS};
 
-fn gyrodrift(args: &[&str]) -> (Output, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
-        .args(args)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    (out, text)
-}
+mod common;
 
-fn ok(args: &[&str]) -> String {
-    let (out, text) = gyrodrift(args);
-    assert!(out.status.success(), "{args:?}: {text}");
-    text
-}
+use common::{gyrodrift, ok};
 
 fn fails(args: &[&str]) -> String {
     let (out, text) = gyrodrift(args);

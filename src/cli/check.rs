@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use drift_core::blob::{decode, Image};
-use drift_core::{Model, ModifiedTables, PolynomialTables, Term};
+use drift_core::{Model, ModifiedTables, PolynomialTables};
 use drift_fit::check::{AxisVerdict, CheckedActivation, Limits, UnitCheck};
 use drift_fit::{pipeline, FitSettings};
 use drift_recording::read_recording;
@@ -91,28 +91,11 @@ fn load<M: Image>(path: &Path) -> anyhow::Result<M> {
     decode(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
-fn refuse_auxiliary_terms(tables: &ModifiedTables, path: &Path) -> anyhow::Result<()> {
-    if let Some(term) = tables
-        .extension
-        .terms
-        .iter()
-        .find(|t| matches!(t.term, Term::Aux { .. }))
-    {
-        bail!(
-            "{}: the extended model reads an auxiliary input ({:?}); `check` cannot tell which recorded channel the firmware passes as that input",
-            path.display(),
-            term.term
-        );
-    }
-    Ok(())
-}
-
 /// Checks every activation of every recording against the unit's stored `M`.
 fn check_all<M: Model + Image>(
     args: &Args,
     files: &[PathBuf],
     settings: &FitSettings,
-    prepare: &dyn Fn(&M, &Path) -> anyhow::Result<()>,
     steps: &Steps,
 ) -> anyhow::Result<Vec<UnitResult>> {
     let mut units: BTreeMap<String, (PathBuf, UnitCheck<M>)> = BTreeMap::new();
@@ -129,8 +112,9 @@ fn check_all<M: Model + Image>(
             Entry::Vacant(entry) => {
                 let image = args.tables.join(unit).join(args.model.file_name());
                 let model: M = load(&image)?;
-                prepare(&model, &image)?;
-                entry.insert((image, UnitCheck::new(unit, model, settings)))
+                let check = UnitCheck::new(unit, model, settings)
+                    .with_context(|| image.display().to_string())?;
+                entry.insert((image, check))
             }
         };
         for segment in &recording.segments {
@@ -193,11 +177,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let settings = load_settings(args.settings.as_deref())?;
     let steps = Steps::new(args.quiet);
     let results = match args.model {
-        Stored::Modified => {
-            check_all::<ModifiedTables>(args, &files, &settings, &refuse_auxiliary_terms, &steps)?
-        }
+        Stored::Modified => check_all::<ModifiedTables>(args, &files, &settings, &steps)?,
         Stored::Standard | Stored::ThirdOrder => {
-            check_all::<PolynomialTables>(args, &files, &settings, &|_, _| Ok(()), &steps)?
+            check_all::<PolynomialTables>(args, &files, &settings, &steps)?
         }
     };
     steps.finish();

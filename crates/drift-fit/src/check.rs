@@ -8,7 +8,7 @@
 //! One pass, recording by recording: [`UnitCheck::add`] corrects one activation and keeps only its
 //! figures, so a long campaign is checked in the memory of one recording.
 
-use drift_core::{Flags, Model};
+use drift_core::{Flags, Model, Term};
 use drift_recording::{Segment, SegmentLabels};
 
 use crate::evaluate::{correct_segment, metric, switch_on_raw};
@@ -109,16 +109,34 @@ pub struct UnitCheck<M: Model> {
     activations: Vec<CheckedActivation>,
 }
 
+/// A model the check cannot run: its extended model reads an auxiliary input, and neither the
+/// model nor the recording says which recorded channel the firmware passes as that input.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("the extended model reads auxiliary input {input}; a stored model does not say which recorded channel the firmware passes as that input, so it cannot be checked on recordings")]
+pub struct ReadsAuxiliaryInput {
+    /// The input's index.
+    pub input: u8,
+}
+
 impl<M: Model> UnitCheck<M> {
     /// A check of `unit_id` against `model` (the tables the unit carries). `settings` gives the
     /// switch-on window and the low-pass, as the fit used them.
-    pub fn new(unit_id: &str, model: M, settings: &FitSettings) -> Self {
-        Self {
+    pub fn new(
+        unit_id: &str,
+        model: M,
+        settings: &FitSettings,
+    ) -> Result<Self, ReadsAuxiliaryInput> {
+        for term in &model.extension().terms {
+            if let Term::Aux { input } = term.term {
+                return Err(ReadsAuxiliaryInput { input });
+            }
+        }
+        Ok(Self {
             unit_id: unit_id.to_owned(),
             model,
             settings: settings.clone(),
             activations: Vec::new(),
-        }
+        })
     }
 
     /// The unit checked.

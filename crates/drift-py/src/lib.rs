@@ -8,6 +8,7 @@
 mod analysed;
 mod args;
 mod arrays;
+mod check;
 mod corrector;
 mod diagnosis;
 mod errors;

@@ -162,6 +162,24 @@ macro_rules! model_class {
                 format!("<{} {}>", $name, self.0.summary())
             }
 
+            /// Is this stored calibration still valid? Corrects every activation of `source`
+            /// (one unit's recordings or segments, held static) as the firmware would; one
+            /// record per axis against the limits (`gyrodrift check` on the command line; the
+            /// defaults are `drift_fit::check::Limits::default()`, which a test compares).
+            #[pyo3(signature = (source, *, max_drift = 0.005, max_rms = 0.02, min_removed = 0.5, settings = None))]
+            fn check<'py>(
+                &self,
+                py: Python<'py>,
+                source: &Bound<'py, PyAny>,
+                max_drift: f64,
+                max_rms: f64,
+                min_removed: f64,
+                settings: Option<&Bound<'py, PyAny>>,
+            ) -> PyResult<Bound<'py, PyAny>> {
+                let limits = crate::check::limits(max_drift, max_rms, min_removed)?;
+                crate::check::check(py, &self.0, source, &limits, settings)
+            }
+
             $($methods)*
         }
     };

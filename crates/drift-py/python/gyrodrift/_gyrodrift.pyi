@@ -199,6 +199,26 @@ class ModifiedTables:
         """The settings stored with the tables."""
     def with_settings(self, settings: Settings) -> ModifiedTables:
         """The same tables with other settings (validated; `self` is unchanged)."""
+    def check(
+        self,
+        source: _Source,
+        *,
+        max_drift: float = 0.005,
+        max_rms: float = 0.02,
+        min_removed: float = 0.5,
+        settings: FitSettings | None = None,
+    ) -> list[_Record]:
+        """Is this stored calibration still valid? (`gyrodrift check` on the command line.)
+
+        Corrects every activation of `source` (one unit's recordings or segments, the unit held
+        static) as the firmware would, and returns one record per axis: `unit_id`, `axis`,
+        `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
+        `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
+        `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`, `faulty` (activation
+        counts) and `failures` (why the axis misses a limit). Limits: mean drift left ≤
+        `max_drift` °/s, residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
+        Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
+        model that reads an auxiliary input), `FileError` or `RecordingError`."""
     @property
     def extension(self) -> tuple[ExtraTerm, ...]:
         """The extended model's extra terms, in model order; empty for the paper's model."""
@@ -282,6 +302,26 @@ class PolynomialTables:
         """The settings stored with the tables."""
     def with_settings(self, settings: Settings) -> PolynomialTables:
         """The same tables with other settings (validated; `self` is unchanged)."""
+    def check(
+        self,
+        source: _Source,
+        *,
+        max_drift: float = 0.005,
+        max_rms: float = 0.02,
+        min_removed: float = 0.5,
+        settings: FitSettings | None = None,
+    ) -> list[_Record]:
+        """Is this stored calibration still valid? (`gyrodrift check` on the command line.)
+
+        Corrects every activation of `source` (one unit's recordings or segments, the unit held
+        static) as the firmware would, and returns one record per axis: `unit_id`, `axis`,
+        `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
+        `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
+        `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`, `faulty` (activation
+        counts) and `failures` (why the axis misses a limit). Limits: mean drift left ≤
+        `max_drift` °/s, residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
+        Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
+        model that reads an auxiliary input), `FileError` or `RecordingError`."""
     def __eq__(self, other: object, /) -> bool: ...
 
 @final

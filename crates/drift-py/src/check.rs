@@ -1,0 +1,113 @@
+//! `ModifiedTables.check` / `PolynomialTables.check`: the command line's `gyrodrift check` for one
+//! unit's model, on recordings or segments, as records (drift-fit's `check` does the work).
+
+use std::sync::Arc;
+
+use drift_core::Model;
+use drift_fit::check::{Limits, UnitCheck};
+use drift_fit::FitSettings;
+use drift_recording::{read_recording, Segment};
+use pyo3::prelude::*;
+
+use crate::errors::Error;
+use crate::fit_settings;
+use crate::sources::{self, Source};
+
+/// A limit: a finite number ≥ 0.
+fn limit(name: &str, value: f64) -> Result<f64, Error> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::Input(format!(
+            "`{name}` must be a finite number ≥ 0, got {value}"
+        )))
+    }
+}
+
+/// The limits from the keyword arguments.
+pub fn limits(max_drift: f64, max_rms: f64, min_removed: f64) -> Result<Limits, Error> {
+    Ok(Limits {
+        max_drift_dps: limit("max_drift", max_drift)?,
+        max_residual_rms_dps: limit("max_rms", max_rms)?,
+        min_removed: limit("min_removed", min_removed)?,
+    })
+}
+
+/// Corrects every activation of `source` (one unit's) with `model`; one record per axis.
+pub fn check<'py, M: Model + Clone + Send + Sync>(
+    py: Python<'py>,
+    model: &Arc<M>,
+    source: &Bound<'py, PyAny>,
+    limits: &Limits,
+    settings: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let settings: FitSettings = fit_settings::or_default(settings)?;
+    let source = sources::source(py, "source", source)?;
+    let model = Arc::clone(model);
+    let records = py.detach(|| -> Result<String, Error> {
+        let mut unit: Option<UnitCheck<M>> = None;
+        let mut add = |segment: &Segment| -> Result<(), Error> {
+            let id = &segment.labels.unit_id;
+            let check = match &mut unit {
+                Some(check) => check,
+                None => unit.insert(
+                    UnitCheck::new(id, (*model).clone(), &settings)
+                        .map_err(|e| Error::Input(e.to_string()))?,
+                ),
+            };
+            if check.unit_id() != id {
+                return Err(Error::Input(format!(
+                    "`source` must hold one unit's activations (a model is one unit's), got `{}` and `{id}`",
+                    check.unit_id()
+                )));
+            }
+            check.add(segment);
+            Ok(())
+        };
+        match &source {
+            Source::Files(files) => {
+                for path in files {
+                    for segment in &read_recording(path)?.segments {
+                        add(segment)?;
+                    }
+                }
+            }
+            Source::Segments(segments) => {
+                for segment in segments {
+                    add(segment)?;
+                }
+            }
+        }
+        let Some(unit) = unit else {
+            return Err(Error::Input(
+                "`source` holds no activations to check".to_owned(),
+            ));
+        };
+        let records: Vec<serde_json::Value> = unit
+            .verdicts(limits)
+            .iter()
+            .map(|v| {
+                let axis = ["X", "Y", "Z"].get(v.axis).copied().unwrap_or("?");
+                serde_json::json!({
+                    "unit_id": unit.unit_id(),
+                    "axis": axis,
+                    "passed": v.passed(),
+                    "activations": v.activations,
+                    "uncorrected_drift_dps": v.uncorrected_drift_dps,
+                    "corrected_drift_dps": v.corrected_drift_dps,
+                    "worst_drift_dps": v.worst_drift_dps,
+                    "removed": v.removed,
+                    "residual_rms_dps": v.residual_rms_dps,
+                    "ambient_out_of_range": v.ambient_out_of_range,
+                    "rise_out_of_span": v.rise_out_of_span,
+                    "past_last_reference": v.past_last_reference,
+                    "faulty": v.faulty,
+                    "failures": v.failures,
+                })
+            })
+            .collect();
+        serde_json::to_string(&records)
+            .map_err(|e| Error::Input(format!("internal: check records JSON: {e}")))
+    })?;
+    py.import("json")?.call_method1("loads", (records,))
+}
