@@ -6,17 +6,9 @@
 //! absorb of each, [`crate::absorb`]) and on the activations being diagnosed, so a kind is defined
 //! once, by what it computes, not by where it is used.
 
-use drift_core::{Extension, ExtensionState, ExtraTerm, Term, TermInputs};
 use drift_recording::{Segment, RAW_PER_CELSIUS};
 
-use crate::evaluate::sample_at;
 use crate::lowpass::centred_moving_average;
-
-/// Time constants of the temperature-rate candidates, ms: a ×4 grid over the thermal time
-/// constants of a small package, seconds to minutes. The element a MEMS gyro's bias follows is
-/// heated through the ASIC whose temperature the unit measures, so its rate is the measured
-/// temperature's rate through a lag the fitter does not know: the diagnosis scores each.
-pub const RATE_TIME_CONSTANTS_MS: [u32; 4] = [2_000, 8_000, 32_000, 128_000];
 
 const AXES: [&str; 3] = ["X", "Y", "Z"];
 
@@ -28,10 +20,9 @@ pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
 pub enum Kind {
     /// A recorded auxiliary channel, the same for every axis.
     Aux(String),
-    /// The axis's own temperature rate, °C/s, through a first-order low-pass of this time
-    /// constant (ms): `d/dt` of the low-passed temperature, computed by drift-core's
-    /// [`ExtensionState`] on the last good readings exactly as the firmware's rate term is.
-    TemperatureRate(u32),
+    /// The axis's own temperature rate, °C/s: central difference over ±1 s of the 1-s low-passed
+    /// temperature.
+    TemperatureRate,
     /// The axis's own temperature rise since switch-on, squared, °C².
     RiseSquared,
     /// Another axis's rise since switch-on, °C: the axis `offset` (1 or 2) places further on.
@@ -51,8 +42,8 @@ impl Kind {
     /// Every kind a segment with these auxiliary channels offers.
     pub fn all(aux_channels: impl IntoIterator<Item = String>, has_set_point: bool) -> Vec<Self> {
         let mut kinds: Vec<Self> = aux_channels.into_iter().map(Self::Aux).collect();
-        kinds.extend(RATE_TIME_CONSTANTS_MS.map(Self::TemperatureRate));
         kinds.extend([
+            Self::TemperatureRate,
             Self::RiseSquared,
             Self::OtherAxisRise(1),
             Self::OtherAxisRise(2),
@@ -71,9 +62,7 @@ impl Kind {
         let own = AXES.get(axis).copied().unwrap_or("?");
         match self {
             Self::Aux(channel) => format!("aux:{channel}"),
-            Self::TemperatureRate(tau_ms) => {
-                format!("temperature rate {own} (τ {} s)", tau_ms / 1000)
-            }
+            Self::TemperatureRate => format!("temperature rate {own}"),
             Self::RiseSquared => format!("rise² {own}"),
             Self::OtherAxisRise(offset) => format!("rise {}", AXES[(axis + offset) % 3]),
             Self::SinceSwitchOn => "time since switch-on".into(),
@@ -117,7 +106,20 @@ impl Kind {
                         .collect(),
                 )
             }
-            Self::TemperatureRate(tau_ms) => Some(filtered_rates(segment, switch_on, *tau_ms)),
+            Self::TemperatureRate => per_axis(&|axis| {
+                let rise = rise(axis);
+                let half = (rate_hz as usize).max(1);
+                (0..n)
+                    .map(|i| {
+                        let (lo, hi) = (i.saturating_sub(half), (i + half).min(n - 1));
+                        if hi > lo {
+                            ((rise[hi] - rise[lo]) * rate_hz / (hi - lo) as f64) as f32
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect()
+            }),
             Self::RiseSquared => {
                 per_axis(&|axis| rise(axis).into_iter().map(|r| (r * r) as f32).collect())
             }
@@ -143,40 +145,4 @@ impl Kind {
             }
         }
     }
-}
-
-/// The temperature rate of every axis of `segment`, °C/s, through drift-core's rate filter of time
-/// constant `tau_ms`, on the last good reading of each axis (held through a missing one) as the
-/// corrector passes it: the firmware's term values, uncentred.
-pub fn filtered_rates(segment: &Segment, switch_on: [f32; 3], tau_ms: u32) -> [Vec<f32>; 3] {
-    let mut extension = Extension::NONE;
-    let _ = extension.terms.push(ExtraTerm {
-        term: Term::TemperatureRate {
-            time_constant_ms: tau_ms,
-        },
-        centre: [0.0; 3],
-        coefficient: [0.0; 3],
-    });
-    let celsius_per_raw = 1.0 / RAW_PER_CELSIUS as f32;
-    let mut state = ExtensionState::power_on();
-    let mut held = switch_on;
-    let mut rates: [Vec<f32>; 3] = std::array::from_fn(|_| Vec::with_capacity(segment.len()));
-    for i in 0..segment.len() {
-        let sample = sample_at(segment, i);
-        for (held, raw) in held.iter_mut().zip(sample.temperature_raw) {
-            if raw.is_finite() {
-                *held = raw;
-            }
-        }
-        let inputs = TermInputs {
-            since_power_on_ms: sample.since_power_on_ms,
-            rise_celsius: [0, 1, 2].map(|a| (held[a] - switch_on[a]) * celsius_per_raw),
-            ..TermInputs::default()
-        };
-        let values = state.values(&extension, &inputs);
-        for (rates, values) in rates.iter_mut().zip(values) {
-            rates.push(values[0]);
-        }
-    }
-    rates
 }

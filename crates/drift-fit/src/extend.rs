@@ -31,6 +31,10 @@ use crate::fit::{fit_unit, FittedUnit};
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
 
+/// Time constant of the temperature-rate filter, ms: about the 1-s low-pass and ±1 s difference
+/// the diagnosis scores the rate with.
+pub const RATE_TIME_CONSTANT_MS: u32 = 2000;
+
 /// Time constant of an auxiliary term's low-pass, ms: the diagnosis scores a channel through the
 /// fit's 1-s window, and a recorded channel's sample noise (2 mV on a 5 V supply at 100 Hz) passed
 /// straight into the correction made the drift metric worse (supply voltage on Y at 5×, before
@@ -65,16 +69,9 @@ impl TermPlan {
     /// Time since switch-on, switch-on temperature and the off-time estimate are the table's own
     /// inputs; campaign time is ageing, which no thermal term should model.
     fn term_for(&mut self, candidate: &str) -> Option<Term> {
-        if let Some(rest) = candidate.strip_prefix("temperature rate ") {
-            // "X (τ 32 s)": the diagnosis scored the rate through this filter.
-            let seconds: u32 = rest
-                .split_once("(τ ")?
-                .1
-                .strip_suffix(" s)")?
-                .parse()
-                .ok()?;
+        if candidate.starts_with("temperature rate ") {
             return Some(Term::TemperatureRate {
-                time_constant_ms: seconds.checked_mul(1000)?,
+                time_constant_ms: RATE_TIME_CONSTANT_MS,
             });
         }
         if candidate.starts_with("rise² ") {
@@ -142,15 +139,10 @@ impl TermPlan {
                         return plan;
                     }
                     // A new auxiliary channel always makes a new term, so the channel list only
-                    // grows with the terms. One rate filter per axis: every rate term shares the
-                    // first one's time constant, so a rate of another is not proposed.
-                    let is_rate = |t: &Term| matches!(t, Term::TemperatureRate { .. });
-                    let new = plan.term_for(&name).filter(|term| {
-                        !plan
-                            .terms
-                            .iter()
-                            .any(|t| t.term == *term || (is_rate(term) && is_rate(&t.term)))
-                    });
+                    // grows with the terms.
+                    let new = plan
+                        .term_for(&name)
+                        .filter(|term| !plan.terms.iter().any(|t| t.term == *term));
                     if let Some(term) = new {
                         plan.terms.push(ChosenTerm {
                             candidate: describe(term, &name),
@@ -232,12 +224,7 @@ impl TermPlan {
 /// on one axis, the term applies its kind on every axis).
 fn describe(term: Term, candidate: &str) -> String {
     match term {
-        Term::TemperatureRate { time_constant_ms } => {
-            format!(
-                "temperature rate τ {} s (own axis)",
-                time_constant_ms / 1000
-            )
-        }
+        Term::TemperatureRate { .. } => "temperature rate (own axis)".into(),
         Term::RiseSquared => "rise² (own axis)".into(),
         _ => candidate.to_owned(),
     }
@@ -718,16 +705,12 @@ mod tests {
         let axes = [
             axis(
                 "X",
-                &[
-                    ("temperature rate X (τ 8 s)", true),
-                    ("aux:supply_voltage", true),
-                ],
+                &[("temperature rate X", true), ("aux:supply_voltage", true)],
             ),
             axis(
                 "Y",
                 &[
-                    ("temperature rate Y (τ 8 s)", true),
-                    ("temperature rate Y (τ 32 s)", true),
+                    ("temperature rate Y", true),
                     ("campaign time (ageing)", true),
                 ],
             ),
@@ -739,7 +722,7 @@ mod tests {
             terms,
             [
                 Term::TemperatureRate {
-                    time_constant_ms: 8000
+                    time_constant_ms: RATE_TIME_CONSTANT_MS
                 },
                 Term::AxisRise { axis: 0 },
                 Term::Aux {
@@ -749,7 +732,7 @@ mod tests {
             ]
         );
         assert_eq!(plan.aux_inputs, ["supply_voltage"]);
-        // Ageing and insignificant candidates never become terms, nor a second rate filter.
+        // Ageing and insignificant candidates never become terms.
         assert!(plan.terms.iter().all(|t| !t.candidate.contains("ageing")));
     }
 
@@ -798,7 +781,7 @@ mod tests {
 
     #[test]
     fn nothing_significant_means_no_terms_and_at_most_four() {
-        let quiet = [axis("X", &[("temperature rate X (τ 2 s)", false)])];
+        let quiet = [axis("X", &[("temperature rate X", false)])];
         assert!(TermPlan::choose(&quiet).terms.is_empty());
         let many = [axis(
             "X",
