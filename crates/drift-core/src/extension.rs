@@ -4,7 +4,8 @@
 //!
 //! Each term is a quantity the microcontroller computes per sample without heap — the axis's own
 //! temperature rate from a first-order filter, an auxiliary input the firmware passes in (supply
-//! voltage, an accelerometer axis), another axis's rise, the axis's own rise squared — centred on
+//! voltage, an accelerometer axis) through a first-order low-pass, another axis's rise, the axis's
+//! own rise squared — centred on
 //! its calibration mean and multiplied by a per-axis coefficient. The term values come from
 //! [`ExtensionState::values`], which the fitter calls too, so firmware and fit compute them
 //! identically.

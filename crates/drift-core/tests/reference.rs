@@ -415,10 +415,12 @@ fn vectors_agree_with_an_independent_f64_reference() {
     assert!(checked > 3000);
 }
 
+/// One extra term from the JSON tables: kind, parameters by name, centre and coefficient per axis.
+type JsonTerm = (String, serde_json::Map<String, Value>, [f64; 3], [f64; 3]);
+
 /// The extended model's extra terms, restated in f64 from the JSON tables.
 struct Extension {
-    /// (kind, parameters by name, centre per axis, coefficient per axis).
-    terms: Vec<(String, serde_json::Map<String, Value>, [f64; 3], [f64; 3])>,
+    terms: Vec<JsonTerm>,
     filtered: [f64; 3],
     /// Per term, the low-passed auxiliary input (None before the first finite one).
     aux_filtered: Vec<Option<f64>>,
