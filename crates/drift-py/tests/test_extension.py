@@ -26,7 +26,9 @@ def extended(models: dict[str, Model]) -> ModifiedTables:
 def terms() -> list[ExtraTerm]:
     return [
         ExtraTerm("temperature_rate", 5000, centre=(0.01, 0.012, 0.008), coefficient=(0.1, -0.08, 0.05)),
-        ExtraTerm("aux", 0, centre=[5.0] * 3, coefficient=np.array([0.01, -0.012, 0.008]), time_constant_ms=2000),
+        ExtraTerm(
+            "aux", 0, centre=[5.0] * 3, coefficient=np.array([0.01, -0.012, 0.008]), time_constant_ms=2000
+        ),
         ExtraTerm("axis_rise", 0, centre=(2.0, 2.0, 2.0), coefficient=(0.0, 0.002, -0.0015)),
         ExtraTerm("rise_squared", centre=(6.0, 7.0, 5.0), coefficient=(0.0003, -0.0002, 0.0001)),
     ]
@@ -175,12 +177,16 @@ def test_with_extension_rejects_what_is_not_a_list_of_terms(
         (("axis_rise", 1.5), {}, "`parameter` must be an integer in 0..=255 (an axis index), got 1.5"),
         (("rise_squared", 0), {}, "`parameter` must be None for kind 'rise_squared', got 0"),
         (("aux", 0), {"centre": (1, 2)}, "`centre` must be a sequence of 3 floats (X, Y, Z), got tuple"),
-        (("aux", 0), {"time_constant_ms": -1}, "`time_constant_ms` must be an integer in 0..=4294967295 (ms), got -1"),
+        (
+            ("aux", 0),
+            {"time_constant_ms": -1},
+            "`time_constant_ms` must be an integer in 0..=4294967295 (ms), got -1",
+        ),
         (
             ("temperature_rate", 2000),
             {"time_constant_ms": 2000},
             "`time_constant_ms` is only for kind 'aux' (a rate term's time constant is its "
-            "`parameter`), got 2000 for kind \"temperature_rate\"",
+            '`parameter`), got 2000 for kind "temperature_rate"',
         ),
         (
             ("aux", 0),
