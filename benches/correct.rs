@@ -35,7 +35,14 @@ fn extended(modified: &ModifiedTables) -> ModifiedTables {
             [0.01, 0.012, 0.008],
             [0.1, -0.08, 0.05],
         ),
-        term(Term::Aux { input: 0 }, [5.0; 3], [0.01, -0.012, 0.008]),
+        term(
+            Term::Aux {
+                input: 0,
+                time_constant_ms: 1000,
+            },
+            [5.0; 3],
+            [0.01, -0.012, 0.008],
+        ),
         term(Term::AxisRise { axis: 0 }, [2.0; 3], [0.0, 0.002, -0.0015]),
         term(
             Term::RiseSquared,

@@ -228,6 +228,20 @@ pub fn run(
         closed.roles.training.len(),
         closed.roles.outside_range
     );
+    for axis in &closed.axes {
+        for c in axis.ranking.iter().take(6) {
+            eprintln!(
+                "  ranking {}: {} explained {:.3}, p {:.1e}{}, absorbed by the tables {:.3}, {}",
+                axis.axis,
+                c.name,
+                c.explained,
+                c.p_value,
+                if c.significant { " (significant)" } else { "" },
+                c.absorbed_by_model,
+                c.level
+            );
+        }
+    }
     for a in closed.extended.iter().flat_map(|e| &e.admissions) {
         eprintln!(
             "  guard: {} on {}: held-out gain {:.2e} (°/s)², p {:.3}, drift gain {:+.2e} °/s → {}",

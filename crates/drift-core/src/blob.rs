@@ -5,7 +5,7 @@
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 4 | magic `GYDT` |
-//! | 4 | 2 | format version ([`FORMAT_VERSION`]; version 1, without extra terms, still reads) |
+//! | 4 | 2 | format version ([`FORMAT_VERSION`]; versions 1 and 2 still read) |
 //! | 6 | 1 | model kind ([`Kind`]) |
 //! | 7 | 1 | reserved, 0 |
 //! | 8 | 4 | payload length `n`, bytes |
@@ -21,7 +21,7 @@ use core::fmt;
 use serde::{de::DeserializeOwned, Serialize};
 
 use crate::error::Error;
-use crate::extension::Extension;
+use crate::extension::{Extension, ExtraTerm, Term, MAX_TERMS};
 use crate::model::Model;
 use crate::polynomial::PolynomialTables;
 use crate::settings::Settings;
@@ -32,8 +32,10 @@ use crate::AXES;
 /// First four bytes of every image.
 pub const MAGIC: [u8; 4] = *b"GYDT";
 /// The image format version this build writes. Version 2 added the extended model's extra terms
-/// to [`ModifiedTables`]; this build still reads version-1 images (they load with no extra terms).
-pub const FORMAT_VERSION: u16 = 2;
+/// to [`ModifiedTables`]; version 3 gave the auxiliary-input term a low-pass time constant
+/// ([`Term::Aux`]). This build still reads version-1 images (they load with no extra terms) and
+/// version-2 images (their auxiliary terms load unfiltered, time constant 0, as they were meant).
+pub const FORMAT_VERSION: u16 = 3;
 /// The oldest image format version this build reads.
 pub const OLDEST_READABLE_VERSION: u16 = 1;
 /// Bytes before the payload.
@@ -74,20 +76,82 @@ struct ModifiedTablesV1<const R: usize, const A: usize, const C: usize> {
     axes: [AxisTable<R, A, C>; AXES],
 }
 
+/// A version-2 extra term: the auxiliary input had no time constant.
+#[derive(serde::Deserialize)]
+enum TermV2 {
+    TemperatureRate { time_constant_ms: u32 },
+    Aux { input: u8 },
+    AxisRise { axis: u8 },
+    RiseSquared,
+}
+
+/// A version-2 [`ExtraTerm`].
+#[derive(serde::Deserialize)]
+struct ExtraTermV2 {
+    term: TermV2,
+    centre: [f32; AXES],
+    coefficient: [f32; AXES],
+}
+
+/// A version-2 modified-model payload.
+#[derive(serde::Deserialize)]
+struct ModifiedTablesV2<const R: usize, const A: usize, const C: usize> {
+    settings: Settings,
+    axes: [AxisTable<R, A, C>; AXES],
+    /// The extension, a one-field struct, which postcard writes as its field.
+    terms: heapless::Vec<ExtraTermV2, MAX_TERMS>,
+}
+
+impl From<ExtraTermV2> for ExtraTerm {
+    fn from(v2: ExtraTermV2) -> Self {
+        let term = match v2.term {
+            TermV2::TemperatureRate { time_constant_ms } => {
+                Term::TemperatureRate { time_constant_ms }
+            }
+            TermV2::Aux { input } => Term::Aux {
+                input,
+                time_constant_ms: 0,
+            },
+            TermV2::AxisRise { axis } => Term::AxisRise { axis },
+            TermV2::RiseSquared => Term::RiseSquared,
+        };
+        Self {
+            term,
+            centre: v2.centre,
+            coefficient: v2.coefficient,
+        }
+    }
+}
+
 impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R, A, C> {
     const KIND: Kind = Kind::Modified;
 
     fn from_payload(version: u16, payload: &[u8]) -> postcard::Result<(Self, &[u8])> {
-        if version == 1 {
-            let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)?;
-            let tables = Self {
-                settings: v1.settings,
-                axes: v1.axes,
-                extension: Extension::NONE,
-            };
-            Ok((tables, rest))
-        } else {
-            postcard::take_from_bytes(payload)
+        match version {
+            1 => {
+                let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)?;
+                let tables = Self {
+                    settings: v1.settings,
+                    axes: v1.axes,
+                    extension: Extension::NONE,
+                };
+                Ok((tables, rest))
+            }
+            2 => {
+                let (v2, rest) = postcard::take_from_bytes::<ModifiedTablesV2<R, A, C>>(payload)?;
+                let mut extension = Extension::NONE;
+                for term in v2.terms {
+                    // The same capacity on both sides: never full.
+                    let _ = extension.terms.push(term.into());
+                }
+                let tables = Self {
+                    settings: v2.settings,
+                    axes: v2.axes,
+                    extension,
+                };
+                Ok((tables, rest))
+            }
+            _ => postcard::take_from_bytes(payload),
         }
     }
 }

@@ -48,8 +48,6 @@ pub struct AxisState<S> {
     /// Flags that hold for the whole activation (from switch-on); `NOT_POWERED_ON` while there is
     /// no activation, which makes a separate "powered on" field unnecessary.
     activation_flags: Flags,
-    /// Last good contribution of the extended model's extra terms, held through input faults.
-    extension_dps: f32,
     model: S,
 }
 
@@ -62,7 +60,6 @@ impl<S: Default> Default for AxisState<S> {
             last_raw: 0.0,
             repeats: 0,
             activation_flags: Flags::NOT_POWERED_ON,
-            extension_dps: 0.0,
             model: S::default(),
         }
     }
@@ -156,7 +153,7 @@ impl<S: Copy + Default> CorrectorState<S> {
             state.activation_flags = activation;
             *flags = activation;
         }
-        self.extension = ExtensionState::power_on(switch_on_raw.map(|raw| settings.celsius(raw)));
+        self.extension = ExtensionState::POWER_ON;
         Ok(flags)
     }
 
@@ -237,34 +234,54 @@ impl<S: Copy + Default> CorrectorState<S> {
         let extension = model.extension();
         if !extension.is_empty() {
             // The extra terms read the last good temperature of every axis (a faulty reading is
-            // held there, like the paper's drift).
-            let extra = self.extension.bias(
+            // held there, like the paper's drift); an auxiliary term whose input is missing holds
+            // its filter.
+            let (extra, input_missing) = self.extension.bias(
                 extension,
                 ms,
-                &[x.celsius, y.celsius, z.celsius],
                 &[x.rise_celsius, y.rise_celsius, z.rise_celsius],
                 aux,
             );
-            for (((state, extra), corrected), (bias, flags)) in self
-                .axes
-                .iter_mut()
-                .zip(extra)
-                .zip(&mut output.corrected_dps)
-                .zip(output.bias_dps.iter_mut().zip(&mut output.flags))
-            {
-                // A non-finite term value makes the sum non-finite (even times a zero
-                // coefficient), so this one check covers every term.
-                if plausible(extra) {
-                    state.extension_dps = extra;
-                } else {
-                    *flags |= Flags::EXTENSION_INPUT_INVALID;
-                }
-                *corrected -= state.extension_dps;
-                *bias += state.extension_dps;
-            }
+            // Written out per axis: a loop over the array's values kept its iterator on the
+            // stack (~90 instructions per sample on the Cortex-M4).
+            let [extra_x, extra_y, extra_z] = extra;
+            let Output {
+                corrected_dps: [corrected_x, corrected_y, corrected_z],
+                bias_dps: [bias_x, bias_y, bias_z],
+                flags: [flags_x, flags_y, flags_z],
+            } = &mut output;
+            add_extension(extra_x, input_missing, corrected_x, bias_x, flags_x);
+            add_extension(extra_y, input_missing, corrected_y, bias_y, flags_y);
+            add_extension(extra_z, input_missing, corrected_z, bias_z, flags_z);
         }
         output
     }
+}
+
+/// Adds one axis's extension bias `extra` to its output; `input_missing`: an auxiliary input a
+/// term reads was not finite (the term held its filter).
+#[inline(always)]
+fn add_extension(
+    extra: f32,
+    input_missing: bool,
+    corrected: &mut f32,
+    bias: &mut f32,
+    flags: &mut Flags,
+) {
+    if input_missing {
+        *flags |= Flags::EXTENSION_INPUT_INVALID;
+    }
+    // Every input the terms read is held finite, so only absurd tables or an absurd (finite)
+    // auxiliary reading make the sum implausible: the extension then adds nothing, flagged
+    // (finding F3: the corrected rate stays finite).
+    let extra = if plausible(extra) {
+        extra
+    } else {
+        *flags |= Flags::EXTENSION_INPUT_INVALID;
+        0.0
+    };
+    *corrected -= extra;
+    *bias += extra;
 }
 
 /// Before `power_on`: the rates pass through, flagged. Kept out of line: firmware calls it only
@@ -306,13 +323,12 @@ fn rate_flag(rate: f32) -> Flags {
     }
 }
 
-/// One axis of one sample after the shared part: the output, and the last good temperature with
-/// its rise, which the extended model's terms read.
+/// One axis of one sample after the shared part: the output, and the last good temperature's rise,
+/// which the extended model's terms read.
 struct AxisOutput {
     corrected_dps: f32,
     bias_dps: f32,
     flags: Flags,
-    celsius: f32,
     rise_celsius: f32,
 }
 
@@ -410,7 +426,6 @@ fn axis_output<S>(state: &AxisState<S>, reading: &Reading, rate: f32) -> AxisOut
         corrected_dps: rate - bias_dps,
         bias_dps,
         flags: reading.flags,
-        celsius: reading.celsius,
         rise_celsius: reading.rise_celsius,
     }
 }

@@ -4,7 +4,8 @@
 //!
 //! Each term is a quantity the microcontroller computes per sample without heap — the axis's own
 //! temperature rate from a first-order filter, an auxiliary input the firmware passes in (supply
-//! voltage, an accelerometer axis), another axis's rise, the axis's own rise squared — centred on
+//! voltage, an accelerometer axis) through a first-order low-pass, another axis's rise, the axis's
+//! own rise squared — centred on
 //! its calibration mean and multiplied by a per-axis coefficient. The term values come from
 //! [`ExtensionState::values`], which the fitter calls too, so firmware and fit compute them
 //! identically.
@@ -33,10 +34,21 @@ pub enum Term {
         /// The filter's time constant `τ`, milliseconds (> 0).
         time_constant_ms: u32,
     },
-    /// Auxiliary input `input` (0 ..[`AUX_INPUTS`]) as the firmware passes it, in its own unit.
+    /// Auxiliary input `input` (0 ..[`AUX_INPUTS`]) in its own unit, through a first-order
+    /// low-pass of time constant `time_constant_ms` (backward Euler, like the rate filter; one
+    /// float of state per term). A recorded channel's sample noise would otherwise pass straight
+    /// into the correction. The filter starts at the first finite input after switch-on and, until
+    /// `time_constant_ms` has passed, is the time-weighted mean of the inputs so far (its time
+    /// constant grows with the time since switch-on), so the first reading's noise does not linger.
+    /// A non-finite input leaves the filter where it was (the term holds, flagged); before the
+    /// first finite input the term is 0.
     Aux {
         /// Index into the auxiliary inputs.
         input: u8,
+        /// The low-pass's time constant, milliseconds; 0 passes the input through unfiltered
+        /// (what images of format version 2 meant, and JSON tables without the field).
+        #[cfg_attr(feature = "serde", serde(default))]
+        time_constant_ms: u32,
     },
     /// The rise since switch-on of another axis (0 = X, 1 = Y, 2 = Z), °C.
     AxisRise {
@@ -104,7 +116,7 @@ impl Extension {
                     }
                     None
                 }
-                Term::Aux { input } => {
+                Term::Aux { input, .. } => {
                     (usize::from(input) >= AUX_INPUTS).then_some(("term_input", AUX_INPUTS))
                 }
                 Term::AxisRise { axis } => {
@@ -149,19 +161,38 @@ impl Extension {
     }
 }
 
-/// What the extension keeps between samples: the temperature filters and the time of the last
-/// sample. Reset at every switch-on.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// What the extension keeps between samples: the temperature-rate filters, the auxiliary inputs'
+/// filters and the time of the last sample. Reset at every switch-on. Plain data (32 bytes): copy
+/// it to persist, restore it to resume.
+#[derive(Clone, Copy, Debug)]
 pub struct ExtensionState {
-    /// Per axis, the temperature of the previous sample, °C.
-    last_celsius: [f32; AXES],
-    /// Per axis, how far the low-passed temperature lags the temperature, °C (for
-    /// [`Term::TemperatureRate`]). Kept as the lag, not as the low-passed temperature: at 1 kHz a
-    /// step of the filter moves it by ~1e-5 °C, below an f32's resolution at 30 °C (2e-6 °C)
-    /// but not at the lag's size (~0.05 °C).
-    lag_celsius: [f32; AXES],
+    /// Per axis, the rise since switch-on through the rate filter's first-order low-pass, °C (for
+    /// [`Term::TemperatureRate`]). The rise rather than the temperature: the filter needs no
+    /// previous reading, and f32 resolves a rise (~5 °C: 5e-7 °C) six times finer than a
+    /// temperature (~30 °C: 2e-6 °C), so the rate's rounding stays below 1e-5 °C/s at 1 kHz.
+    filtered_rise: [f32; AXES],
+    /// Per term, the low-passed auxiliary input ([`Term::Aux`]; unused by other kinds): NaN until
+    /// the first finite input, then held through non-finite ones.
+    aux: [f32; MAX_TERMS],
     /// Time of the previous sample, ms since switch-on.
     last_ms: u32,
+}
+
+/// Bit for bit: the auxiliary filters start as NaN, and a state must equal its copy.
+impl PartialEq for ExtensionState {
+    fn eq(&self, other: &Self) -> bool {
+        let bits = |state: &Self| {
+            let floats = state.filtered_rise.into_iter().chain(state.aux);
+            floats.map(f32::to_bits).chain([state.last_ms])
+        };
+        bits(self).eq(bits(other))
+    }
+}
+
+impl Default for ExtensionState {
+    fn default() -> Self {
+        Self::POWER_ON
+    }
 }
 
 /// One sample's inputs to the extension, per axis unless said otherwise.
@@ -169,45 +200,53 @@ pub struct ExtensionState {
 pub struct TermInputs {
     /// Time since switch-on, ms.
     pub since_power_on_ms: u32,
-    /// Temperature, °C.
-    pub celsius: [f32; AXES],
-    /// Rise since switch-on, °C.
+    /// Rise since switch-on, °C (finite: the corrector passes the last good reading's).
     pub rise_celsius: [f32; AXES],
     /// The auxiliary inputs (shared by the axes).
     pub aux: [f32; AUX_INPUTS],
 }
 
 impl ExtensionState {
-    /// The state at switch-on: the filters start at the switch-on temperatures (rate 0).
-    pub fn power_on(switch_on_celsius: [f32; AXES]) -> Self {
-        Self {
-            last_celsius: switch_on_celsius,
-            lag_celsius: [0.0; AXES],
-            last_ms: 0,
-        }
+    /// The state at switch-on: the rate filters at rise 0 (rate 0), the auxiliary filters waiting
+    /// for their first finite input.
+    pub const POWER_ON: Self = Self {
+        filtered_rise: [0.0; AXES],
+        aux: [f32::NAN; MAX_TERMS],
+        last_ms: 0,
+    };
+
+    /// The state at switch-on ([`Self::POWER_ON`]).
+    pub fn power_on() -> Self {
+        Self::POWER_ON
     }
 
-    /// Advances the filter to this sample and returns the centred term values. Non-finite inputs
-    /// give non-finite values for the terms that read them (the corrector then holds and flags);
-    /// a non-finite temperature leaves the filter where it was.
+    /// Advances the filters to this sample and returns the centred term values: the values the
+    /// corrector multiplies by the coefficients, the same bits. A term whose auxiliary input is
+    /// not finite holds its last filtered value (0 before the first finite one).
     pub fn values(&mut self, extension: &Extension, inputs: &TermInputs) -> TermValues {
+        let previous_ms = self.last_ms;
         let elapsed_ms = self.elapsed_ms(inputs.since_power_on_ms);
-        // Validation makes every rate term agree on τ; the first one's is used.
-        let rates = extension
-            .terms
-            .iter()
-            .find_map(|t| match t.term {
-                Term::TemperatureRate { time_constant_ms } => Some(time_constant_ms),
-                _ => None,
-            })
-            .map_or([f32::NAN; AXES], |tau_ms| {
-                self.step(tau_ms, elapsed_ms, &inputs.celsius)
-            });
+        let filtered_rise = &mut self.filtered_rise;
+        let mut rates = None;
         let mut values = [[0.0; MAX_TERMS]; AXES];
-        for (t, term) in extension.terms.iter().enumerate() {
+        for (t, (term, held)) in extension.terms.iter().zip(&mut self.aux).enumerate() {
             let raw = match term.term {
-                Term::TemperatureRate { .. } => rates,
-                Term::Aux { input } => [shared(&inputs.aux, input); AXES],
+                Term::TemperatureRate { time_constant_ms } => *rates.get_or_insert_with(|| {
+                    step_rates(
+                        filtered_rise,
+                        time_constant_ms,
+                        elapsed_ms,
+                        &inputs.rise_celsius,
+                    )
+                }),
+                Term::Aux {
+                    input,
+                    time_constant_ms,
+                } => {
+                    let input = shared(&inputs.aux, input);
+                    let tau_ms = time_constant_ms.min(previous_ms);
+                    aux_value(held, term, input, tau_ms, elapsed_ms).0
+                }
                 Term::AxisRise { axis } => [shared(&inputs.rise_celsius, axis); AXES],
                 Term::RiseSquared => inputs.rise_celsius.map(|rise| rise * rise),
             };
@@ -220,22 +259,24 @@ impl ExtensionState {
         values
     }
 
-    /// Advances the filter to this sample and returns the extension's bias per axis, °/s: the
-    /// same bits as [`Extension::bias`] of [`Self::values`], without the value matrix. Non-finite
-    /// when a term's value is (the corrector then holds and flags).
+    /// Advances the filters to this sample and returns the extension's bias per axis, °/s — the
+    /// same bits as [`Extension::bias`] of [`Self::values`], without the value matrix — and
+    /// whether an auxiliary input a term reads was not finite (that term then holds).
     #[inline(always)]
     pub(crate) fn bias(
         &mut self,
         extension: &Extension,
         since_power_on_ms: u32,
-        celsius: &[f32; AXES],
         rise_celsius: &[f32; AXES],
         aux: &[f32; AUX_INPUTS],
-    ) -> [f32; AXES] {
+    ) -> ([f32; AXES], bool) {
+        let previous_ms = self.last_ms;
         let elapsed_ms = self.elapsed_ms(since_power_on_ms);
         let mut rates = None;
+        let mut inputs_ok = true;
         let [mut x, mut y, mut z] = [0.0_f32; AXES];
-        for term in &extension.terms {
+        let filtered_rise = &mut self.filtered_rise;
+        for (term, held) in extension.terms.iter().zip(&mut self.aux) {
             let ([cx, cy, cz], [mx, my, mz]) = (term.coefficient, term.centre);
             // Summed in each arm rather than after a match that returns the values: measured 12
             // instructions per sample fewer on the Cortex-M4 (docs/embedded.md).
@@ -248,15 +289,24 @@ impl ExtensionState {
                 // The filter steps once per sample, at the first rate term (validation makes
                 // every rate term agree on τ), as `values` does.
                 Term::TemperatureRate { time_constant_ms } => {
-                    add(*rates
-                        .get_or_insert_with(|| self.step(time_constant_ms, elapsed_ms, celsius)))
+                    add(*rates.get_or_insert_with(|| {
+                        step_rates(filtered_rise, time_constant_ms, elapsed_ms, rise_celsius)
+                    }))
                 }
-                Term::Aux { input } => add([shared(aux, input); AXES]),
+                Term::Aux {
+                    input,
+                    time_constant_ms,
+                } => {
+                    let tau_ms = time_constant_ms.min(previous_ms);
+                    let (value, ok) = aux_value(held, term, shared(aux, input), tau_ms, elapsed_ms);
+                    inputs_ok &= ok;
+                    add(value);
+                }
                 Term::AxisRise { axis } => add([shared(rise_celsius, axis); AXES]),
                 Term::RiseSquared => add(rise_celsius.map(|rise| rise * rise)),
             }
         }
-        [x, y, z]
+        ([x, y, z], !inputs_ok)
     }
 
     /// Time since the previous sample, ms; remembers this sample's time.
@@ -266,36 +316,67 @@ impl ExtensionState {
         self.last_ms = since_power_on_ms;
         elapsed_ms
     }
+}
 
-    /// Steps the temperature filters of time constant `tau_ms` by `elapsed_ms` to `celsius`;
-    /// returns each axis's temperature rate, °C/s.
-    #[inline(always)]
-    fn step(&mut self, tau_ms: u32, elapsed_ms: u32, celsius: &[f32; AXES]) -> [f32; AXES] {
-        // Both below 2^24 in practice (τ is seconds, Δt milliseconds to seconds), so exact. Two
-        // divisions per sample rather than a cache keyed by (τ, Δt): the cache cost 20 bytes of
-        // state and, counted in instructions, more than it saved.
-        let (tau, elapsed) = (tau_ms as f32, elapsed_ms as f32);
-        let keep = tau / (tau + elapsed);
-        let per_second = 1000.0 / tau;
-        let mut rates = [f32::NAN; AXES];
-        for (((rate, celsius), last), lag) in rates
-            .iter_mut()
-            .zip(celsius)
-            .zip(&mut self.last_celsius)
-            .zip(&mut self.lag_celsius)
-        {
-            // Backward Euler of the first-order low-pass T_f' = (T − T_f)/τ, written for the
-            // lag d = T − T_f: d ← (d + ΔT) · τ/(τ + Δt); the rate estimate is d/τ. Stable for
-            // any step, no exp(); ΔT of two close readings is exact in f32.
-            let next = (*lag + (celsius - *last)) * keep;
-            *rate = next * per_second;
-            if next.is_finite() {
-                *lag = next;
-                *last = *celsius;
-            }
-        }
-        rates
+/// Steps the rate filters of time constant `tau_ms` by `elapsed_ms` to each axis's `rise_celsius`;
+/// returns each axis's temperature rate, °C/s.
+#[inline(always)]
+fn step_rates(
+    filtered_rise: &mut [f32; AXES],
+    tau_ms: u32,
+    elapsed_ms: u32,
+    rise_celsius: &[f32; AXES],
+) -> [f32; AXES] {
+    // Both below 2^24 in practice (τ is seconds, Δt milliseconds to seconds), so exact. Two
+    // divisions per sample rather than a cache keyed by (τ, Δt): the cache cost 20 bytes of
+    // state and, counted in instructions, more than it saved.
+    let (tau, elapsed) = (tau_ms as f32, elapsed_ms as f32);
+    let keep = tau / (tau + elapsed);
+    let per_second = 1000.0 / tau;
+    let mut rates = [0.0; AXES];
+    for ((rate, rise), filtered) in rates.iter_mut().zip(rise_celsius).zip(filtered_rise) {
+        // Backward Euler of the first-order low-pass r_f' = (r − r_f)/τ, written for the lag
+        // d = r − r_f: d = (r − r_f,previous) · τ/(τ + Δt); the rate estimate is d/τ. Stable for
+        // any step, no exp(). A rounding of the stored r_f decays with the filter rather than
+        // accumulating (|error| ≤ 8e-6 °C/s at 1 kHz over a 5 °C rise, against an f64 filter).
+        let lag = (rise - *filtered) * keep;
+        *rate = lag * per_second;
+        *filtered = rise - lag;
     }
+    rates
+}
+
+/// One auxiliary term's value for every axis from its filter `held` and this sample's `input`,
+/// and whether the input was finite. The filter is the backward Euler step of the first-order
+/// low-pass `f' = (u − f)/τ`: `f ← u + (f − u) · τ/(τ + Δt)` (τ = 0: `f ← u`); it starts at the
+/// first finite input and holds through non-finite ones. Before any, the value is the term's
+/// centre (the term adds 0). The callers pass `τ = min(τ_term, t_previous)`, the previous
+/// sample's time since switch-on: until `τ_term` has passed, the filter is the time-weighted mean
+/// of the inputs so far, so the first reading's noise does not linger for `τ`.
+#[inline(always)]
+fn aux_value(
+    held: &mut f32,
+    term: &ExtraTerm,
+    input: f32,
+    tau_ms: u32,
+    elapsed_ms: u32,
+) -> ([f32; AXES], bool) {
+    let ok = input.is_finite();
+    if ok {
+        *held = if tau_ms == 0 || held.is_nan() {
+            input
+        } else {
+            let tau = tau_ms as f32;
+            input + (*held - input) * (tau / (tau + elapsed_ms as f32))
+        };
+    }
+    let value = *held;
+    let values = if value.is_nan() {
+        term.centre
+    } else {
+        [value; AXES]
+    };
+    (values, ok)
 }
 
 /// A term that reads the same input for every axis: input `index` of `inputs` (NaN if missing).

@@ -39,10 +39,10 @@ impl Flags {
     /// [`MAX_PLAUSIBLE_DRIFT_DPS`](crate::MAX_PLAUSIBLE_DRIFT_DPS), for example from a temperature
     /// reading far outside any sensor's range): the last good drift estimate is held.
     pub const MODEL_INVALID: Self = Self(1 << 8);
-    /// Extended model: an auxiliary input an extra term reads is NaN, infinite or was not passed, or
-    /// the terms' contribution is beyond [`MAX_PLAUSIBLE_DRIFT_DPS`](crate::MAX_PLAUSIBLE_DRIFT_DPS):
-    /// the extra terms' last good contribution is held. (Temperature faults hold the temperature
-    /// the terms read, under the flags above.)
+    /// Extended model: an auxiliary input an extra term reads is NaN, infinite or was not passed
+    /// (that term holds its filtered input), or the terms' contribution is non-finite or beyond
+    /// [`MAX_PLAUSIBLE_DRIFT_DPS`](crate::MAX_PLAUSIBLE_DRIFT_DPS) (the extension then adds
+    /// nothing). (Temperature faults hold the temperature the terms read, under the flags above.)
     pub const EXTENSION_INPUT_INVALID: Self = Self(1 << 9);
 
     /// Every flag with its name, in bit order (for bindings, logs and reports: a flag added here is

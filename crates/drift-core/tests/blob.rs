@@ -261,6 +261,36 @@ fn version_1_images_still_load() {
     assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), tables);
 }
 
+/// The extended fixture as the version-2 build wrote it (`testdata/image-v2-extended.bin`, the
+/// `extended` image of `testdata/vectors.json` before version 3), committed as it was: it still
+/// loads, its auxiliary term unfiltered (time constant 0), everything else as it was.
+#[test]
+fn version_2_images_still_load_with_unfiltered_aux_terms() {
+    use drift_core::Term;
+    let v2 = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../testdata/image-v2-extended.bin"
+    ))
+    .unwrap();
+    assert_eq!(u16::from_le_bytes([v2[4], v2[5]]), 2);
+    let tables: FixtureTables = decode(&v2).unwrap();
+    let mut expected = fixture::extended();
+    for term in &mut expected.extension.terms {
+        if let Term::Aux {
+            time_constant_ms, ..
+        } = &mut term.term
+        {
+            *time_constant_ms = 0;
+        }
+    }
+    assert_eq!(tables, expected);
+    // Re-encoding writes the current version, which a version-2 reader would refuse by number.
+    let mut buffer = vec![0; 64 * 1024];
+    let len = encode(&tables, &mut buffer).unwrap();
+    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
+    assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), tables);
+}
+
 #[test]
 fn extended_images_round_trip_and_bad_terms_are_named() {
     use drift_core::{ExtraTerm, Term};
@@ -281,7 +311,10 @@ fn extended_images_round_trip_and_bad_terms_are_named() {
             .to_string()
     };
     assert_eq!(
-        bad_term(Term::Aux { input: 4 }),
+        bad_term(Term::Aux {
+            input: 4,
+            time_constant_ms: 1000
+        }),
         "term_input[0]: must be less than 4"
     );
     assert_eq!(

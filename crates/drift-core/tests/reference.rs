@@ -370,14 +370,13 @@ fn vectors_agree_with_an_independent_f64_reference() {
                     .zip(&states)
                     .map(|(r, st)| (r - st.on_raw) / s.per)
                     .collect();
-                let extra = extension.step(f64::from(input[0]), &celsius, &rise, &aux);
-                for (axis, (output, extra)) in outputs.iter_mut().zip(extra).enumerate() {
-                    match extra {
-                        Some(value) => extension.last[axis] = value,
-                        None => output.2 |= EXTENSION_INPUT_INVALID,
+                let (extra, missing) = extension.step(f64::from(input[0]), &celsius, &rise, &aux);
+                for (output, extra) in outputs.iter_mut().zip(extra) {
+                    if missing {
+                        output.2 |= EXTENSION_INPUT_INVALID;
                     }
-                    output.0 -= extension.last[axis];
-                    output.1 += extension.last[axis];
+                    output.0 -= extra;
+                    output.1 += extra;
                 }
             }
             for axis in 0..3 {
@@ -416,36 +415,38 @@ fn vectors_agree_with_an_independent_f64_reference() {
     assert!(checked > 3000);
 }
 
+/// One extra term from the JSON tables: kind, parameters by name, centre and coefficient per axis.
+type JsonTerm = (String, serde_json::Map<String, Value>, [f64; 3], [f64; 3]);
+
 /// The extended model's extra terms, restated in f64 from the JSON tables.
 struct Extension {
-    /// (kind, parameter, centre per axis, coefficient per axis).
-    terms: Vec<(String, f64, [f64; 3], [f64; 3])>,
+    terms: Vec<JsonTerm>,
     filtered: [f64; 3],
+    /// Per term, the low-passed auxiliary input (None before the first finite one).
+    aux_filtered: Vec<Option<f64>>,
     last_ms: f64,
-    last: [f64; 3],
 }
 
 impl Extension {
     fn new(json: &Value, switch_on_celsius: [f64; 3]) -> Self {
         let triple = |v: &Value| [f(&v[0]), f(&v[1]), f(&v[2])];
-        let terms = json["terms"]
+        let terms: Vec<_> = json["terms"]
             .as_array()
             .map(|terms| {
                 terms
                     .iter()
                     .map(|t| {
-                        let (kind, parameter) = match &t["term"] {
-                            Value::String(name) => (name.clone(), 0.0),
+                        let (kind, parameters) = match &t["term"] {
+                            Value::String(name) => (name.clone(), serde_json::Map::new()),
                             Value::Object(map) => {
                                 let (name, inner) = map.iter().next().unwrap();
-                                let parameter = inner.as_object().unwrap().values().next().unwrap();
-                                (name.clone(), f(parameter))
+                                (name.clone(), inner.as_object().unwrap().clone())
                             }
                             other => panic!("term {other}"),
                         };
                         (
                             kind,
-                            parameter,
+                            parameters,
                             triple(&t["centre"]),
                             triple(&t["coefficient"]),
                         )
@@ -454,49 +455,73 @@ impl Extension {
             })
             .unwrap_or_default();
         Self {
+            aux_filtered: vec![None; terms.len()],
             terms,
             filtered: switch_on_celsius,
             last_ms: 0.0,
-            last: [0.0; 3],
         }
     }
 
-    /// Per axis, the terms' contribution, or None when an input it reads is not finite.
-    fn step(&mut self, ms: f64, celsius: &[f64], rise: &[f64], aux: &[f64; 4]) -> Vec<Option<f64>> {
+    /// Per axis, the terms' contribution, and whether an auxiliary input a term reads is not
+    /// finite (that term then holds its filtered value; 0 before the first finite input).
+    fn step(&mut self, ms: f64, celsius: &[f64], rise: &[f64], aux: &[f64; 4]) -> (Vec<f64>, bool) {
         let elapsed = (ms - self.last_ms).max(0.0);
+        let previous_ms = self.last_ms;
         self.last_ms = ms;
         let tau = self
             .terms
             .iter()
             .find(|t| t.0 == "TemperatureRate")
-            .map(|t| t.1);
-        (0..3)
+            .map(|t| f(&t.1["time_constant_ms"]));
+        let mut rate = [f64::NAN; 3];
+        if let Some(tau) = tau {
+            for axis in 0..3 {
+                // The textbook form (the core keeps the lag instead, for f32 precision).
+                let next = self.filtered[axis]
+                    + elapsed / (tau + elapsed) * (celsius[axis] - self.filtered[axis]);
+                rate[axis] = (celsius[axis] - next) * 1000.0 / tau;
+                self.filtered[axis] = next;
+            }
+        }
+        let mut missing = false;
+        let mut aux_value = vec![None; self.terms.len()];
+        for (t, (kind, parameters, ..)) in self.terms.iter().enumerate() {
+            if kind != "Aux" {
+                continue;
+            }
+            let input = aux[f(&parameters["input"]) as usize];
+            // The time constant grows with the time since switch-on until it reaches the term's.
+            let tau = f(&parameters["time_constant_ms"]).min(previous_ms);
+            let held = &mut self.aux_filtered[t];
+            if input.is_finite() {
+                // Textbook first-order low-pass (backward Euler), starting at the first input.
+                *held = Some(match *held {
+                    Some(previous) if tau > 0.0 => {
+                        previous + elapsed / (tau + elapsed) * (input - previous)
+                    }
+                    _ => input,
+                });
+            } else {
+                missing = true;
+            }
+            aux_value[t] = *held;
+        }
+        let sums = (0..3)
             .map(|axis| {
-                let mut rate = f64::NAN;
-                if let Some(tau) = tau {
-                    // The textbook form (the core keeps the lag instead, for f32 precision).
-                    let next = self.filtered[axis]
-                        + elapsed / (tau + elapsed) * (celsius[axis] - self.filtered[axis]);
-                    rate = (celsius[axis] - next) * 1000.0 / tau;
-                    self.filtered[axis] = next;
-                }
                 let mut sum = 0.0;
-                for (kind, parameter, centre, coefficient) in &self.terms {
+                for (t, (kind, parameters, centre, coefficient)) in self.terms.iter().enumerate() {
                     let value = match kind.as_str() {
-                        "TemperatureRate" => rate,
-                        "Aux" => aux[*parameter as usize],
-                        "AxisRise" => rise[*parameter as usize],
+                        "TemperatureRate" => rate[axis],
+                        "Aux" => aux_value[t].unwrap_or(centre[axis]),
+                        "AxisRise" => rise[f(&parameters["axis"]) as usize],
                         "RiseSquared" => rise[axis] * rise[axis],
                         other => panic!("unknown term {other}"),
                     };
-                    let value = value - centre[axis];
-                    if !value.is_finite() {
-                        return None;
-                    }
-                    sum += coefficient[axis] * value;
+                    sum += coefficient[axis] * (value - centre[axis]);
                 }
-                Some(sum)
+                sum
             })
-            .collect()
+            .collect();
+        (sums, missing)
     }
 }

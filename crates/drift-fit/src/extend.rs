@@ -35,6 +35,14 @@ use crate::settings::FitSettings;
 /// the diagnosis scores the rate with.
 pub const RATE_TIME_CONSTANT_MS: u32 = 2000;
 
+/// Time constant of an auxiliary term's low-pass, ms: the diagnosis scores a channel through the
+/// fit's 1-s window, and a recorded channel's sample noise (2 mV on a 5 V supply at 100 Hz) passed
+/// straight into the correction made the drift metric worse (supply voltage on Y at 5×, before
+/// session 4). A first-order low-pass of time constant τ has the noise bandwidth 1/(4τ): at 1 s half
+/// the 1-s window's (1/(2 s)); it lags a step of its input by τ, and the offsets it is for change
+/// at switch-on (supply, orientation), not within a second.
+pub const AUX_TIME_CONSTANT_MS: u32 = 1000;
+
 const AXIS_NAMES: [&str; 3] = ["X", "Y", "Z"];
 
 /// One extra term chosen from the diagnosis.
@@ -91,6 +99,7 @@ impl TermPlan {
         };
         Some(Term::Aux {
             input: u8::try_from(input).ok()?,
+            time_constant_ms: AUX_TIME_CONSTANT_MS,
         })
     }
 
@@ -152,7 +161,11 @@ impl TermPlan {
         let mut kept = Self::default();
         for chosen in keep.iter().filter_map(|&t| self.terms.get(t)) {
             let mut chosen = chosen.clone();
-            if let Term::Aux { input } = chosen.term {
+            if let Term::Aux {
+                input,
+                time_constant_ms,
+            } = chosen.term
+            {
                 let Some(channel) = self.aux_inputs.get(usize::from(input)) else {
                     continue;
                 };
@@ -166,7 +179,10 @@ impl TermPlan {
                 let Ok(input) = u8::try_from(renumbered) else {
                     continue;
                 };
-                chosen.term = Term::Aux { input };
+                chosen.term = Term::Aux {
+                    input,
+                    time_constant_ms,
+                };
             }
             kept.terms.push(chosen);
         }
@@ -247,8 +263,10 @@ fn term_values(
     switch_on: [f32; 3],
 ) -> Vec<[Vec<f32>; 3]> {
     let shape = plan.extension(&[], &[]);
-    let mut state = ExtensionState::power_on(switch_on.map(|r| settings.celsius(r)));
+    let mut state = ExtensionState::power_on();
     let mut held = switch_on;
+    // The corrector's conversion: times the reciprocal, the same bits.
+    let celsius_per_raw = 1.0 / settings.raw_per_celsius;
     let mut values: Vec<[Vec<f32>; 3]> = (0..plan.terms.len())
         .map(|_| std::array::from_fn(|_| Vec::with_capacity(segment.len())))
         .collect();
@@ -261,8 +279,7 @@ fn term_values(
         }
         let inputs = TermInputs {
             since_power_on_ms: sample.since_power_on_ms,
-            celsius: held.map(|r| settings.celsius(r)),
-            rise_celsius: [0, 1, 2].map(|a| (held[a] - switch_on[a]) / settings.raw_per_celsius),
+            rise_celsius: [0, 1, 2].map(|a| (held[a] - switch_on[a]) * celsius_per_raw),
             aux: plan.aux_at(segment, i),
         };
         let row = state.values(&shape, &inputs);
@@ -708,7 +725,10 @@ mod tests {
                     time_constant_ms: RATE_TIME_CONSTANT_MS
                 },
                 Term::AxisRise { axis: 0 },
-                Term::Aux { input: 0 },
+                Term::Aux {
+                    input: 0,
+                    time_constant_ms: AUX_TIME_CONSTANT_MS
+                },
             ]
         );
         assert_eq!(plan.aux_inputs, ["supply_voltage"]);
@@ -745,7 +765,16 @@ mod tests {
         let plan = TermPlan::choose(&axes);
         let kept = plan.keeping(&[1, 2]);
         let terms: Vec<Term> = kept.terms.iter().map(|t| t.term).collect();
-        assert_eq!(terms, [Term::Aux { input: 0 }, Term::RiseSquared]);
+        assert_eq!(
+            terms,
+            [
+                Term::Aux {
+                    input: 0,
+                    time_constant_ms: AUX_TIME_CONSTANT_MS
+                },
+                Term::RiseSquared
+            ]
+        );
         assert_eq!(kept.aux_inputs, ["b"]);
         assert!(plan.keeping(&[]).terms.is_empty() && plan.keeping(&[]).aux_inputs.is_empty());
     }

@@ -7,7 +7,7 @@
 //! Invariants: decoding never panics; an accepted image validates, runs a corrector, and
 //! survives encode → decode unchanged (images are not canonical: finding F1).
 
-use drift_core::blob::{decode, encode, Image, Kind, FORMAT_VERSION, HEADER_LEN, TRAILER_LEN};
+use drift_core::blob::{decode, encode, Image, Kind, HEADER_LEN, TRAILER_LEN};
 use drift_core::{Corrector, ModifiedTables, PolynomialTables, Sample};
 
 const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
@@ -41,9 +41,20 @@ fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8]) {
     // The CRC still covers every byte. What must hold: the model survives encode → decode, and the
     // canonical image is never longer than the one decoded.
     // A version-1 image of the paper's tables is re-encoded as the current version, which adds
-    // the (empty) extension: postcard writes its length, one byte.
+    // the (empty) extension: postcard writes its length, one byte. A version-2 image gains each
+    // auxiliary term's time constant (0: one byte each).
     let version = u16::from_le_bytes([bytes[4], bytes[5]]);
-    let upgrade = usize::from(version < FORMAT_VERSION && M::KIND == Kind::Modified);
+    let aux_terms = model
+        .extension()
+        .terms
+        .iter()
+        .filter(|t| matches!(t.term, drift_core::Term::Aux { .. }))
+        .count();
+    let upgrade = match (version, M::KIND) {
+        (1, Kind::Modified) => 1,
+        (2, Kind::Modified) => aux_terms,
+        _ => 0,
+    };
     assert!(
         len <= bytes.len() + upgrade,
         "re-encoding is longer than the image"

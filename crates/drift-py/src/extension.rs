@@ -33,7 +33,19 @@ fn required<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     }
 }
 
-fn term(kind: &str, parameter: Option<&Bound<'_, PyAny>>) -> Result<Term, Error> {
+fn term(
+    kind: &str,
+    parameter: Option<&Bound<'_, PyAny>>,
+    time_constant_ms: Option<&Bound<'_, PyAny>>,
+) -> Result<Term, Error> {
+    let time_constant_ms = time_constant_ms.filter(|value| !value.is_none());
+    if let Some(value) = time_constant_ms.filter(|_| kind != "aux") {
+        return Err(Error::Input(format!(
+            "`time_constant_ms` is only for kind 'aux' (a rate term's time constant is its \
+             `parameter`), got {} for kind {kind:?}",
+            args::shown(value)
+        )));
+    }
     Ok(match kind {
         "temperature_rate" => Term::TemperatureRate {
             time_constant_ms: required(
@@ -50,6 +62,14 @@ fn term(kind: &str, parameter: Option<&Bound<'_, PyAny>>) -> Result<Term, Error>
                 "an integer in 0..=255 (an auxiliary input's index)",
                 parameter,
             )?,
+            time_constant_ms: match time_constant_ms {
+                Some(value) => args::value(
+                    "time_constant_ms",
+                    "an integer in 0..=4294967295 (ms)",
+                    value,
+                )?,
+                None => 0,
+            },
         },
         "axis_rise" => Term::AxisRise {
             axis: required(
@@ -90,9 +110,20 @@ fn kind_name(term: Term) -> &'static str {
 fn parameter(term: Term) -> Option<u32> {
     match term {
         Term::TemperatureRate { time_constant_ms } => Some(time_constant_ms),
-        Term::Aux { input } => Some(u32::from(input)),
+        Term::Aux { input, .. } => Some(u32::from(input)),
         Term::AxisRise { axis } => Some(u32::from(axis)),
         Term::RiseSquared => None,
+    }
+}
+
+/// The low-pass time constant of an auxiliary or rate term, ms.
+fn time_constant(term: Term) -> Option<u32> {
+    match term {
+        Term::TemperatureRate { time_constant_ms }
+        | Term::Aux {
+            time_constant_ms, ..
+        } => Some(time_constant_ms),
+        Term::AxisRise { .. } | Term::RiseSquared => None,
     }
 }
 
@@ -103,18 +134,20 @@ fn triple(values: [f32; 3]) -> (f32, f32, f32) {
 
 #[pymethods]
 impl PyExtraTerm {
-    /// A term of `kind` with its `parameter` (see the getters), centre and coefficient per axis.
+    /// A term of `kind` with its `parameter` (see the getters), centre and coefficient per axis;
+    /// an 'aux' term's low-pass `time_constant_ms` (default 0: unfiltered).
     #[new]
-    #[pyo3(signature = (kind, parameter = None, *, centre, coefficient))]
+    #[pyo3(signature = (kind, parameter = None, *, centre, coefficient, time_constant_ms = None))]
     fn new(
         kind: &Bound<'_, PyAny>,
         parameter: Option<&Bound<'_, PyAny>>,
         centre: &Bound<'_, PyAny>,
         coefficient: &Bound<'_, PyAny>,
+        time_constant_ms: Option<&Bound<'_, PyAny>>,
     ) -> Result<Self, Error> {
         let kind = args::text("kind", kind)?;
         Ok(Self(ExtraTerm {
-            term: term(&kind, parameter)?,
+            term: term(&kind, parameter, time_constant_ms)?,
             centre: args::per_axis("centre", centre)?,
             coefficient: args::per_axis("coefficient", coefficient)?,
         }))
@@ -133,6 +166,13 @@ impl PyExtraTerm {
         parameter(self.0.term)
     }
 
+    /// The low-pass time constant, ms: an 'aux' term's (0: unfiltered), a 'temperature_rate'
+    /// term's (its `parameter`); `None` for the other kinds.
+    #[getter]
+    fn time_constant_ms(&self) -> Option<u32> {
+        time_constant(self.0.term)
+    }
+
     /// Per axis, the value the term is measured from (its calibration mean), in the term's unit.
     #[getter]
     fn centre(&self) -> (f32, f32, f32) {
@@ -147,8 +187,14 @@ impl PyExtraTerm {
 
     fn __repr__(&self) -> String {
         let parameter = parameter(self.0.term).map_or_else(String::new, |p| format!(", {p}"));
+        let filter = match self.0.term {
+            Term::Aux {
+                time_constant_ms, ..
+            } if time_constant_ms != 0 => format!(", time_constant_ms={time_constant_ms}"),
+            _ => String::new(),
+        };
         format!(
-            "ExtraTerm('{}'{parameter}, centre={:?}, coefficient={:?})",
+            "ExtraTerm('{}'{parameter}, centre={:?}, coefficient={:?}{filter})",
             kind_name(self.0.term),
             triple(self.0.centre),
             triple(self.0.coefficient)

@@ -26,7 +26,9 @@ def extended(models: dict[str, Model]) -> ModifiedTables:
 def terms() -> list[ExtraTerm]:
     return [
         ExtraTerm("temperature_rate", 5000, centre=(0.01, 0.012, 0.008), coefficient=(0.1, -0.08, 0.05)),
-        ExtraTerm("aux", 0, centre=[5.0] * 3, coefficient=np.array([0.01, -0.012, 0.008])),
+        ExtraTerm(
+            "aux", 0, centre=[5.0] * 3, coefficient=np.array([0.01, -0.012, 0.008]), time_constant_ms=2000
+        ),
         ExtraTerm("axis_rise", 0, centre=(2.0, 2.0, 2.0), coefficient=(0.0, 0.002, -0.0015)),
         ExtraTerm("rise_squared", centre=(6.0, 7.0, 5.0), coefficient=(0.0003, -0.0002, 0.0001)),
     ]
@@ -47,6 +49,7 @@ def test_extension_lists_the_terms_as_in_the_json(extended: ModifiedTables, vect
     assert isinstance(got, tuple) and len(got) == len(expected) == gyrodrift.MAX_EXTRA_TERMS
     assert [t.kind for t in got] == ["temperature_rate", "aux", "axis_rise", "rise_squared"]
     assert [t.parameter for t in got] == [5000, 0, 0, None]
+    assert [t.time_constant_ms for t in got] == [5000, 2000, None, None]
     for term, raw in zip(got, expected):
         # The JSON holds the f32 values printed shortest; the getters give the same f32s.
         assert term.centre == tuple(np.asarray(raw["centre"], dtype=np.float32).tolist())
@@ -58,6 +61,9 @@ def test_extension_lists_the_terms_as_in_the_json(extended: ModifiedTables, vect
 def test_extra_term_repr_reads_as_its_constructor() -> None:
     assert repr(ExtraTerm("aux", 2, centre=(5.0, 5.0, 5.0), coefficient=(0.5, 0.0, -0.25))) == (
         "ExtraTerm('aux', 2, centre=(5.0, 5.0, 5.0), coefficient=(0.5, 0.0, -0.25))"
+    )
+    assert repr(ExtraTerm("aux", 0, centre=(5, 5, 5), coefficient=(1, 0, 0), time_constant_ms=1000)) == (
+        "ExtraTerm('aux', 0, centre=(5.0, 5.0, 5.0), coefficient=(1.0, 0.0, 0.0), time_constant_ms=1000)"
     )
     assert repr(ExtraTerm("rise_squared", None, centre=(0, 0, 0), coefficient=(1, 1, 1))) == (
         "ExtraTerm('rise_squared', centre=(0.0, 0.0, 0.0), coefficient=(1.0, 1.0, 1.0))"
@@ -173,6 +179,17 @@ def test_with_extension_rejects_what_is_not_a_list_of_terms(
         (("aux", 0), {"centre": (1, 2)}, "`centre` must be a sequence of 3 floats (X, Y, Z), got tuple"),
         (
             ("aux", 0),
+            {"time_constant_ms": -1},
+            "`time_constant_ms` must be an integer in 0..=4294967295 (ms), got -1",
+        ),
+        (
+            ("temperature_rate", 2000),
+            {"time_constant_ms": 2000},
+            "`time_constant_ms` is only for kind 'aux' (a rate term's time constant is its "
+            '`parameter`), got 2000 for kind "temperature_rate"',
+        ),
+        (
+            ("aux", 0),
             {"coefficient": "abc"},
             "`coefficient` must be a sequence of 3 floats (X, Y, Z), got str",
         ),
@@ -196,7 +213,7 @@ def test_json_round_trip_keeps_the_extension(modified: ModifiedTables) -> None:
     model = modified.with_extension(terms()[1:3])
     text = model.to_json()
     assert [t["term"] for t in json.loads(text)["extension"]["terms"]] == [
-        {"Aux": {"input": 0}},
+        {"Aux": {"input": 0, "time_constant_ms": 2000}},
         {"AxisRise": {"axis": 0}},
     ]
     assert ModifiedTables.from_json(text) == model

@@ -218,7 +218,7 @@ fn scenarios() -> Vec<Scenario> {
         },
         Scenario {
             name: "extended-with-aux",
-            description: "the paper's tables plus 4 extra terms (temperature rate, supply voltage, X rise, rise²) at 33 °C with a sagging supply, a NaN supply reading (held, flagged) and 1-ms steps",
+            description: "the paper's tables plus 4 extra terms (temperature rate, supply voltage low-passed at τ = 2 s, X rise, rise²) at 33 °C with a sagging supply, a NaN supply reading (the supply term holds its filter, flagged) and 1-ms steps",
             model: "extended",
             switch_on_celsius: Some([33.0, 33.2, 32.8]),
             final_rise: [4.0, 5.0, 3.0],
@@ -245,7 +245,7 @@ fn scenarios() -> Vec<Scenario> {
         },
         Scenario {
             name: "extended-without-aux",
-            description: "the extended model corrected without auxiliary inputs: the supply term holds 0, flagged on every sample",
+            description: "the extended model corrected without auxiliary inputs: the supply term is 0 (no input yet), flagged on every sample; the other terms act",
             model: "extended",
             switch_on_celsius: Some([30.0, 30.0, 30.0]),
             final_rise: [4.0, 4.0, 4.0],

@@ -140,7 +140,10 @@ pub fn extended() -> FixtureTables {
             coefficient: [0.1, -0.08, 0.05],
         },
         ExtraTerm {
-            term: Term::Aux { input: 0 },
+            term: Term::Aux {
+                input: 0,
+                time_constant_ms: 2000,
+            },
             centre: [5.0; 3],
             coefficient: [0.01, -0.012, 0.008],
         },

@@ -122,7 +122,7 @@ class Flags(enum.IntFlag):
     temperature reading far outside any sensor): last good drift held."""
     EXTENSION_INPUT_INVALID = _gyrodrift.EXTENSION_INPUT_INVALID
     """Extended model: an auxiliary input an extra term reads is NaN/inf or was not passed
-    (`aux=None`): the extra terms' last good contribution held."""
+    (`aux=None`): that term holds its last filtered value (0 before any)."""
 
     @classmethod
     def faults(cls) -> Flags:

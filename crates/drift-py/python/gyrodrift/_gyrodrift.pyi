@@ -242,7 +242,9 @@ class ExtraTerm:
     - `'temperature_rate'`: the axis's temperature rate, °C/s, from a first-order low-pass of time
       constant `parameter` ms (every rate term of a model must use the same one);
     - `'aux'`: auxiliary input `parameter` (0 .. AUX_INPUTS), as passed in `aux=` to
-      `Corrector.correct`/`correct_batch`, in its own unit, shared by the axes;
+      `Corrector.correct`/`correct_batch`, in its own unit, shared by the axes, through a
+      first-order low-pass of time constant `time_constant_ms` (default 0: unfiltered; the
+      closed loop fits 1000 ms, so a recorded channel's sample noise stays out of the correction);
     - `'axis_rise'`: the rise since switch-on of axis `parameter` (0 = X, 1 = Y, 2 = Z), °C;
     - `'rise_squared'`: the axis's own rise squared, °C²; `parameter` is None.
 
@@ -257,6 +259,7 @@ class ExtraTerm:
         *,
         centre: _Floats3,
         coefficient: _Floats3,
+        time_constant_ms: int | None = None,
     ) -> ExtraTerm: ...
     @property
     def kind(self) -> _TermKind:
@@ -264,6 +267,10 @@ class ExtraTerm:
     @property
     def parameter(self) -> int | None:
         """The time constant (ms), auxiliary input index or axis index; None for 'rise_squared'."""
+    @property
+    def time_constant_ms(self) -> int | None:
+        """The low-pass time constant, ms: an 'aux' term's (0: unfiltered) or a
+        'temperature_rate' term's (its `parameter`); None for the other kinds."""
     @property
     def centre(self) -> tuple[float, float, float]:
         """Per axis, the value the term is measured from (its calibration mean), in its unit."""
@@ -382,7 +389,7 @@ class Corrector:
         `aux`: the sample's `AUX_INPUTS` auxiliary inputs (4 floats or a (4,) array, by input
         index), read by an extended model's 'aux' terms (drift-core's `correct_with_aux`); other
         models ignore them. Without `aux` (drift-core's `correct`), or with a NaN/inf input an
-        'aux' term reads, the extra terms' last good contribution is held, flagged
+        'aux' term reads, that term holds its last filtered value (0 before any), flagged
         EXTENSION_INPUT_INVALID.
         """
     def correct_batch(
