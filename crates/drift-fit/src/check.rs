@@ -127,7 +127,7 @@ impl<M: Model> UnitCheck<M> {
         settings: &FitSettings,
     ) -> Result<Self, ReadsAuxiliaryInput> {
         for term in &model.extension().terms {
-            if let Term::Aux { input } = term.term {
+            if let Term::Aux { input, .. } = term.term {
                 return Err(ReadsAuxiliaryInput { input });
             }
         }
