@@ -285,11 +285,28 @@ fn fused_block(
         ..
     } = constants;
     let readings = raw.get(..count)?;
-    if !readings.iter().fold(true, |all, raw| all & raw.is_finite()) {
+    let finite = |readings: &[f32]| readings.iter().fold(true, |all, raw| all & raw.is_finite());
+    // A whole block (the usual case) as a fixed-size array: no loop tail.
+    let all_finite = match <&[f32; BLOCK_SAMPLES]>::try_from(readings) {
+        Ok(whole) => finite(whole),
+        Err(_) => finite(readings),
+    };
+    if !all_finite {
         return None;
     }
-    let changes = changes(state.last_raw, raw, count);
     let after = usize::from(settings.stuck_after_samples);
+    if after == 0 || usize::from(state.repeats).saturating_add(count) < after {
+        return unstuck_block(
+            Inputs { rate, raw, count },
+            flags,
+            bias,
+            corrected,
+            &drift,
+            constants,
+            state,
+        );
+    }
+    let changes = changes(state.last_raw, raw, count);
     let Carried {
         mut repeats,
         mut last_raw,
@@ -357,6 +374,85 @@ fn fused_block(
         last_raw,
         bias_dps,
     })
+}
+
+/// [`fused_block`] when no reading of the block can reach the stuck threshold (the usual case with
+/// the default threshold): every reading healthy, one fused loop over the block.
+#[inline(always)]
+fn unstuck_block(
+    inputs: Inputs<'_>,
+    flags: &mut [Flags; BLOCK_SAMPLES],
+    bias: &mut [f32; BLOCK_SAMPLES],
+    corrected: &mut [f32; BLOCK_SAMPLES],
+    drift: &impl Fn(f32) -> (f32, Flags),
+    constants: Constants<'_>,
+    state: Carried,
+) -> Option<Carried> {
+    let Inputs { rate, raw, count } = inputs;
+    let readings = raw.get(..count)?;
+    let whole = whole_vectors(0, count, 4);
+    let all = fused_run(
+        rate.get(whole.clone())?,
+        raw.get(whole.clone())?,
+        flags.get_mut(whole.clone())?,
+        bias.get_mut(whole.clone())?,
+        corrected.get_mut(whole)?,
+        drift,
+        constants,
+    );
+    if !all {
+        return None;
+    }
+    // The stuck counter as `read_axis` leaves it: the repeats since the last change.
+    let repeats = match last_change(state.last_raw, readings) {
+        Some(change) => saturating_u16(count.saturating_sub(change).saturating_sub(1)),
+        None => state.repeats.saturating_add(saturating_u16(count)),
+    };
+    Some(Carried {
+        repeats,
+        last_raw: *readings.last()?,
+        bias_dps: *bias.get(count.checked_sub(1)?)?,
+    })
+}
+
+/// The index of the last reading that differs (in its bits) from the one before it, `previous`
+/// before the first; `None` if every reading repeats `previous`. Eight pairs at a time from the
+/// end, each eight one vector comparison.
+#[inline(always)]
+fn last_change(previous: f32, readings: &[f32]) -> Option<usize> {
+    let differs = |a: &f32, b: &f32| a.to_bits() != b.to_bits();
+    let mut end = readings.len();
+    while end > 8 {
+        let start = end.saturating_sub(8);
+        let now = readings
+            .get(start..end)
+            .and_then(|r| <&[f32; 8]>::try_from(r).ok());
+        let before = readings
+            .get(start.saturating_sub(1)..end.saturating_sub(1))
+            .and_then(|r| <&[f32; 8]>::try_from(r).ok());
+        let (Some(now), Some(before)) = (now, before) else {
+            break;
+        };
+        let any = now
+            .iter()
+            .zip(before)
+            .fold(0_u32, |any, (a, b)| any | (a.to_bits() ^ b.to_bits()));
+        if any != 0 {
+            let at = now.iter().zip(before).rposition(|(a, b)| differs(a, b));
+            return at.map(|at| start.saturating_add(at));
+        }
+        end = start;
+    }
+    // The first readings, the first of them against `previous`.
+    let head = readings.get(..end).unwrap_or_default();
+    let mut pairs = head.windows(2);
+    match pairs.rposition(|pair| matches!(pair, [before, now] if differs(now, before))) {
+        Some(at) => Some(at.saturating_add(1)),
+        None => head
+            .first()
+            .filter(|first| differs(first, &previous))
+            .map(|_| 0),
+    }
 }
 
 /// What the fused loop needs besides the readings.
