@@ -57,7 +57,7 @@ impl<S: Copy + Default> CorrectorState<S> {
     /// Corrects `samples` in order into `outputs` without auxiliary inputs and returns how many
     /// (the shorter of the two lengths): the same outputs and the same final state, bit for bit, as
     /// [`Self::correct`] sample by sample, faster for the polynomial baselines (which then use
-    /// ~9 KiB of stack).
+    /// ~12 KiB of stack).
     pub fn correct_block<M>(
         &mut self,
         model: &M,
@@ -533,8 +533,8 @@ fn whole_vectors(start: usize, end: usize, width: usize) -> core::ops::Range<usi
 /// it, `previous` before the first: where the runs of repeats start. The comparisons as one
 /// vectorised loop over the block, then eight bytes at a time into bits.
 #[inline(always)]
-fn changes(previous: f32, raw: &[f32; BLOCK_SAMPLES], count: usize) -> u64 {
-    const _: () = assert!(BLOCK_SAMPLES == 64, "one bit per reading in a u64");
+fn changes(previous: f32, raw: &[f32; BLOCK_SAMPLES], count: usize) -> u128 {
+    const _: () = assert!(BLOCK_SAMPLES == 128, "one bit per reading in a u128");
     let mut differs = [0_u8; BLOCK_SAMPLES];
     if let (Some((first, rest)), Some((&now, later))) =
         (differs.split_first_mut(), raw.split_first())
@@ -544,16 +544,16 @@ fn changes(previous: f32, raw: &[f32; BLOCK_SAMPLES], count: usize) -> u64 {
             *differs = u8::from(now.to_bits() != before.to_bits());
         }
     }
-    let mut changes = 0_u64;
+    let mut changes = 0_u128;
     for (shift, eight) in (0_u32..).step_by(8).zip(differs.chunks_exact(8)) {
         let bytes = <[u8; 8]>::try_from(eight).map_or(0, u64::from_le_bytes);
         // Bytes of 0 or 1 → one bit each: the product gathers byte k's bit into bit 56 + k.
-        changes |= (bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56) << shift;
+        changes |= u128::from(bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56) << shift;
     }
     let kept = u32::try_from(count)
         .ok()
-        .and_then(|count| 1_u64.checked_shl(count))
-        .map_or(u64::MAX, |bit| bit.wrapping_sub(1));
+        .and_then(|count| 1_u128.checked_shl(count))
+        .map_or(u128::MAX, |bit| bit.wrapping_sub(1));
     changes & kept
 }
 
