@@ -69,6 +69,21 @@ impl<S: Copy + Default> CorrectorState<S> {
         M::Axis: AxisModel<State = S>,
     {
         let count = samples.len().min(outputs.len());
+        // A model without the block form (the paper's), an extended model or a state that is not
+        // powered on: sample by sample, without lanes to zero or fill.
+        let settings = model.settings();
+        let answers = self.is_powered_on()
+            && model.extension().is_empty()
+            && (model.axes().iter().zip(&self.axes)).all(|(axis, state)| {
+                axis.drift_of_temperatures(settings, &state.model, Probe)
+                    .is_some()
+            });
+        if !answers {
+            for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
+                *output = self.correct(model, sample);
+            }
+            return count;
+        }
         let mut lanes = [EMPTY_LANE; AXES];
         let pairs = samples
             .chunks(BLOCK_SAMPLES)
@@ -190,6 +205,16 @@ impl<S: Copy + Default> CorrectorState<S> {
         }
         true
     }
+}
+
+/// Asks a model whether it has the block form, doing nothing with it.
+struct Probe;
+
+impl TemperatureBlock for Probe {
+    type Output = ();
+
+    #[inline(always)]
+    fn run(self, _drift: impl Fn(f32) -> (f32, Flags)) {}
 }
 
 /// What an axis's state carries from sample to sample through a block (besides the model's
