@@ -14,7 +14,7 @@
 //! pays the kernel's first-touch page faults.
 //!
 //! The checksum (XOR of every output's bits) lets the Python side check that it computed the same
-//! thing. Usage: `cargo run --release --example correct_throughput -- [samples] [repeats]`.
+//! thing. Usage: `cargo run --release --example correct_throughput -- [samples] [repeats] [model]`.
 
 use std::time::Instant;
 
@@ -106,15 +106,18 @@ fn main() -> anyhow::Result<()> {
     let modified: ModifiedTables = model(&vectors, "modified")?;
     let standard: PolynomialTables = model(&vectors, "standard")?;
     let third_order: PolynomialTables = model(&vectors, "third_order")?;
-    for (name, result) in [
-        ("modified", run(&modified, &samples, &mut outputs, repeats)?),
-        ("standard", run(&standard, &samples, &mut outputs, repeats)?),
-        (
-            "third_order",
-            run(&third_order, &samples, &mut outputs, repeats)?,
-        ),
-    ] {
-        let (seconds, fresh_seconds, checksum) = result;
+    // An optional third argument keeps one model (for a profile of one model's block path).
+    let only = args.get(2).map(String::as_str);
+    let wanted = |name: &str| only.is_none_or(|only| only == name);
+    for name in ["modified", "standard", "third_order"] {
+        if !wanted(name) {
+            continue;
+        }
+        let (seconds, fresh_seconds, checksum) = match name {
+            "modified" => run(&modified, &samples, &mut outputs, repeats)?,
+            "standard" => run(&standard, &samples, &mut outputs, repeats)?,
+            _ => run(&third_order, &samples, &mut outputs, repeats)?,
+        };
         println!(
             "{name} {count} {seconds:.6} {:.0} {:.0} {checksum:08x}",
             f64::from(count) / seconds,

@@ -201,8 +201,9 @@ fn main() -> Result<()> {
         for a in analysed {
             by_unit.entry(a.labels.unit_id.clone()).or_default().push(a);
         }
-        by_unit
-            .values()
+        let units: Vec<&Vec<Analysed>> = by_unit.values().collect();
+        units
+            .par_iter()
             .map(|activations| fit_unit(activations, settings))
             .collect::<Result<Vec<_>, _>>()
     });

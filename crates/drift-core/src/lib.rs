@@ -38,7 +38,7 @@ pub use extension::{
     Extension, ExtensionState, ExtraTerm, Term, TermInputs, TermValues, AUX_INPUTS, MAX_TERMS,
 };
 pub use flags::Flags;
-pub use model::{AxisModel, Model, BLOCK_SAMPLES};
+pub use model::{AxisModel, Model, TemperatureBlock, BLOCK_SAMPLES};
 pub use polynomial::{
     PolynomialAxis, PolynomialAxisState, PolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
 };

@@ -8,7 +8,7 @@ use heapless::Vec;
 
 use crate::error::{check_finite, Error, Location, Problem};
 use crate::flags::Flags;
-use crate::model::{AxisModel, Model, BLOCK_SAMPLES};
+use crate::model::{AxisModel, Model, TemperatureBlock};
 use crate::settings::Settings;
 use crate::AXES;
 
@@ -153,37 +153,63 @@ impl AxisModel for PolynomialAxis {
         (bias - state.at_switch_on_dps, flags)
     }
 
-    /// `drift` for a block of temperatures: the same operations per temperature as
-    /// [`PolynomialAxis::evaluate`], in the same order.
-    fn drift_of_temperatures(
+    /// `drift` as a function of the temperature: the same operations per temperature as
+    /// [`PolynomialAxis::evaluate`], in the same order, for the corrector's block loops.
+    fn drift_of_temperatures<B: TemperatureBlock>(
         &self,
         settings: &Settings,
         state: &Self::State,
-        celsius: &[f32; BLOCK_SAMPLES],
-        drift: &mut [f32; BLOCK_SAMPLES],
-        flags: &mut [Flags; BLOCK_SAMPLES],
-    ) -> bool {
-        let block = Block {
-            span: Span::new(self.range_celsius, settings.ambient_margin_celsius),
-            at_switch_on_dps: state.at_switch_on_dps,
-            celsius,
-        };
+        block: B,
+    ) -> Option<B::Output> {
+        let span = Span::new(self.range_celsius, settings.ambient_margin_celsius);
+        let at_switch_on_dps = state.at_switch_on_dps;
         // The coefficient count as a constant: each temperature goes through the whole
-        // polynomial in registers, one pass over the block (measured ~1.1× the block path's
+        // polynomial in registers, in one pass over the block (measured ~1.1× the block path's
         // speed against a pass per coefficient).
         let coefficients = self.coefficients.as_slice();
-        match coefficients.len() {
-            1 => block.fill_with::<1>(coefficients, drift, flags),
-            2 => block.fill_with::<2>(coefficients, drift, flags),
-            3 => block.fill_with::<3>(coefficients, drift, flags),
-            4 => block.fill_with::<4>(coefficients, drift, flags),
-            5 => block.fill_with::<5>(coefficients, drift, flags),
-            6 => block.fill_with::<6>(coefficients, drift, flags),
-            7 => block.fill_with::<7>(coefficients, drift, flags),
-            _ => block.fill_with::<MAX_POLYNOMIAL_COEFFICIENTS>(coefficients, drift, flags),
-        }
-        true
+        Some(match coefficients.len() {
+            1 => with_count::<1, B>(coefficients, span, at_switch_on_dps, block),
+            2 => with_count::<2, B>(coefficients, span, at_switch_on_dps, block),
+            3 => with_count::<3, B>(coefficients, span, at_switch_on_dps, block),
+            4 => with_count::<4, B>(coefficients, span, at_switch_on_dps, block),
+            5 => with_count::<5, B>(coefficients, span, at_switch_on_dps, block),
+            6 => with_count::<6, B>(coefficients, span, at_switch_on_dps, block),
+            7 => with_count::<7, B>(coefficients, span, at_switch_on_dps, block),
+            _ => with_count::<MAX_POLYNOMIAL_COEFFICIENTS, B>(
+                coefficients,
+                span,
+                at_switch_on_dps,
+                block,
+            ),
+        })
     }
+}
+
+/// `block` run with the polynomial's drift, the coefficients as an array of `N` when they are `N`.
+#[inline(always)]
+fn with_count<const N: usize, B: TemperatureBlock>(
+    coefficients: &[f32],
+    span: Span,
+    at_switch_on_dps: f32,
+    block: B,
+) -> B::Output {
+    match <[f32; N]>::try_from(coefficients) {
+        // By value (`move`): the block's loop may run out of line, with the coefficients its own.
+        Ok(fixed) => block.run(move |celsius| drift_at(span, at_switch_on_dps, celsius, &fixed)),
+        Err(_) => block.run(move |celsius| drift_at(span, at_switch_on_dps, celsius, coefficients)),
+    }
+}
+
+/// What `drift` returns at `celsius`: the polynomial minus its value at switch-on, and the flag.
+#[inline(always)]
+fn drift_at(span: Span, at_switch_on_dps: f32, celsius: f32, coefficients: &[f32]) -> (f32, Flags) {
+    let drift = horner(coefficients, span.normalised(celsius)) - at_switch_on_dps;
+    let flags = if span.outside(celsius) {
+        Flags::TEMPERATURE_OUT_OF_RANGE
+    } else {
+        Flags::NONE
+    };
+    (drift, flags)
 }
 
 /// A polynomial at `x`, constant term first: Horner's scheme from the highest coefficient. The
@@ -194,47 +220,6 @@ fn horner(coefficients: &[f32], x: f32) -> f32 {
         .iter()
         .rev()
         .fold(0.0_f32, |acc, &c| acc * x + c)
-}
-
-/// One block of temperatures through one axis's polynomial.
-struct Block<'a> {
-    span: Span,
-    at_switch_on_dps: f32,
-    celsius: &'a [f32; BLOCK_SAMPLES],
-}
-
-impl Block<'_> {
-    /// `drift` and `flags` for the block, the coefficients as an array of `N` when they are `N`.
-    #[inline(always)]
-    fn fill_with<const N: usize>(
-        &self,
-        coefficients: &[f32],
-        drift: &mut [f32; BLOCK_SAMPLES],
-        flags: &mut [Flags; BLOCK_SAMPLES],
-    ) {
-        match <[f32; N]>::try_from(coefficients) {
-            Ok(fixed) => self.fill(drift, flags, |x| horner(&fixed, x)),
-            Err(_) => self.fill(drift, flags, |x| horner(coefficients, x)),
-        }
-    }
-
-    #[inline(always)]
-    fn fill(
-        &self,
-        drift: &mut [f32; BLOCK_SAMPLES],
-        flags: &mut [Flags; BLOCK_SAMPLES],
-        polynomial: impl Fn(f32) -> f32,
-    ) {
-        let outputs = drift.iter_mut().zip(flags.iter_mut());
-        for ((drift, flags), &celsius) in outputs.zip(self.celsius) {
-            *drift = polynomial(self.span.normalised(celsius)) - self.at_switch_on_dps;
-            *flags = if self.span.outside(celsius) {
-                Flags::TEMPERATURE_OUT_OF_RANGE
-            } else {
-                Flags::NONE
-            };
-        }
-    }
 }
 
 /// A polynomial baseline for a whole unit.

@@ -104,6 +104,12 @@ impl Windows {
             .chain(std::iter::repeat_n(self.last, ends))
     }
 
+    /// [`Self::records`] as a lattice: `(first, spacing, points, last)` — sample 0, then `points`
+    /// lattice points `first + j·spacing`, then `last` (none of it without windows).
+    pub fn lattice(&self) -> (usize, usize, usize, usize) {
+        (self.offset, self.spacing, self.lattice_points, self.last)
+    }
+
     /// Number of records ([`Self::records`]).
     pub fn record_count(&self) -> usize {
         match self.queries {

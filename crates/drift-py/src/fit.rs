@@ -56,8 +56,10 @@ fn fit_segments(
     for a in analysed {
         by_unit.entry(a.labels.unit_id.clone()).or_default().push(a);
     }
-    by_unit
-        .values()
+    // The units are independent: on rayon's threads too (in unit order).
+    let units: Vec<&Vec<Analysed>> = by_unit.values().collect();
+    units
+        .par_iter()
         .map(|activations| fit_unit(activations, settings).map_err(Error::from))
         .collect()
 }
