@@ -3,7 +3,7 @@
 //! A model whose drift depends on the temperature alone (the polynomial baselines) hands the
 //! corrector its drift as a function of the temperature ([`AxisModel::drift_of_temperatures`]),
 //! which runs inside loops over [`BLOCK_SAMPLES`] readings per axis. In the common case — every
-//! reading of the block finite, no reading that can reach the stuck threshold, every drift finite —
+//! reading of the block finite, no reading that can reach the stuck threshold, every drift plausible —
 //! one fused loop per axis does what `correct_axis` does per sample (conversion, model, flags,
 //! bias, output), which the compiler vectorises. Otherwise that axis goes through the general
 //! block path: the model's answers for the block, then, with the same operations in the same order
@@ -227,7 +227,7 @@ struct Carried {
 }
 
 /// The fused path of one axis's block, for the common case: every reading finite and every drift
-/// finite. The readings are split into runs of repeats of one value (the stuck counter within a
+/// plausible. The readings are split into runs of repeats of one value (the stuck counter within a
 /// run is known from where it starts); the healthy part of each run goes through one loop that
 /// does what `correct_axis` does for a healthy reading with a finite drift — the conversion, the
 /// model, the flags, the held bias (the model's answer), the output — and which the compiler
@@ -490,8 +490,8 @@ struct Constants<'a> {
 }
 
 /// Healthy readings through the model and into the outputs (one slice each, so the compiler knows
-/// they do not overlap); whether every drift was finite (if not, the general path holds and flags
-/// it).
+/// they do not overlap); whether every drift was plausible (if not, the general path holds and
+/// flags it).
 #[inline(always)]
 fn fused_run(
     rate: &[f32],
@@ -508,7 +508,8 @@ fn fused_run(
         initial_bias_dps,
         activation_flags,
     } = constants;
-    // Branch-free, so the loop vectorises; `all` says afterwards whether every drift was finite.
+    // Branch-free, so the loop vectorises; `all` says afterwards whether every drift was
+    // plausible (finite and within MAX_PLAUSIBLE_DRIFT_DPS).
     let mut all = true;
     let outputs = flags
         .iter_mut()
@@ -516,7 +517,7 @@ fn fused_run(
         .zip(corrected.iter_mut());
     for ((&rate, &raw), ((flags, bias), corrected)) in rate.iter().zip(raw).zip(outputs) {
         let (drift, model_flags) = drift(settings.celsius_with(raw, celsius_per_raw));
-        all &= drift.is_finite();
+        all &= super::plausible(drift);
         // As `read_axis`, `hold_drift` and `axis_output` for a healthy reading and a finite
         // drift: the checks' flags and the model's, the held bias, the output.
         *flags = activation_flags | rate_flag(rate) | model_flags;
