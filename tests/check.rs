@@ -126,6 +126,15 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     assert!(text.contains("GIU-02/modified.bin"), "{text}");
     assert!(!missing.exists());
 
+    // A limit that means nothing is refused before anything is read.
+    let (out, text) = check(&campaign, &tables, &missing, &["--max-rms", "-1"]);
+    assert!(!out.status.success());
+    assert!(
+        text.contains("--max-rms must be a finite number ≥ 0, got -1"),
+        "{text}"
+    );
+    assert!(!missing.exists());
+
     // The baselines are checked the same way (the standard one removes less: a looser limit).
     let standard = dir.path().join("standard");
     let loose = [

@@ -52,13 +52,13 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "modified")]
     pub model: Stored,
     /// Most drift left per activation (mean over activations, per axis), °/s.
-    #[arg(long, default_value_t = Limits::default().max_drift_dps)]
+    #[arg(long, default_value_t = Limits::default().max_drift_dps, allow_negative_numbers = true)]
     pub max_drift: f64,
     /// Largest residual bias RMS (per axis), °/s.
-    #[arg(long, default_value_t = Limits::default().max_residual_rms_dps)]
+    #[arg(long, default_value_t = Limits::default().max_residual_rms_dps, allow_negative_numbers = true)]
     pub max_rms: f64,
     /// Smallest share (0…1) of the uncorrected drift the tables must remove.
-    #[arg(long, default_value_t = Limits::default().min_removed)]
+    #[arg(long, default_value_t = Limits::default().min_removed, allow_negative_numbers = true)]
     pub min_removed: f64,
     /// Fit settings as JSON (the switch-on window and the low-pass the fit used).
     #[arg(long)]
@@ -80,7 +80,7 @@ struct UnitResult {
     activations: Vec<CheckedActivation>,
 }
 
-/// The image a unit carries, decoded; refuses what it cannot check.
+/// The image a unit carries, decoded; errors name the file.
 fn load<M: Image>(path: &Path) -> anyhow::Result<M> {
     let bytes = std::fs::read(path).with_context(|| {
         format!(
@@ -173,6 +173,15 @@ fn markdown(results: &[UnitResult], limits: &str) -> String {
 /// Runs `gyrodrift check`; fails (exit status 1) when any unit × axis misses a limit, after
 /// writing the report.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    for (flag, value) in [
+        ("--max-drift", args.max_drift),
+        ("--max-rms", args.max_rms),
+        ("--min-removed", args.min_removed),
+    ] {
+        if !value.is_finite() || value < 0.0 {
+            bail!("{flag} must be a finite number ≥ 0, got {value}");
+        }
+    }
     let files = pipeline::recording_files(&args.recordings)?;
     let settings = load_settings(args.settings.as_deref())?;
     let steps = Steps::new(args.quiet);
