@@ -142,15 +142,14 @@ impl AxisModel for PolynomialAxis {
         temperature_celsius: f32,
         _rise_celsius: f32,
     ) -> (f32, Flags) {
-        let (bias, outside) = self.evaluate(temperature_celsius, settings.ambient_margin_celsius);
-        let flags = if outside {
-            Flags::TEMPERATURE_OUT_OF_RANGE
-        } else {
-            Flags::NONE
-        };
         // Split as initial bias + drift since switch-on, like the modified model, so the two report
-        // comparable quantities.
-        (bias - state.at_switch_on_dps, flags)
+        // comparable quantities. The block path runs the same `drift_at`.
+        drift_at(
+            Span::new(self.range_celsius, settings.ambient_margin_celsius),
+            state.at_switch_on_dps,
+            temperature_celsius,
+            &self.coefficients,
+        )
     }
 
     /// `drift` as a function of the temperature: the same operations per temperature as
@@ -200,7 +199,8 @@ fn with_count<const N: usize, B: TemperatureBlock>(
     }
 }
 
-/// What `drift` returns at `celsius`: the polynomial minus its value at switch-on, and the flag.
+/// The drift at `celsius` (the polynomial minus its value at switch-on) and the flag: the one
+/// formula of the per-sample `drift` and the block path.
 #[inline(always)]
 fn drift_at(span: Span, at_switch_on_dps: f32, celsius: f32, coefficients: &[f32]) -> (f32, Flags) {
     let drift = horner(coefficients, span.normalised(celsius)) - at_switch_on_dps;
