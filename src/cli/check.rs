@@ -96,6 +96,7 @@ fn check_all<M: Model + Image>(
     args: &Args,
     files: &[PathBuf],
     settings: &FitSettings,
+    limits: &Limits,
     steps: &Steps,
 ) -> anyhow::Result<Vec<UnitResult>> {
     let mut units: BTreeMap<String, (PathBuf, UnitCheck<M>)> = BTreeMap::new();
@@ -121,25 +122,24 @@ fn check_all<M: Model + Image>(
             check.add(segment);
         }
     }
-    let limits = Limits {
-        max_drift_dps: args.max_drift,
-        max_residual_rms_dps: args.max_rms,
-        min_removed: args.min_removed,
-    };
     Ok(units
         .into_iter()
         .map(|(unit_id, (image, check))| UnitResult {
-            axes: check.verdicts(&limits),
-            activations: check.activations().to_vec(),
+            axes: check.verdicts(limits),
+            activations: check.into_activations(),
             unit_id,
             image,
         })
         .collect())
 }
 
-fn markdown(results: &[UnitResult], limits: &str) -> String {
-    let mut md = format!(
-        "# Calibration check\n\nThe stored firmware image of each unit, run through drift-core's corrector over every activation recorded (unit static), against the limits {limits}. Drift: max − min of the 1-s low-passed rate per activation, mean over activations; residual RMS: RMS of the 1-s low-passed corrected rate (includes the switch-on bias the tables predict).\n\n| unit | axis | activations | uncorrected drift | drift left | worst | removed | residual RMS | ambient out of range | rise out of span | past last reference | faults | verdict |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n"
+/// The axis names, by axis index.
+const AXES: [&str; 3] = ["X", "Y", "Z"];
+
+/// The verdicts as a Markdown table (printed, and the heart of `check.md`).
+fn table(results: &[UnitResult]) -> String {
+    let mut md = String::from(
+        "| unit | axis | activations | uncorrected drift | drift left | worst | removed | residual RMS | ambient out of range | rise out of span | past last reference | faults | verdict |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
     );
     for unit in results {
         for v in &unit.axes {
@@ -147,7 +147,7 @@ fn markdown(results: &[UnitResult], limits: &str) -> String {
                 md,
                 "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.0} % | {:.4} | {} | {} | {} | {} | {} |",
                 unit.unit_id,
-                ["X", "Y", "Z"][v.axis],
+                AXES[v.axis],
                 v.activations,
                 v.uncorrected_drift_dps,
                 v.corrected_drift_dps,
@@ -166,6 +166,18 @@ fn markdown(results: &[UnitResult], limits: &str) -> String {
             );
         }
     }
+    md
+}
+
+/// `check.md`: what was checked against which limits, the table, what its columns mean.
+fn markdown(results: &[UnitResult], limits: &Limits) -> String {
+    let mut md = format!(
+        "# Calibration check\n\nThe stored firmware image of each unit, run through drift-core's corrector over every activation recorded (unit static), against the limits: drift left ≤ {} °/s, residual RMS ≤ {} °/s, removed ≥ {:.0} %. Drift: max − min of the 1-s low-passed rate per activation, mean over activations; residual RMS: RMS of the 1-s low-passed corrected rate (includes the switch-on bias the tables predict).\n\n",
+        limits.max_drift_dps,
+        limits.max_residual_rms_dps,
+        100.0 * limits.min_removed
+    );
+    md.push_str(&table(results));
     md.push_str("\nThe flag columns count activations: switched on outside the calibrated ambients, rise outside the stored curves (both clamped), running past the last reference time (`k` held), as the corrector documents; \"faults\" counts activations with a sensor or table fault flag. An activation outside the envelope measures the envelope as much as the tables.\n");
     md
 }
@@ -173,47 +185,37 @@ fn markdown(results: &[UnitResult], limits: &str) -> String {
 /// Runs `gyrodrift check`; fails (exit status 1) when any unit × axis misses a limit, after
 /// writing the report.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    for (flag, value) in [
-        ("--max-drift", args.max_drift),
-        ("--max-rms", args.max_rms),
-        ("--min-removed", args.min_removed),
-    ] {
-        if !value.is_finite() || value < 0.0 {
-            bail!("{flag} must be a finite number ≥ 0, got {value}");
-        }
+    let limits = Limits {
+        max_drift_dps: args.max_drift,
+        max_residual_rms_dps: args.max_rms,
+        min_removed: args.min_removed,
+    };
+    if let Some((field, value)) = limits.invalid() {
+        let flag = match field {
+            "max_drift_dps" => "--max-drift",
+            "max_residual_rms_dps" => "--max-rms",
+            _ => "--min-removed",
+        };
+        bail!("{flag} must be a finite number ≥ 0, got {value}");
     }
     let files = pipeline::recording_files(&args.recordings)?;
     let settings = load_settings(args.settings.as_deref())?;
     let steps = Steps::new(args.quiet);
     let results = match args.model {
-        Stored::Modified => check_all::<ModifiedTables>(args, &files, &settings, &steps)?,
+        Stored::Modified => check_all::<ModifiedTables>(args, &files, &settings, &limits, &steps)?,
         Stored::Standard | Stored::ThirdOrder => {
-            check_all::<PolynomialTables>(args, &files, &settings, &steps)?
+            check_all::<PolynomialTables>(args, &files, &settings, &limits, &steps)?
         }
     };
     steps.finish();
-    let limits = format!(
-        "drift left ≤ {} °/s, residual RMS ≤ {} °/s, removed ≥ {:.0} %",
-        args.max_drift,
-        args.max_rms,
-        100.0 * args.min_removed
-    );
     let md = markdown(&results, &limits);
     let json = serde_json::to_string_pretty(&serde_json::json!({
-        "limits": {
-            "max_drift_dps": args.max_drift,
-            "max_residual_rms_dps": args.max_rms,
-            "min_removed": args.min_removed,
-        },
+        "limits": limits,
         "units": results,
     }))?;
     write_atomic(&args.out.join("check.json"), json.as_bytes())?;
     write_atomic(&args.out.join("check.md"), md.as_bytes())?;
-    let table_start = md.find("| unit").unwrap_or(0);
-    let table_end = md[table_start..]
-        .find("\n\n")
-        .map_or(md.len(), |end| table_start + end);
-    println!("{}", &md[table_start..table_end]);
+    print!("{}", table(&results));
     println!("report: {}", args.out.join("check.md").display());
     let failed: Vec<String> = results
         .iter()
@@ -221,7 +223,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             u.axes
                 .iter()
                 .filter(|v| !v.passed())
-                .map(move |v| format!("{} {}", u.unit_id, ["X", "Y", "Z"][v.axis]))
+                .map(move |v| format!("{} {}", u.unit_id, AXES[v.axis]))
         })
         .collect();
     if !failed.is_empty() {

@@ -29,6 +29,19 @@ pub struct Limits {
     pub min_removed: f64,
 }
 
+impl Limits {
+    /// The first limit that means nothing (negative, NaN or infinite), as (field name, value).
+    pub fn invalid(&self) -> Option<(&'static str, f64)> {
+        [
+            ("max_drift_dps", self.max_drift_dps),
+            ("max_residual_rms_dps", self.max_residual_rms_dps),
+            ("min_removed", self.min_removed),
+        ]
+        .into_iter()
+        .find(|(_, value)| !value.is_finite() || *value < 0.0)
+    }
+}
+
 impl Default for Limits {
     fn default() -> Self {
         Self {
@@ -165,6 +178,11 @@ impl<M: Model> UnitCheck<M> {
         &self.activations
     }
 
+    /// The activations checked, given up with the check.
+    pub fn into_activations(self) -> Vec<CheckedActivation> {
+        self.activations
+    }
+
     /// The verdict per axis against `limits` (an axis without activations fails: nothing was
     /// checked).
     pub fn verdicts(&self, limits: &Limits) -> [AxisVerdict; 3] {
@@ -285,6 +303,21 @@ mod tests {
         let nan = verdict(&[activation(0.03, f64::NAN, 0.003, 0)], 0, &limits);
         assert_eq!(nan.failures.len(), 2, "a NaN never passes: {nan:?}");
         assert!(!verdict(&[], 0, &limits).passed());
+    }
+
+    #[test]
+    fn limits_that_mean_nothing_are_named() {
+        assert_eq!(Limits::default().invalid(), None);
+        let negative = Limits {
+            max_residual_rms_dps: -1.0,
+            ..Limits::default()
+        };
+        assert_eq!(negative.invalid(), Some(("max_residual_rms_dps", -1.0)));
+        let nan = Limits {
+            min_removed: f64::NAN,
+            ..Limits::default()
+        };
+        assert_eq!(nan.invalid().map(|(name, _)| name), Some("min_removed"));
     }
 
     #[test]

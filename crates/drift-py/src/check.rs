@@ -13,24 +13,26 @@ use crate::errors::Error;
 use crate::fit_settings;
 use crate::sources::{self, Source};
 
-/// A limit: a finite number ≥ 0.
-fn limit(name: &str, value: f64) -> Result<f64, Error> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(Error::Input(format!(
-            "`{name}` must be a finite number ≥ 0, got {value}"
-        )))
-    }
-}
-
-/// The limits from the keyword arguments.
+/// The limits from the keyword arguments (drift-fit says which are valid).
 pub fn limits(max_drift: f64, max_rms: f64, min_removed: f64) -> Result<Limits, Error> {
-    Ok(Limits {
-        max_drift_dps: limit("max_drift", max_drift)?,
-        max_residual_rms_dps: limit("max_rms", max_rms)?,
-        min_removed: limit("min_removed", min_removed)?,
-    })
+    let limits = Limits {
+        max_drift_dps: max_drift,
+        max_residual_rms_dps: max_rms,
+        min_removed,
+    };
+    match limits.invalid() {
+        None => Ok(limits),
+        Some((field, value)) => {
+            let argument = match field {
+                "max_drift_dps" => "max_drift",
+                "max_residual_rms_dps" => "max_rms",
+                _ => "min_removed",
+            };
+            Err(Error::Input(format!(
+                "`{argument}` must be a finite number ≥ 0, got {value}"
+            )))
+        }
+    }
 }
 
 /// Corrects every activation of `source` (one unit's) with `model`; one record per axis.
