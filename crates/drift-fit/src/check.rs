@@ -23,7 +23,8 @@ pub struct Limits {
     pub max_drift_dps: f64,
     /// Largest RMS of the 1-s low-passed corrected rate, °/s: the residual bias, including the
     /// switch-on bias the tables predict (which ageing moves) and the turn-on repeatability.
-    /// Default 0.02: twice the largest a freshly fitted simulated unit leaves on its own data.
+    /// Default 0.02: above the 0.006–0.014 a freshly fitted simulated unit leaves on its own data
+    /// (seed 5, `gyrodrift check` in docs/fitting.md), below what another unit's tables leave.
     pub max_residual_rms_dps: f64,
     /// Smallest share of the uncorrected drift the tables must remove (0…1). Default 0.5.
     pub min_removed: f64,
