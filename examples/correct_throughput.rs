@@ -14,7 +14,10 @@
 //! pays the kernel's first-touch page faults.
 //!
 //! The checksum (XOR of every output's bits) lets the Python side check that it computed the same
-//! thing. Usage: `cargo run --release --example correct_throughput -- [samples] [repeats] [model]`.
+//! thing. Usage: `cargo run --release --example correct_throughput -- [samples] [repeats] [model|all]
+//! [stuck_after]`. The test vectors' models count 20 identical temperature readings as a stuck sensor
+//! (so the vectors exercise that path), which holds about 60 % of this stream's samples; a
+//! `stuck_after` of 2000 (drift-core's default) measures the typical case, where none is stuck.
 
 use std::time::Instant;
 
@@ -103,11 +106,21 @@ fn main() -> anyhow::Result<()> {
     let vectors: serde_json::Value = serde_json::from_str(VECTORS)?;
     let samples: Vec<Sample> = (0..count).map(sample).collect();
     let mut outputs = vec![Output::default(); samples.len()];
-    let modified: ModifiedTables = model(&vectors, "modified")?;
-    let standard: PolynomialTables = model(&vectors, "standard")?;
-    let third_order: PolynomialTables = model(&vectors, "third_order")?;
+    let mut modified: ModifiedTables = model(&vectors, "modified")?;
+    let mut standard: PolynomialTables = model(&vectors, "standard")?;
+    let mut third_order: PolynomialTables = model(&vectors, "third_order")?;
+    if let Some(stuck_after) = args.get(3) {
+        let stuck_after: u16 = stuck_after.parse().context("stuck_after (0..=65535)")?;
+        for settings in [
+            &mut modified.settings,
+            &mut standard.settings,
+            &mut third_order.settings,
+        ] {
+            settings.stuck_after_samples = stuck_after;
+        }
+    }
     // An optional third argument keeps one model (for a profile of one model's block path).
-    let only = args.get(2).map(String::as_str);
+    let only = args.get(2).map(String::as_str).filter(|only| *only != "all");
     let wanted = |name: &str| only.is_none_or(|only| only == name);
     for name in ["modified", "standard", "third_order"] {
         if !wanted(name) {
