@@ -36,7 +36,7 @@ cargo build -p drift-core --target thumbv7em-none-eabihf --release --locked
 
 step "tests: workspace (all features) and drift-core without default features"
 cargo test --workspace --all-features --locked
-cargo test -p drift-core --no-default-features --locked --lib
+cargo test -p drift-core --no-default-features --locked  # the vectors and image tests need serde (required-features)
 
 step "fuzz targets: format and compile on stable (the corpora are replayed by the tests above)"
 # Fuzzing itself (nightly, minutes per target) is scripts/fuzz.sh; Miri over drift-core takes

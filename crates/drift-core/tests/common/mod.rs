@@ -13,6 +13,11 @@
     missing_docs
 )]
 
+// The shared vectors are JSON and carry firmware images: they need the `serde` feature. The
+// fixture does not, so the fault, extension and property tests also run without it
+// (`cargo test -p drift-core --no-default-features`).
+#[cfg(feature = "serde")]
 pub mod cases;
 pub mod fixture;
+#[cfg(feature = "serde")]
 pub mod format;
