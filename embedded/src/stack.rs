@@ -5,7 +5,7 @@ use core::ptr::{read_volatile, write_volatile};
 
 const PATTERN: u32 = 0x5AA5_C33C;
 /// How deep below the caller's stack pointer to paint, bytes.
-const DEPTH: usize = 64 * 1024;
+pub const DEPTH: usize = 256 * 1024;
 /// Words just below the stack pointer left unpainted (the probe's own use).
 const MARGIN: usize = 32;
 

@@ -127,33 +127,52 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
     const KIND: Kind = Kind::Modified;
 
     fn from_payload(version: u16, payload: &[u8]) -> postcard::Result<(Self, &[u8])> {
+        // One function per version, never inlined: each needs stack for its own copy of the
+        // tables, and in one frame they would add up.
         match version {
-            1 => {
-                let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)?;
-                let tables = Self {
-                    settings: v1.settings,
-                    axes: v1.axes,
-                    extension: Extension::NONE,
-                };
-                Ok((tables, rest))
-            }
-            2 => {
-                let (v2, rest) = postcard::take_from_bytes::<ModifiedTablesV2<R, A, C>>(payload)?;
-                let mut extension = Extension::NONE;
-                for term in v2.terms {
-                    // The same capacity on both sides: never full.
-                    let _ = extension.terms.push(term.into());
-                }
-                let tables = Self {
-                    settings: v2.settings,
-                    axes: v2.axes,
-                    extension,
-                };
-                Ok((tables, rest))
-            }
-            _ => postcard::take_from_bytes(payload),
+            1 => from_v1(payload),
+            2 => from_v2(payload),
+            _ => from_current(payload),
         }
     }
+}
+
+#[inline(never)]
+fn from_v1<const R: usize, const A: usize, const C: usize>(
+    payload: &[u8],
+) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
+    let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)?;
+    let tables = ModifiedTables {
+        settings: v1.settings,
+        axes: v1.axes,
+        extension: Extension::NONE,
+    };
+    Ok((tables, rest))
+}
+
+#[inline(never)]
+fn from_v2<const R: usize, const A: usize, const C: usize>(
+    payload: &[u8],
+) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
+    let (v2, rest) = postcard::take_from_bytes::<ModifiedTablesV2<R, A, C>>(payload)?;
+    let mut extension = Extension::NONE;
+    for term in v2.terms {
+        // The same capacity on both sides: never full.
+        let _ = extension.terms.push(term.into());
+    }
+    let tables = ModifiedTables {
+        settings: v2.settings,
+        axes: v2.axes,
+        extension,
+    };
+    Ok((tables, rest))
+}
+
+#[inline(never)]
+fn from_current<const R: usize, const A: usize, const C: usize>(
+    payload: &[u8],
+) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
+    postcard::take_from_bytes(payload)
 }
 
 impl Image for PolynomialTables {
