@@ -277,7 +277,8 @@ pub fn run(
     let twin_field: Vec<&Segment> = twin
         .iter()
         .filter(|s| {
-            s.labels.series_kind == SeriesKind::Field && is(VALIDATION, s.labels.set_point_celsius)
+            s.labels.series_kind == SeriesKind::Field
+                && is(VALIDATION, s.labels.nominal_set_point_celsius())
         })
         .collect();
     let offset: [f64; 3] = std::array::from_fn(|a| {
