@@ -235,10 +235,22 @@ impl Plan {
         Ok(())
     }
 
-    /// Every set point recorded: the calibration ones, then the validation one.
+    /// Every set point recorded, in recording order: the lowest and the highest calibration set
+    /// point, the validation one, then the calibration ones between. The simulator's random
+    /// streams and clock follow the file order, so a third calibration ambient only adds files
+    /// after those of the two-point experiment: both see the same +30, +40 and +33 °C activations
+    /// (bit for bit), and the comparison is of the calibration alone.
     pub fn set_points(&self) -> Vec<f64> {
-        let mut all = self.calibration.clone();
+        let c = &self.calibration;
+        let (Some(&lowest), Some(&highest)) = (c.first(), c.last()) else {
+            return vec![VALIDATION];
+        };
+        let mut all = vec![lowest];
+        if highest > lowest {
+            all.push(highest);
+        }
         all.push(VALIDATION);
+        all.extend(c.iter().filter(|&&t| t > lowest && t < highest));
         all
     }
 }
@@ -396,4 +408,28 @@ pub fn run(
             }
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_third_calibration_ambient_is_recorded_after_the_two_point_experiments_files() {
+        let two = Plan::default();
+        assert_eq!(two.set_points(), [30.0, 40.0, 33.0]);
+        let three = Plan {
+            calibration: vec![30.0, 35.0, 40.0],
+            ..Plan::default()
+        };
+        assert_eq!(three.set_points(), [30.0, 40.0, 33.0, 35.0]);
+        three.check().unwrap();
+        for refused in [vec![30.0], vec![40.0, 30.0], vec![30.0, 33.0, 40.0]] {
+            let plan = Plan {
+                calibration: refused,
+                ..Plan::default()
+            };
+            assert!(plan.check().is_err(), "{plan:?}");
+        }
+    }
 }
