@@ -4,8 +4,11 @@
 //!
 //! ```sh
 //! cargo run --release --example closed_loop -- [--seeds 1] [--first-seed 1] [--sessions 6] \
-//!     [--scale 1] [--effects thermal_lag,supply_voltage]
+//!     [--scale 1] [--effects thermal_lag,supply_voltage] [--calibration 30,40]
 //! ```
+//!
+//! `--calibration` sets the calibration set points (°C, increasing; +33 °C is the validation set
+//! point and cannot be one); the protocol and field sessions are recorded at each.
 
 use gyrodrift::closed_loop::{run, Plan, Row};
 
@@ -43,8 +46,31 @@ fn print(r: &Row) {
     );
 }
 
+const USAGE: &str = "closed_loop [--seeds 1] [--first-seed 1] [--sessions 6] [--scale 1] \
+[--effects none,thermal_lag,…] [--calibration 30,40]";
+const FLAGS: [&str; 6] = [
+    "--seeds",
+    "--first-seed",
+    "--sessions",
+    "--scale",
+    "--effects",
+    "--calibration",
+];
+
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("{USAGE}\neffects: {}", EFFECTS.join(", "));
+        return Ok(());
+    }
+    // A mistyped flag would otherwise run the whole experiment with a default in its place.
+    for pair in args.chunks(2) {
+        anyhow::ensure!(
+            FLAGS.contains(&pair[0].as_str()) && pair.len() == 2,
+            "`{}` is not a flag with a value; usage: {USAGE}",
+            pair[0]
+        );
+    }
     let value = |flag: &str| {
         args.iter()
             .position(|a| a == flag)
@@ -52,10 +78,16 @@ fn main() -> anyhow::Result<()> {
     };
     let seeds: u64 = value("--seeds").map_or(Ok(1), |s| s.parse())?;
     let first_seed: u64 = value("--first-seed").map_or(Ok(1), |s| s.parse())?;
+    let defaults = Plan::default();
     let plan = Plan {
-        sessions: value("--sessions").map_or(Ok(6), |s| s.parse())?,
-        scale: value("--scale").map_or(Ok(1.0), |s| s.parse())?,
+        sessions: value("--sessions").map_or(Ok(defaults.sessions), |s| s.parse())?,
+        scale: value("--scale").map_or(Ok(defaults.scale), |s| s.parse())?,
+        calibration: value("--calibration").map_or(Ok(defaults.calibration), |s| {
+            s.split(',').map(|t| t.trim().parse::<f64>()).collect()
+        })?,
     };
+    plan.check()?;
+    eprintln!("calibration set points {:?} °C", plan.calibration);
     let effects: Vec<String> = value("--effects").map_or_else(
         || EFFECTS.map(String::from).to_vec(),
         |s| s.split(',').map(String::from).collect(),
@@ -87,10 +119,11 @@ fn main() -> anyhow::Result<()> {
             )
         };
         println!(
-            "{effect}: diagnosis significant on {}; a term admitted on {}; scale {}, {} field activations measured and {} trained on per run",
+            "{effect}: diagnosis significant on {}; a term admitted on {}; scale {}, calibration at {:?} °C, {} field activations measured and {} trained on per run",
             share(&|r| r.significant),
             share(&|r| !r.admitted.is_empty()),
             plan.scale,
+            plan.calibration,
             of.first().map_or(0, |r| r.field_activations),
             of.first().map_or(0, |r| r.training_activations),
         );

@@ -1,8 +1,9 @@
 //! The closed-loop experiment of `docs/closed-loop.md` (run by `examples/closed_loop.rs`, checked
 //! by `tests/closed_loop.rs`): for one hidden simulator effect (or none), simulate a campaign with
 //! that effect switched on and the fitter told nothing; fit the paper's tables on the +30/+40 °C
-//! protocol activations; diagnose the residual on field-like activations at +30/+40 °C (inside the
-//! calibrated ambient range); offer the significant winners as the extended model's terms, admit
+//! protocol activations (or other calibration set points: [`Plan::calibration`]); diagnose the
+//! residual on field-like activations at the calibration set points (inside the calibrated ambient
+//! range); offer the significant winners as the extended model's terms, admit
 //! each where the refitted model lowers the held-out error, fit their coefficients there and
 //! refit the tables; report the error before and after on the +33 °C field activations (never
 //! fitted or chosen on) beside the noise floor of a zero-drift twin unit recorded the same way.
@@ -20,8 +21,10 @@ use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{read_recording, Segment, SeriesKind};
 use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, UnitModel};
 
-const CALIBRATION: [f64; 2] = [30.0, 40.0];
-const VALIDATION: f64 = 33.0;
+/// The paper's calibration set points (°C).
+pub const DEFAULT_CALIBRATION: [f64; 2] = [30.0, 40.0];
+/// The set point the error is measured at (°C): never a calibration one.
+pub const VALIDATION: f64 = 33.0;
 
 /// Field-like use without ambient ramps or carried units (the paper's own field gap, reported
 /// on its own row): random off-times, supply voltage and orientation changing per activation,
@@ -60,8 +63,9 @@ pub fn scaled(mut effects: HiddenEffects, scale: f64) -> HiddenEffects {
     effects
 }
 
-/// The campaign of one run: the paper's protocol at +30/+40 °C (fewer intervals and repeats than
-/// the default, to keep a run short) and `plan.sessions` field sessions at +30, +40 and +33 °C.
+/// The campaign of one run: the paper's protocol (fewer intervals and repeats than the default, to
+/// keep a run short) and `plan.sessions` field sessions at each calibration set point
+/// (`plan.calibration`, +30/+40 °C by default) and at +33 °C.
 pub fn campaign(
     seed: u64,
     effect: &str,
@@ -109,6 +113,7 @@ pub fn campaign(
             effects
         },
         truth_bias: drift_sim::campaign::TruthBias::AuxRate,
+        set_points_celsius: plan.set_points(),
         ..Campaign::default()
     })
 }
@@ -184,13 +189,70 @@ impl Row {
     }
 }
 
-/// The experiment's size.
-#[derive(Debug, Clone, Copy)]
+/// The experiment's size and calibration.
+#[derive(Debug, Clone)]
 pub struct Plan {
     /// Field sessions per set point (8 activations each).
     pub sessions: u32,
     /// Effect magnitude relative to the simulator's defaults.
     pub scale: f64,
+    /// Calibration set points (°C), strictly increasing, without [`VALIDATION`]: the protocol is
+    /// recorded at each, and the field sessions there are the training activations. A third one
+    /// between +30 and +40 °C tests whether an ambient dependence the two-point interpolation
+    /// misses is a calibration gap rather than a missing term.
+    pub calibration: Vec<f64>,
+}
+
+impl Default for Plan {
+    /// The experiment of `docs/closed-loop.md`: 6 sessions, the simulator's magnitudes, +30/+40 °C.
+    fn default() -> Self {
+        Self {
+            sessions: 6,
+            scale: 1.0,
+            calibration: DEFAULT_CALIBRATION.to_vec(),
+        }
+    }
+}
+
+impl Plan {
+    /// Refuses calibration set points the experiment cannot use: fewer than two (the paper's
+    /// table interpolates between ambients), not strictly increasing, or including the
+    /// validation set point (its activations would be fitted on and then measured on).
+    pub fn check(&self) -> anyhow::Result<()> {
+        let c = &self.calibration;
+        anyhow::ensure!(
+            c.len() >= 2,
+            "need at least two calibration set points, got {c:?}"
+        );
+        anyhow::ensure!(
+            c.windows(2).all(|w| w[0] < w[1]) && c.iter().all(|t| t.is_finite()),
+            "calibration set points must be finite and strictly increasing, got {c:?}"
+        );
+        anyhow::ensure!(
+            !c.iter().any(|&t| is(VALIDATION, t)),
+            "{VALIDATION} °C is the validation set point: it cannot be calibrated on"
+        );
+        Ok(())
+    }
+
+    /// Every set point recorded, in recording order: the lowest and the highest calibration set
+    /// point, the validation one, then the calibration ones between. The simulator's random
+    /// streams and clock follow the file order, so a third calibration ambient only adds files
+    /// after those of the two-point experiment: both see the same +30, +40 and +33 °C activations
+    /// (bit for bit), and the comparison is of the calibration alone.
+    pub fn set_points(&self) -> Vec<f64> {
+        let c = &self.calibration;
+        let (Some(&lowest), Some(&highest)) = (c.first(), c.last()) else {
+            return vec![VALIDATION];
+        };
+        let mut all = vec![lowest];
+        if highest > lowest {
+            all.push(highest);
+        }
+        all.push(VALIDATION);
+        all.extend(c.iter().filter(|&&t| t > lowest && t < highest));
+        all
+    }
 }
 
 /// Runs the experiment for one effect and seed in `work` (recordings are deleted afterwards);
@@ -202,6 +264,8 @@ pub fn run(
     settings: &FitSettings,
     plan_size: &Plan,
 ) -> anyhow::Result<Vec<Row>> {
+    plan_size.check()?;
+    let calibration = &plan_size.calibration;
     let dir = work.join(format!("{effect}-{seed}"));
     let twin_dir = work.join(format!("{effect}-{seed}-floor"));
     simulate_campaign(
@@ -216,13 +280,13 @@ pub fn run(
         |_| {},
     )?;
     let all = segments(&dir)?;
-    let analysed = Roles::split(&all, &CALIBRATION)
+    let analysed = Roles::split(&all, calibration)
         .calibration
         .iter()
         .map(|s| analyse(s, settings))
         .collect::<Result<Vec<_>, _>>()?;
     let base = fit_unit(&analysed, settings)?;
-    let closed = close(&base, &all, &CALIBRATION, settings, true)?;
+    let closed = close(&base, &all, calibration, settings, true)?;
     eprintln!(
         "  {} field activations at the calibration set points inside the calibrated ambient range, {} outside held out",
         closed.roles.training.len(),
@@ -253,9 +317,29 @@ pub fn run(
             if a.admitted { "admitted" } else { "left out" }
         );
     }
+    let held_out = closed.before_after(&base, settings);
+    // The +33 °C protocol activations, on stderr only: the paper's own validation, where the
+    // histories are the calibration's. An error that shows there too is the tables' interpolation
+    // between ambients; one that shows only in the field comes from use differing from calibration.
+    let protocol: Vec<&BeforeAfter> = held_out
+        .iter()
+        .filter(|r| r.series_kind == "protocol" && is(VALIDATION, r.set_point_celsius))
+        .collect();
+    for a in 0..3 {
+        let of = |f: &dyn Fn(&BeforeAfter) -> f64| {
+            mean(&protocol.iter().map(|r| f(r)).collect::<Vec<_>>())
+        };
+        eprintln!(
+            "  +{VALIDATION} °C protocol, {} activations, axis {a}: drift {:.4} → {:.4}, RMS {:.4} → {:.4} °/s",
+            protocol.len(),
+            of(&|r| r.drift_dps[a].0),
+            of(&|r| r.drift_dps[a].1),
+            of(&|r| r.rms_dps[a].0),
+            of(&|r| r.rms_dps[a].1),
+        );
+    }
     // Measured on: the +33 °C field activations (never fitted or chosen on).
-    let measured: Vec<BeforeAfter> = closed
-        .before_after(&base, settings)
+    let measured: Vec<BeforeAfter> = held_out
         .into_iter()
         .filter(|r| r.series_kind == "field" && is(VALIDATION, r.set_point_celsius))
         .collect();
@@ -277,7 +361,8 @@ pub fn run(
     let twin_field: Vec<&Segment> = twin
         .iter()
         .filter(|s| {
-            s.labels.series_kind == SeriesKind::Field && is(VALIDATION, s.labels.set_point_celsius)
+            s.labels.series_kind == SeriesKind::Field
+                && is(VALIDATION, s.labels.nominal_set_point_celsius())
         })
         .collect();
     let offset: [f64; 3] = std::array::from_fn(|a| {
@@ -343,4 +428,28 @@ pub fn run(
             }
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_third_calibration_ambient_is_recorded_after_the_two_point_experiments_files() {
+        let two = Plan::default();
+        assert_eq!(two.set_points(), [30.0, 40.0, 33.0]);
+        let three = Plan {
+            calibration: vec![30.0, 35.0, 40.0],
+            ..Plan::default()
+        };
+        assert_eq!(three.set_points(), [30.0, 40.0, 33.0, 35.0]);
+        three.check().unwrap();
+        for refused in [vec![30.0], vec![40.0, 30.0], vec![30.0, 33.0, 40.0]] {
+            let plan = Plan {
+                calibration: refused,
+                ..Plan::default()
+            };
+            assert!(plan.check().is_err(), "{plan:?}");
+        }
+    }
 }

@@ -12,6 +12,7 @@ fn rows(effect: &str, seed: u64) -> Vec<Row> {
     let plan = Plan {
         sessions: 3,
         scale: 4.0,
+        ..Plan::default()
     };
     run(effect, seed, work.path(), &FitSettings::default(), &plan).unwrap()
 }

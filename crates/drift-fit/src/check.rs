@@ -263,6 +263,7 @@ mod tests {
             labels: SegmentLabels {
                 unit_id: "GIU-01".to_owned(),
                 set_point_celsius: 30.0,
+                session_set_point_celsius: None,
                 series_kind: drift_recording::SeriesKind::Protocol,
                 series: 1,
                 repeat: 1,

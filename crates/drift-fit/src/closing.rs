@@ -32,7 +32,8 @@ pub struct Closed<'a> {
 /// The error of one held-out activation with the paper's model and with the extended one.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BeforeAfter {
-    /// Chamber set point, °C.
+    /// The set point the activation belongs to (the recording's nominal one; with ambient ramps
+    /// the ambient at switch-on differs), °C.
     pub set_point_celsius: f64,
     /// `protocol` or `field`.
     pub series_kind: &'static str,
@@ -111,7 +112,7 @@ impl Closed<'_> {
                     _ => (drift_before, rms_before),
                 };
                 BeforeAfter {
-                    set_point_celsius: segment.labels.set_point_celsius,
+                    set_point_celsius: segment.labels.nominal_set_point_celsius(),
                     series_kind: segment.labels.series_kind.as_str(),
                     drift_dps: std::array::from_fn(|a| (drift_before[a], drift_after[a])),
                     rms_dps: std::array::from_fn(|a| (rms_before[a], rms_after[a])),

@@ -629,6 +629,7 @@ mod tests {
             labels: SegmentLabels {
                 unit_id: "U".into(),
                 set_point_celsius: 25.0,
+                session_set_point_celsius: None,
                 series_kind: SeriesKind::Protocol,
                 series,
                 repeat: 1,

@@ -57,6 +57,7 @@ fn activation(
         labels: SegmentLabels {
             unit_id: "u".into(),
             set_point_celsius: 33.0,
+            session_set_point_celsius: None,
             series_kind: SeriesKind::Field,
             series: 1,
             repeat: 1,

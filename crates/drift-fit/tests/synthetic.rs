@@ -44,6 +44,7 @@ fn segment(set_point: f64, interval_min: f64, activation: u32) -> Segment {
         labels: SegmentLabels {
             unit_id: "synthetic".into(),
             set_point_celsius: set_point,
+            session_set_point_celsius: None,
             series_kind: SeriesKind::Protocol,
             series: 1,
             repeat: 1,

@@ -91,6 +91,7 @@ impl PyLabels {
         Ok(Self(SegmentLabels {
             unit_id,
             set_point_celsius: set_point,
+            session_set_point_celsius: None,
             series_kind: series_kind.map_or(Ok(SeriesKind::Protocol), self::series_kind)?,
             series: count("series", series)?,
             repeat: count("repeat", repeat)?,

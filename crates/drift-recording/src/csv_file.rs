@@ -846,6 +846,7 @@ fn to_segment(
     let labels = SegmentLabels {
         unit_id: options.unit_id.clone(),
         set_point_celsius: set_point,
+        session_set_point_celsius: options.set_point_celsius,
         series_kind: options.series_kind,
         series: u32::try_from(k + 1).unwrap_or(u32::MAX),
         repeat: 1,

@@ -112,6 +112,8 @@ struct Opened {
     metadata: BTreeMap<String, String>,
     unit_id: String,
     sample_rate_hz: u32,
+    /// The metadata's `set_point_celsius`, when it has one.
+    session_set_point_celsius: Option<f64>,
 }
 
 fn open(path: &Path) -> Result<Opened, ReadError> {
@@ -225,11 +227,23 @@ fn open_bytes(path: &Path, buf: Vec<u8>) -> Result<Opened, ReadError> {
             "sample_rate_hz must divide 10⁹, got {sample_rate_hz}"
         )));
     }
+    // Optional (an imported log may not know it), but a value that is there must be a number:
+    // the activations' roles are decided by it.
+    let session_set_point_celsius = metadata
+        .get("set_point_celsius")
+        .map(|s| match s.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(meta_err(format!(
+                "set_point_celsius must be a finite number of °C, got `{s}`"
+            ))),
+        })
+        .transpose()?;
     Ok(Opened {
         buf,
         metadata,
         unit_id,
         sample_rate_hz,
+        session_set_point_celsius,
     })
 }
 
@@ -259,6 +273,7 @@ fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
         metadata,
         unit_id,
         sample_rate_hz,
+        session_set_point_celsius,
     } = opened;
     let mcap_err = |e| ReadError::Mcap {
         path: path.to_path_buf(),
@@ -268,6 +283,7 @@ fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
         path,
         unit_id: &unit_id,
         rate_hz: sample_rate_hz,
+        session_set_point_celsius,
         open: None,
         segments: Vec::new(),
         topics: HashMap::new(),
@@ -302,6 +318,8 @@ struct Reader<'p> {
     path: &'p Path,
     unit_id: &'p str,
     rate_hz: u32,
+    /// The recording's nominal set point, copied into every activation's labels.
+    session_set_point_celsius: Option<f64>,
     open: Option<Open>,
     segments: Vec<Segment>,
     topics: HashMap<String, TopicState>,
@@ -392,6 +410,7 @@ impl Reader<'_> {
             let labels = SegmentLabels {
                 unit_id: self.unit_id.to_owned(),
                 set_point_celsius: e.set_point_celsius,
+                session_set_point_celsius: self.session_set_point_celsius,
                 series_kind: kind,
                 series: e.series,
                 repeat: e.repeat,

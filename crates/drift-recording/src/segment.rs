@@ -58,8 +58,15 @@ impl SeriesKind {
 pub struct SegmentLabels {
     /// Unit id (from the recording metadata).
     pub unit_id: String,
-    /// Chamber set point at switch-on (°C).
+    /// Chamber set point at switch-on (°C): the power event's. In a field session whose chamber
+    /// ramps, this is the ambient of the moment, not the session's set point.
     pub set_point_celsius: f64,
+    /// The chamber set point the whole recording was made at (°C; the recording metadata's
+    /// `set_point_celsius`, nominal for field files); `None` when the metadata does not say.
+    /// Which set point an activation *belongs to* (calibration, validation) is this one: with
+    /// ambient ramps almost no activation switches on exactly at the nominal set point.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub session_set_point_celsius: Option<f64>,
     /// Protocol or field.
     pub series_kind: SeriesKind,
     /// Series number within the file (from 1).
@@ -72,6 +79,16 @@ pub struct SegmentLabels {
     pub interval_min: Option<f64>,
     /// Off-time before this switch-on as logged by the bench (s); `None` if unknown.
     pub off_before_s: Option<f64>,
+}
+
+impl SegmentLabels {
+    /// The set point the activation belongs to: the recording's nominal set point when it gives
+    /// one, else the chamber set point at switch-on (a recording without the metadata key, or a
+    /// segment made in memory).
+    pub fn nominal_set_point_celsius(&self) -> f64 {
+        self.session_set_point_celsius
+            .unwrap_or(self.set_point_celsius)
+    }
 }
 
 /// An auxiliary channel of one activation, at its own rate.

@@ -49,6 +49,7 @@ fn segment(
         labels: SegmentLabels {
             unit_id: "BENCH-9".into(),
             set_point_celsius: 30.0,
+            session_set_point_celsius: None,
             series_kind: SeriesKind::Protocol,
             series: 1,
             repeat: 1,

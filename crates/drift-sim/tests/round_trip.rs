@@ -133,6 +133,7 @@ fn labels_aux_channels_and_sample_counts_match_the_campaign() {
             })
         );
         assert_eq!(l.set_point_celsius, 30.0);
+        assert_eq!(l.session_set_point_celsius, Some(30.0));
         assert_eq!(seg.len(), 3000);
         assert_eq!(seg.since_power_on_ms(2999), Some(2999));
         for name in [
@@ -165,6 +166,10 @@ fn labels_aux_channels_and_sample_counts_match_the_campaign() {
         assert_eq!(seg.labels.series_kind, SeriesKind::Field);
         assert_eq!(seg.labels.interval_min, None);
         assert!(seg.len() >= 2000 && seg.len() <= 4000 && seg.len() % 100 == 0);
+        // Every activation belongs to the file's set point, wherever the ramp had taken the
+        // chamber at its switch-on.
+        assert_eq!(seg.labels.session_set_point_celsius, Some(-10.0));
+        assert_eq!(seg.labels.nominal_set_point_celsius(), -10.0);
     }
 }
 
