@@ -120,7 +120,10 @@ fn main() -> anyhow::Result<()> {
         }
     }
     // An optional third argument keeps one model (for a profile of one model's block path).
-    let only = args.get(2).map(String::as_str).filter(|only| *only != "all");
+    let only = args
+        .get(2)
+        .map(String::as_str)
+        .filter(|only| *only != "all");
     let wanted = |name: &str| only.is_none_or(|only| only == name);
     for name in ["modified", "standard", "third_order"] {
         if !wanted(name) {
