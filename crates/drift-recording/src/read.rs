@@ -410,7 +410,11 @@ impl Reader<'_> {
             let labels = SegmentLabels {
                 unit_id: self.unit_id.to_owned(),
                 set_point_celsius: e.set_point_celsius,
-                session_set_point_celsius: self.session_set_point_celsius,
+                // `None` when it says what the switch-on label says: one form for one meaning,
+                // so labels made in memory (without it) read back equal from the file.
+                session_set_point_celsius: self
+                    .session_set_point_celsius
+                    .filter(|&nominal| nominal != e.set_point_celsius),
                 series_kind: kind,
                 series: e.series,
                 repeat: e.repeat,

@@ -62,7 +62,8 @@ pub struct SegmentLabels {
     /// ramps, this is the ambient of the moment, not the session's set point.
     pub set_point_celsius: f64,
     /// The chamber set point the whole recording was made at (°C; the recording metadata's
-    /// `set_point_celsius`, nominal for field files); `None` when the metadata does not say.
+    /// `set_point_celsius`, nominal for field files); `None` when the metadata does not say, or
+    /// says the same as `set_point_celsius` (one form per meaning: labels round-trip).
     /// Which set point an activation *belongs to* (calibration, validation) is this one: with
     /// ambient ramps almost no activation switches on exactly at the nominal set point.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -133,7 +133,9 @@ fn labels_aux_channels_and_sample_counts_match_the_campaign() {
             })
         );
         assert_eq!(l.set_point_celsius, 30.0);
-        assert_eq!(l.session_set_point_celsius, Some(30.0));
+        // The file's nominal set point is the switch-on one here: said once (`None`).
+        assert_eq!(l.session_set_point_celsius, None);
+        assert_eq!(l.nominal_set_point_celsius(), 30.0);
         assert_eq!(seg.len(), 3000);
         assert_eq!(seg.since_power_on_ms(2999), Some(2999));
         for name in [
@@ -168,7 +170,6 @@ fn labels_aux_channels_and_sample_counts_match_the_campaign() {
         assert!(seg.len() >= 2000 && seg.len() <= 4000 && seg.len() % 100 == 0);
         // Every activation belongs to the file's set point, wherever the ramp had taken the
         // chamber at its switch-on.
-        assert_eq!(seg.labels.session_set_point_celsius, Some(-10.0));
         assert_eq!(seg.labels.nominal_set_point_celsius(), -10.0);
     }
 }
