@@ -63,17 +63,6 @@ def best_of(repeats: int, run: Callable[[], T]) -> tuple[float, T]:
     return best, result
 
 
-def best_timed(repeats: int, run: Callable[[], tuple[float, T]]) -> tuple[float, T]:
-    """Best of `repeats` seconds that `run` timed itself (what it set up is not counted) and the last
-    result."""
-    best, result = float("inf"), None
-    for _ in range(repeats):
-        seconds, result = run()
-        best = min(best, seconds)
-    assert result is not None
-    return best, result
-
-
 class Table:
     """Rows of (what, figure, ratio, floor) printed as Markdown; remembers failed floors."""
 
