@@ -112,6 +112,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             refs.join(", "),
             args.out.join(&unit.unit_id).display()
         );
+        // What the fit decided or found that a reader must know (dropped curves, stage 3's premise).
+        for note in &unit.notes {
+            println!("  note: {note}");
+        }
     }
     Ok(())
 }

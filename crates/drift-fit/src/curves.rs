@@ -70,6 +70,8 @@ pub struct AveragedCurve {
     pub drift_dps: [Vec<f64>; 3],
     /// Mean temperature rise, °C.
     pub rise_celsius: [Vec<f64>; 3],
+    /// Mean sensor temperature at switch-on, per axis, °C: how warm the history left the unit.
+    pub switch_on_celsius: [f64; 3],
 }
 
 impl AveragedCurve {
@@ -137,6 +139,7 @@ fn average(key: CurveKey, members: &[&Analysed]) -> AveragedCurve {
         members: members.len(),
         drift_dps: [0, 1, 2].map(|axis| mean(members, len, |m| &m.drift_dps[axis])),
         rise_celsius: [0, 1, 2].map(|axis| mean(members, len, |m| &m.rise_celsius[axis])),
+        switch_on_celsius: mean_of(members, |a| a.switch_on_celsius),
     }
 }
 

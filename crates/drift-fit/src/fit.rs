@@ -254,6 +254,11 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
             )));
         }
     }
+    notes.extend(
+        crate::history_order::crossings(&set_points, first)
+            .iter()
+            .map(|c| c.note()),
+    );
     let protocol: Vec<&Analysed> = activations
         .iter()
         .filter(|a| CurveKey::of(a, settings).is_some())

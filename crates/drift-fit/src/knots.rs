@@ -239,6 +239,7 @@ mod tests {
                     members: 1,
                     drift_dps: [drift.clone(), drift.clone(), drift],
                     rise_celsius: [rise.clone(), rise.clone(), rise],
+                    switch_on_celsius: [30.0; 3],
                 })
                 .collect(),
         }

@@ -19,6 +19,7 @@ pub mod error;
 pub mod evaluate;
 pub mod extend;
 pub mod fit;
+pub mod history_order;
 pub mod knots;
 pub mod lowpass;
 pub mod measured;

@@ -1,0 +1,67 @@
+//! Stage 3's premise on simulated physics: the fit says when the rise no longer tells heating
+//! histories apart (heating power that grows with temperature), and says nothing when it does.
+
+use drift_fit::pipeline::{self, Options};
+use drift_fit::FitSettings;
+use drift_sim::hidden::RiseNonlinearity;
+use drift_sim::{simulate_campaign, Campaign, HiddenEffects, Protocol};
+
+/// The paper's protocol at +30/+40 °C with the 1-, 2- and 30-min series, once.
+fn campaign(effects: HiddenEffects) -> Campaign {
+    Campaign {
+        name: "history-order".into(),
+        seed: 3,
+        units: 1,
+        set_points_celsius: vec![30.0, 40.0],
+        protocol: Some(Protocol {
+            intervals_min: vec![1.0, 2.0, 30.0],
+            repeats: 1,
+            ..Protocol::default()
+        }),
+        effects,
+        ..Campaign::default()
+    }
+}
+
+/// The fit's notes about stage 3.
+fn stage3_notes(effects: HiddenEffects) -> Vec<String> {
+    let dir = tempfile::tempdir().unwrap();
+    simulate_campaign(&campaign(effects), dir.path(), |_| {}).unwrap();
+    let files = pipeline::recording_files(dir.path()).unwrap();
+    let options = Options {
+        calibration_set_points: vec![30.0, 40.0],
+        validation_set_points: vec![],
+        fit: FitSettings::default(),
+        held_out_repeats: false,
+        evaluate: false,
+    };
+    let outcome = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap();
+    outcome.fitted[0]
+        .notes
+        .iter()
+        .filter(|n| n.contains("stage 3"))
+        .cloned()
+        .collect()
+}
+
+#[test]
+fn heating_power_growing_with_temperature_makes_the_curves_cross() {
+    let effects = HiddenEffects {
+        rise_nonlinearity: Some(RiseNonlinearity { per_c: 0.1 }),
+        ..HiddenEffects::default()
+    };
+    let notes = stage3_notes(effects);
+    // Every set point and axis: the 2-min series' warm starts out-heat colder starts early on.
+    assert_eq!(notes.len(), 6, "{notes:#?}");
+    for (note, prefix) in notes
+        .iter()
+        .zip(["30 °C, X", "30 °C, Y", "30 °C, Z", "40 °C, X"])
+    {
+        assert!(note.starts_with(prefix), "{note}");
+    }
+}
+
+#[test]
+fn a_unit_without_the_effect_keeps_the_papers_order() {
+    assert_eq!(stage3_notes(HiddenEffects::default()), Vec::<String>::new());
+}
