@@ -286,6 +286,9 @@ pub fn run(
         .map(|s| analyse(s, settings))
         .collect::<Result<Vec<_>, _>>()?;
     let base = fit_unit(&analysed, settings)?;
+    for crossing in &base.crossings {
+        eprintln!("  tables: {}", crossing.note());
+    }
     let closed = close(&base, &all, calibration, settings, true)?;
     eprintln!(
         "  {} field activations at the calibration set points inside the calibrated ambient range, {} outside held out",

@@ -35,6 +35,32 @@ pub struct Args {
     pub extend: bool,
 }
 
+/// Where the tables' own history lookup fails, as Markdown: no per-sample candidate can carry it
+/// (the lookup picks the wrong curve), so it is said before the ranking.
+fn crossings_markdown(fitted: &FittedUnit) -> String {
+    if fitted.crossings.is_empty() {
+        return String::from("The calibration curves keep the paper's order (a warmer start rises less at every moment), so stage 3 can tell heating histories apart by the rise.\n\n");
+    }
+    let mut md = String::from("## The tables' history lookup\n\nStage 3 finds an activation's heating history by its rise, which assumes a warmer start rises less. In these calibration curves warmer starts rise more (worst pair per set point and axis); stage 3 then reads the drift/rise ratio of another history on every activation. No term of the candidates below repairs a wrong lookup: an input that names the history (the off-time before switch-on) would. `examples/stage3_oracle.rs` measures what it costs.\n\n| set point | axis | warmer start | colder start | switched on warmer by | rises more by | at | pairs crossing |\n|---:|---|---|---|---:|---:|---:|---:|\n");
+    for c in &fitted.crossings {
+        let _ = writeln!(
+            md,
+            "| {:+.1} °C | {} | {} | {} | {:.2} °C | {:.3} °C | {:.1} s | {} of {} |",
+            c.set_point_celsius,
+            ["X", "Y", "Z"][c.axis],
+            c.warmer.name(),
+            c.colder.name(),
+            c.switched_on_warmer_by_celsius,
+            c.rise_excess_celsius,
+            f64::from(c.at_ms) / 1000.0,
+            c.crossing_pairs,
+            c.compared_pairs
+        );
+    }
+    md.push('\n');
+    md
+}
+
 /// The ranking as Markdown.
 pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
     let mut md = String::from("## Diagnosis of the residual after the paper's model\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: one-sided test of the held-out improvement per activation, Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
@@ -188,8 +214,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 roles.held_out.len()
             );
         }
+        md.push_str(&crossings_markdown(fitted));
         md.push_str(&markdown(axes, args.top));
         println!("{unit}:");
+        for crossing in &fitted.crossings {
+            println!("  tables: {}", crossing.note());
+        }
         for axis in axes.iter() {
             let chosen = axis
                 .chosen()

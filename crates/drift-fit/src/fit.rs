@@ -10,6 +10,7 @@ use crate::analyse::Analysed;
 use crate::baselines;
 use crate::curves::{group, CurveKey, SetPointCurves};
 use crate::error::FitError;
+use crate::history_order::{crossings, Crossing};
 use crate::knots::{choose, k_window, mean_window};
 use crate::parallel::per_axis;
 use crate::settings::FitSettings;
@@ -37,8 +38,12 @@ pub struct FittedUnit {
     pub set_points: Vec<SetPointCurves>,
     /// The curve keys kept, in table order before the per-reference-time sort.
     pub curve_keys: Vec<CurveKey>,
-    /// Things the fit decided that a reader should know (dropped curves, nudged ties).
+    /// Things the fit decided or found that a reader should know (dropped curves, nudged ties,
+    /// the crossings below).
     pub notes: Vec<String>,
+    /// Where the rise fails to tell heating histories apart (stage 3's premise), worst per set
+    /// point × axis; empty when it holds.
+    pub crossings: Vec<Crossing>,
 }
 
 fn check(settings: &FitSettings) -> Result<(), FitError> {
@@ -254,11 +259,8 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
             )));
         }
     }
-    notes.extend(
-        crate::history_order::crossings(&set_points, first)
-            .iter()
-            .map(|c| c.note()),
-    );
+    let crossings = crossings(&set_points, first);
+    notes.extend(crossings.iter().map(Crossing::note));
     let protocol: Vec<&Analysed> = activations
         .iter()
         .filter(|a| CurveKey::of(a, settings).is_some())
@@ -316,5 +318,6 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
         curve_keys: common.into_iter().collect(),
         set_points,
         notes,
+        crossings,
     })
 }
