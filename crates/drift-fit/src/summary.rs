@@ -37,7 +37,9 @@ impl Split {
 pub struct Record {
     /// Unit id.
     pub unit: String,
-    /// Chamber set point, °C.
+    /// The set point the activations belong to, °C: their recording's nominal one
+    /// ([`drift_recording::SegmentLabels::nominal_set_point_celsius`]), not the ambient at
+    /// switch-on, which differs in field sessions whose ambient ramps.
     pub set_point_celsius: f64,
     /// Which data.
     pub split: Split,
@@ -53,12 +55,14 @@ pub struct Record {
     pub activations: usize,
 }
 
-/// Averages activation results into records, one per unit × set point × split × model × axis.
+/// Averages activation results into records, one per unit × set point × split × model × axis;
+/// the set point is each activation's nominal one (a ramped field session gives one row, not one
+/// per ambient at switch-on).
 pub fn summarise(results: &[(Split, ActivationResult)]) -> Vec<Record> {
     type Key = (String, i64, Split, ModelKind, usize);
     let mut sums: BTreeMap<Key, (f64, f64, usize)> = BTreeMap::new();
     for (split, result) in results {
-        let set_point = (result.labels.set_point_celsius * 1000.0).round() as i64;
+        let set_point = (result.labels.nominal_set_point_celsius() * 1000.0).round() as i64;
         for model in &result.models {
             for axis in 0..3 {
                 let entry = sums
