@@ -153,10 +153,10 @@ def test_ramped_field_labels_give_the_sessions_nominal_set_point(tmp_path: Path)
     gyrodrift.simulate(tmp_path, campaign)
     (recording,) = gyrodrift.load_campaign(tmp_path)
     labels = [s.labels for s in recording.segments]
-    assert len(labels) == 6 and all(l.series_kind == "field" for l in labels)
-    assert all(l.nominal_set_point_celsius == 33.0 for l in labels)
+    assert len(labels) == 6 and all(lab.series_kind == "field" for lab in labels)
+    assert all(lab.nominal_set_point_celsius == 33.0 for lab in labels)
     # The ambient at switch-on ramps away from the set point (it starts there).
-    assert any(l.set_point_celsius != 33.0 for l in labels)
+    assert any(lab.set_point_celsius != 33.0 for lab in labels)
     # Labels made in Python have no session set point: the switch-on one is the nominal one.
     assert gyrodrift.Labels(unit_id="U", set_point_celsius=31.5).nominal_set_point_celsius == 31.5
     with pytest.raises(AttributeError):
