@@ -161,3 +161,8 @@ def test_ramped_field_labels_give_the_sessions_nominal_set_point(tmp_path: Path)
     assert gyrodrift.Labels(unit_id="U", set_point_celsius=31.5).nominal_set_point_celsius == 31.5
     with pytest.raises(AttributeError):
         labels[0].nominal_set_point_celsius = 30.0  # type: ignore[misc]
+    # A recording built from them keeps the session's set point: the labels read back equal.
+    gyrodrift.Recording(recording.segments).save(tmp_path / "copy.mcap")
+    copy = gyrodrift.Recording.load(tmp_path / "copy.mcap")
+    assert copy.metadata["set_point_celsius"] == "33"
+    assert [s.labels for s in copy.segments] == labels
