@@ -1,5 +1,6 @@
 //! End to end on small simulated campaigns: simulate → fit → correct → the floors; the fit
-//! never depends on validation recordings; bad campaigns give clear errors.
+//! never depends on validation recordings; field sessions whose ambient ramps are evaluated under
+//! their nominal set point; bad campaigns give clear errors.
 
 use std::path::Path;
 
@@ -7,7 +8,7 @@ use drift_fit::evaluate::ModelKind;
 use drift_fit::pipeline::{self, Options, Outcome};
 use drift_fit::summary::{summarise, Split};
 use drift_fit::FitSettings;
-use drift_sim::{simulate_campaign, Campaign, Protocol};
+use drift_sim::{simulate_campaign, Campaign, Field, Protocol, UnitModel};
 
 fn small(seed: u64, noise_scale: f64) -> Campaign {
     Campaign {
@@ -182,5 +183,97 @@ fn a_campaign_without_first_activations_is_refused_clearly() {
     assert!(
         format!("{error:#}").contains("no protocol activations at the calibration set points"),
         "{error:#}"
+    );
+}
+
+/// A short protocol (enough for a fit) and one field session per set point whose ambient ramps
+/// and is carried: its activations switch on at ambients other than the set point.
+fn ramped(seed: u64, unit_model: UnitModel) -> Campaign {
+    Campaign {
+        name: "ramped".into(),
+        seed,
+        units: 1,
+        unit_model,
+        protocol: Some(Protocol {
+            intervals_min: vec![1.0, 5.0],
+            activations: 3,
+            repeats: 1,
+            rest_min: 30.0,
+            ..Protocol::default()
+        }),
+        field: Some(Field {
+            sessions: 1,
+            activations: 5,
+            activation_s: [20.0, 40.0],
+            off_min: [0.5, 5.0],
+            ambient_ramp_c_per_min: 6.0,
+            carry_probability: 0.5,
+            rest_min: 10.0,
+            ..Field::default()
+        }),
+        ..Campaign::default()
+    }
+}
+
+/// Activations per set point of `split`'s records (one unit; the same count on every model and
+/// axis).
+fn activations_per_set_point(outcome: &Outcome, split: Split) -> Vec<(f64, usize)> {
+    let records = summarise(&outcome.results);
+    let mut rows: Vec<(f64, usize)> = records
+        .iter()
+        .filter(|r| r.split == split && r.model == "uncorrected" && r.axis == "X")
+        .map(|r| (r.set_point_celsius, r.activations))
+        .collect();
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    rows
+}
+
+#[test]
+fn ramped_field_sessions_are_evaluated_under_their_nominal_set_point() {
+    let dir = tempfile::tempdir().unwrap();
+    simulate_campaign(&ramped(11, UnitModel::Physical), dir.path(), |_| {}).unwrap();
+    let outcome = run(dir.path());
+    // The sessions did ramp: most field activations switch on away from their set point.
+    let field: Vec<_> = outcome
+        .results
+        .iter()
+        .filter(|(split, _)| *split == Split::Field)
+        .map(|(_, r)| &r.labels)
+        .collect();
+    assert_eq!(field.len(), 15);
+    let away = field
+        .iter()
+        .filter(|l| (l.set_point_celsius - l.nominal_set_point_celsius()).abs() > 1e-6)
+        .count();
+    assert!(away >= 10, "{field:#?}");
+    // One field row per session set point, each with the session's 5 activations.
+    assert_eq!(
+        activations_per_set_point(&outcome, Split::Field),
+        [(30.0, 5), (33.0, 5), (40.0, 5)]
+    );
+    // Validation: the +33 °C protocol (2 intervals × 3 activations); field activations stay field.
+    assert_eq!(
+        activations_per_set_point(&outcome, Split::Validation),
+        [(33.0, 6)]
+    );
+}
+
+#[test]
+fn the_noise_floor_keeps_every_activation_of_the_twins_validation_sessions() {
+    let dir = tempfile::tempdir().unwrap();
+    simulate_campaign(
+        &ramped(12, UnitModel::ZeroSystematicDrift),
+        dir.path(),
+        |_| {},
+    )
+    .unwrap();
+    let files = pipeline::recording_files(dir.path()).unwrap();
+    let outcome = pipeline::run(&files, &options(), true, &|_, _, _| {}).unwrap();
+    assert!(outcome.results.iter().all(|(s, _)| *s == Split::NoiseFloor));
+    // The +33 °C protocol's 6 activations and the +33 °C field session's 5, wherever the ramp
+    // had taken the ambient at switch-on.
+    assert_eq!(
+        activations_per_set_point(&outcome, Split::NoiseFloor),
+        [(33.0, 11)]
     );
 }

@@ -178,7 +178,7 @@ pub fn field_table(records: &[Record], fitted: &[FittedUnit]) -> String {
     if of_split(records, Split::Field).next().is_none() {
         return String::new();
     }
-    let mut md = String::from("## Field-like use\n\nActivations with random off-times, ambient ramps, supply and orientation changes (never used in the fit), mean over set points:\n\n| model |");
+    let mut md = String::from("## Field-like use\n\nActivations with random off-times, ambient ramps, supply and orientation changes (never used in the fit), mean over set points. A session's activations count under its nominal set point (the recording's), not under the ambient at switch-on, which ramps and jumps in the field.\n\n| model |");
     for (i, _) in units.iter().enumerate() {
         for axis in AXES {
             let _ = write!(md, " GIU {} {axis} |", i + 1);
@@ -221,7 +221,7 @@ pub fn noise_floor(records: &[Record], noise_units: &[String]) -> String {
     if noise_units.is_empty() {
         return String::new();
     }
-    let mut md = String::from("## Noise floor\n\nA unit whose systematic drift is zero (same heating and noise): the drift metric of its raw output is what white noise and bias instability alone produce over 2 min with a 1-s window. Its own fitted tables should not add to it.\n\n| unit | set point | model | X | Y | Z |\n|---|---|---|---:|---:|---:|\n");
+    let mut md = String::from("## Noise floor\n\nA unit whose systematic drift is zero (same heating and noise): the drift metric of its raw output is what white noise and bias instability alone produce over 2 min with a 1-s window. Its own fitted tables should not add to it. Measured on every activation of its recordings at the validation set points (the nominal one for a field session, whatever the ambient at switch-on).\n\n| unit | set point | model | X | Y | Z |\n|---|---|---|---:|---:|---:|\n");
     for unit in noise_units {
         for set_point in set_points(records, Split::NoiseFloor) {
             for model in ["uncorrected", "modified"] {

@@ -134,6 +134,11 @@ pub fn calibration_file(path: &Path, options: &Options) -> Result<Option<bool>, 
 }
 
 /// Whether an activation is calibration data: a protocol activation at a calibration set point.
+///
+/// This goes by the chamber set point at switch-on, the label the fit groups curves by
+/// (`curves.rs`): protocol sessions do not ramp, so it is also the recording's nominal one.
+/// Validation, field and noise-floor membership go by the nominal set point
+/// ([`drift_recording::SegmentLabels::nominal_set_point_celsius`]) instead.
 pub fn calibration_segment(segment: &Segment, options: &Options) -> bool {
     segment.labels.series_kind == SeriesKind::Protocol
         && is_one_of(
@@ -244,10 +249,16 @@ pub fn run(
             .par_iter()
             .filter_map(|segment| {
                 let labels = &segment.labels;
-                let validation =
-                    is_one_of(labels.set_point_celsius, &options.validation_set_points);
+                // The set point the activation belongs to: in a field session whose ambient
+                // ramps, the switch-on label is the ambient of the moment (31.7, 35.2 … in a
+                // +33 °C session), almost never a validation set point.
+                let validation = is_one_of(
+                    labels.nominal_set_point_celsius(),
+                    &options.validation_set_points,
+                );
                 let (split, model) = if noise_floor {
-                    // The noise floor is measured where the other units are validated.
+                    // The noise floor is measured where the other units are validated: every
+                    // activation of the twin's sessions at a validation set point.
                     if !validation {
                         return None;
                     }

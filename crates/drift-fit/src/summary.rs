@@ -37,7 +37,9 @@ impl Split {
 pub struct Record {
     /// Unit id.
     pub unit: String,
-    /// Chamber set point, °C.
+    /// The set point the activations belong to, °C: their recording's nominal one
+    /// ([`drift_recording::SegmentLabels::nominal_set_point_celsius`]), not the ambient at
+    /// switch-on, which differs in field sessions whose ambient ramps.
     pub set_point_celsius: f64,
     /// Which data.
     pub split: Split,
@@ -53,12 +55,14 @@ pub struct Record {
     pub activations: usize,
 }
 
-/// Averages activation results into records, one per unit × set point × split × model × axis.
+/// Averages activation results into records, one per unit × set point × split × model × axis;
+/// the set point is each activation's nominal one (a ramped field session gives one row, not one
+/// per ambient at switch-on).
 pub fn summarise(results: &[(Split, ActivationResult)]) -> Vec<Record> {
     type Key = (String, i64, Split, ModelKind, usize);
     let mut sums: BTreeMap<Key, (f64, f64, usize)> = BTreeMap::new();
     for (split, result) in results {
-        let set_point = (result.labels.set_point_celsius * 1000.0).round() as i64;
+        let set_point = (result.labels.nominal_set_point_celsius() * 1000.0).round() as i64;
         for model in &result.models {
             for axis in 0..3 {
                 let entry = sums
@@ -90,4 +94,55 @@ pub fn summarise(results: &[(Split, ActivationResult)]) -> Vec<Record> {
             },
         )
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use drift_recording::{SegmentLabels, SeriesKind};
+
+    use super::*;
+    use crate::evaluate::ModelResult;
+
+    /// A field activation switched on at `at_switch_on` in a session at `session`, with drift
+    /// `drift` on every axis.
+    fn result(at_switch_on: f64, session: Option<f64>, drift: f64) -> (Split, ActivationResult) {
+        let labels = SegmentLabels {
+            unit_id: "U".into(),
+            set_point_celsius: at_switch_on,
+            session_set_point_celsius: session,
+            series_kind: SeriesKind::Field,
+            series: 1,
+            repeat: 1,
+            activation: 1,
+            interval_min: None,
+            off_before_s: None,
+        };
+        let models = vec![ModelResult {
+            model: ModelKind::Uncorrected,
+            drift_dps: [drift; 3],
+            residual_rms_dps: [drift; 3],
+            flags: [0; 3],
+        }];
+        (Split::Field, ActivationResult { labels, models })
+    }
+
+    #[test]
+    fn ramped_activations_are_summarised_under_their_sessions_set_point() {
+        let results = [
+            result(31.7, Some(33.0), 0.01),
+            result(35.2, Some(33.0), 0.03),
+            result(33.0, None, 0.02),
+            // No session set point recorded: the switch-on one.
+            result(36.5, None, 0.04),
+        ];
+        let rows: Vec<(f64, usize, f64)> = summarise(&results)
+            .iter()
+            .filter(|r| r.axis == "X")
+            .map(|r| (r.set_point_celsius, r.activations, r.drift_dps))
+            .collect();
+        assert_eq!(rows.len(), 2, "{rows:?}");
+        assert_eq!((rows[0].0, rows[0].1), (33.0, 3));
+        assert!((rows[0].2 - 0.02).abs() < 1e-12, "{rows:?}");
+        assert_eq!((rows[1].0, rows[1].1), (36.5, 1));
+    }
 }

@@ -113,6 +113,14 @@ impl PyLabels {
         self.0.set_point_celsius
     }
 
+    /// The set point the activation belongs to, °C: the recording's nominal one (in a field
+    /// session whose ambient ramps, not the ambient at switch-on); the switch-on set point when the
+    /// recording does not say, or for labels made in Python.
+    #[getter]
+    fn nominal_set_point_celsius(&self) -> f64 {
+        self.0.nominal_set_point_celsius()
+    }
+
     /// "protocol" or "field".
     #[getter]
     fn series_kind(&self) -> &'static str {

@@ -146,15 +146,15 @@ fn default_metadata(
         .map(|s| &s.bind(py).get().segment.labels)
         .collect();
     if let Some(first) = labels.first() {
-        // Only when every activation agrees: the fitter then picks files by metadata alone.
+        // Only when every activation agrees: the fitter then picks files by metadata alone. The
+        // set point the activations belong to (the session's, for ramped field segments read from
+        // a file), so it reads back as their nominal one.
+        let nominal = first.nominal_set_point_celsius();
         if labels
             .iter()
-            .all(|l| l.set_point_celsius == first.set_point_celsius)
+            .all(|l| l.nominal_set_point_celsius() == nominal)
         {
-            metadata.insert(
-                "set_point_celsius".into(),
-                first.set_point_celsius.to_string(),
-            );
+            metadata.insert("set_point_celsius".into(), nominal.to_string());
         }
         if labels.iter().all(|l| l.series_kind == first.series_kind) {
             metadata.insert("series_kind".into(), first.series_kind.as_str().into());

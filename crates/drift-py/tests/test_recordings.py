@@ -132,3 +132,37 @@ def test_in_memory_segments_feed_the_corrector(campaign_dir: Path) -> None:
     )
     assert corrected.shape == segment.rate_dps.shape
     assert not (flags & gyrodrift.Flags.faults().value).any()
+
+
+def test_ramped_field_labels_give_the_sessions_nominal_set_point(tmp_path: Path) -> None:
+    campaign = {
+        "name": "py-ramped",
+        "seed": 5,
+        "units": 1,
+        "set_points_celsius": [33.0],
+        "field": {
+            "sessions": 1,
+            "activations": 6,
+            "activation_s": [1.0, 2.0],
+            "off_min": [0.5, 1.0],
+            "ambient_ramp_c_per_min": 6.0,
+            "carry_probability": 0.5,
+            "rest_min": 1.0,
+        },
+    }
+    gyrodrift.simulate(tmp_path, campaign)
+    (recording,) = gyrodrift.load_campaign(tmp_path)
+    labels = [s.labels for s in recording.segments]
+    assert len(labels) == 6 and all(lab.series_kind == "field" for lab in labels)
+    assert all(lab.nominal_set_point_celsius == 33.0 for lab in labels)
+    # The ambient at switch-on ramps away from the set point (it starts there).
+    assert any(lab.set_point_celsius != 33.0 for lab in labels)
+    # Labels made in Python have no session set point: the switch-on one is the nominal one.
+    assert gyrodrift.Labels(unit_id="U", set_point_celsius=31.5).nominal_set_point_celsius == 31.5
+    with pytest.raises(AttributeError):
+        labels[0].nominal_set_point_celsius = 30.0  # type: ignore[misc]
+    # A recording built from them keeps the session's set point: the labels read back equal.
+    gyrodrift.Recording(recording.segments).save(tmp_path / "copy.mcap")
+    copy = gyrodrift.Recording.load(tmp_path / "copy.mcap")
+    assert copy.metadata["set_point_celsius"] == "33"
+    assert [s.labels for s in copy.segments] == labels

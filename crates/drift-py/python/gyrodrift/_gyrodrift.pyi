@@ -441,6 +441,9 @@ class Labels:
     def set_point_celsius(self) -> float:
         """Chamber set point at switch-on, °C."""
     @property
+    def nominal_set_point_celsius(self) -> float:
+        """The recording's nominal set point, °C (not the ambient at switch-on); read-only."""
+    @property
     def series_kind(self) -> str:
         """ "protocol" or "field"."""
     @property
