@@ -9,6 +9,9 @@
 //! cargo run --release --example stage3_oracle -- <campaign dir> [calibration set points, default 30,40]
 //! ```
 //!
+//! Then the calibration curves themselves (axis X, rise and `k` at 5 and 20 s, switch-on
+//! temperature), which show whether a warmer start rises less.
+//!
 //! When the two columns agree, the rise identifies the history as the paper assumes; when the
 //! paper's column is larger, the curves cross (`drift_fit::history_order`) and the difference is
 //! what an input that names the history (the off-time) would recover. Numbers in docs/closed-loop.md.
@@ -147,5 +150,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mean(by_history)
         );
     }
+    print_curves(&outcome.fitted);
     Ok(())
+}
+
+/// The averaged calibration curves on axis X at 5 and 20 s: whether a warmer start rises less.
+fn print_curves(fitted: &[drift_fit::FittedUnit]) {
+    const AXIS: usize = 0;
+    println!(
+        "\n| unit | set point | curve | switched on at | rise 5 s | k 5 s | rise 20 s | k 20 s |"
+    );
+    println!("|---|---:|---|---:|---:|---:|---:|---:|");
+    for unit in fitted {
+        for sp in &unit.set_points {
+            for curve in &sp.curves {
+                let at = |s: u32| {
+                    let i = (s * 1000 / sp.grid_ms) as usize;
+                    let rise = curve.rise_celsius[AXIS].get(i).copied().unwrap_or(f64::NAN);
+                    let drift = curve.drift_dps[AXIS].get(i).copied().unwrap_or(f64::NAN);
+                    format!("{rise:.3} | {:.5}", drift / rise)
+                };
+                println!(
+                    "| {} | {:+.1} °C | {} | {:.2} | {} | {} |",
+                    unit.unit_id,
+                    sp.set_point_celsius,
+                    curve.key.name(),
+                    curve.switch_on_celsius[AXIS],
+                    at(5),
+                    at(20)
+                );
+            }
+        }
+    }
 }
