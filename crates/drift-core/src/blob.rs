@@ -5,7 +5,7 @@
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 4 | magic `GYDT` |
-//! | 4 | 2 | format version ([`FORMAT_VERSION`]; versions 1 and 2 still read) |
+//! | 4 | 2 | format version ([`FORMAT_VERSION`]; versions 1 to 3 still read) |
 //! | 6 | 1 | model kind ([`Kind`]) |
 //! | 7 | 1 | reserved, 0 |
 //! | 8 | 4 | payload length `n`, bytes |
@@ -25,17 +25,18 @@ use crate::extension::{Extension, ExtraTerm, Term, MAX_TERMS};
 use crate::model::Model;
 use crate::polynomial::PolynomialTables;
 use crate::settings::Settings;
-use crate::table::AxisTable;
-use crate::table::ModifiedTables;
+use crate::table::{AmbientCurves, AxisTable, Curve, ModifiedTables};
 use crate::AXES;
 
 /// First four bytes of every image.
 pub const MAGIC: [u8; 4] = *b"GYDT";
 /// The image format version this build writes. Version 2 added the extended model's extra terms
 /// to [`ModifiedTables`]; version 3 gave the auxiliary-input term a low-pass time constant
-/// ([`Term::Aux`]). This build still reads version-1 images (they load with no extra terms) and
-/// version-2 images (their auxiliary terms load unfiltered, time constant 0, as they were meant).
-pub const FORMAT_VERSION: u16 = 3;
+/// ([`Term::Aux`]); version 4 lets stage 3 be keyed by heating history
+/// ([`AmbientCurves::residual_heat_celsius`]). This build still reads version-1 images (they load
+/// with no extra terms), version-2 images (their auxiliary terms load unfiltered, time constant 0,
+/// as they were meant) and version-3 images (stage 3 keyed by rise, as the paper's).
+pub const FORMAT_VERSION: u16 = 4;
 /// The oldest image format version this build reads.
 pub const OLDEST_READABLE_VERSION: u16 = 1;
 /// Bytes before the payload.
@@ -69,11 +70,55 @@ pub trait Image: Model + Serialize + DeserializeOwned {
     }
 }
 
+/// A version-1 to -3 ambient: stage 3 keyed by rise only.
+#[derive(serde::Deserialize)]
+struct AmbientCurvesV3<const R: usize, const C: usize> {
+    ambient_celsius: f32,
+    initial_bias_dps: f32,
+    curves: heapless::Vec<Curve<R>, C>,
+}
+
+/// A version-1 to -3 axis table.
+#[derive(serde::Deserialize)]
+struct AxisTableV3<const R: usize, const A: usize, const C: usize> {
+    reference_ms: heapless::Vec<u32, R>,
+    ambients: heapless::Vec<AmbientCurvesV3<R, C>, A>,
+}
+
+impl<const R: usize, const A: usize, const C: usize> From<AxisTableV3<R, A, C>>
+    for AxisTable<R, A, C>
+{
+    fn from(v3: AxisTableV3<R, A, C>) -> Self {
+        let mut ambients = heapless::Vec::new();
+        for ambient in v3.ambients {
+            // The same capacity on both sides: never full.
+            let _ = ambients.push(AmbientCurves {
+                ambient_celsius: ambient.ambient_celsius,
+                initial_bias_dps: ambient.initial_bias_dps,
+                curves: ambient.curves,
+                residual_heat_celsius: heapless::Vec::new(),
+            });
+        }
+        Self {
+            reference_ms: v3.reference_ms,
+            ambients,
+        }
+    }
+}
+
 /// A version-1 modified-model payload: the tables before the extended model existed.
 #[derive(serde::Deserialize)]
 struct ModifiedTablesV1<const R: usize, const A: usize, const C: usize> {
     settings: Settings,
-    axes: [AxisTable<R, A, C>; AXES],
+    axes: [AxisTableV3<R, A, C>; AXES],
+}
+
+/// A version-3 modified-model payload.
+#[derive(serde::Deserialize)]
+struct ModifiedTablesV3<const R: usize, const A: usize, const C: usize> {
+    settings: Settings,
+    axes: [AxisTableV3<R, A, C>; AXES],
+    extension: Extension,
 }
 
 /// A version-2 extra term: the auxiliary input had no time constant.
@@ -97,7 +142,7 @@ struct ExtraTermV2 {
 #[derive(serde::Deserialize)]
 struct ModifiedTablesV2<const R: usize, const A: usize, const C: usize> {
     settings: Settings,
-    axes: [AxisTable<R, A, C>; AXES],
+    axes: [AxisTableV3<R, A, C>; AXES],
     /// The extension, a one-field struct, which postcard writes as its field.
     terms: heapless::Vec<ExtraTermV2, MAX_TERMS>,
 }
@@ -132,6 +177,7 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
         match version {
             1 => from_v1(payload),
             2 => from_v2(payload),
+            3 => from_v3(payload),
             _ => from_current(payload),
         }
     }
@@ -144,8 +190,21 @@ fn from_v1<const R: usize, const A: usize, const C: usize>(
     let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)?;
     let tables = ModifiedTables {
         settings: v1.settings,
-        axes: v1.axes,
+        axes: v1.axes.map(AxisTable::from),
         extension: Extension::NONE,
+    };
+    Ok((tables, rest))
+}
+
+#[inline(never)]
+fn from_v3<const R: usize, const A: usize, const C: usize>(
+    payload: &[u8],
+) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
+    let (v3, rest) = postcard::take_from_bytes::<ModifiedTablesV3<R, A, C>>(payload)?;
+    let tables = ModifiedTables {
+        settings: v3.settings,
+        axes: v3.axes.map(AxisTable::from),
+        extension: v3.extension,
     };
     Ok((tables, rest))
 }
@@ -162,7 +221,7 @@ fn from_v2<const R: usize, const A: usize, const C: usize>(
     }
     let tables = ModifiedTables {
         settings: v2.settings,
-        axes: v2.axes,
+        axes: v2.axes.map(AxisTable::from),
         extension,
     };
     Ok((tables, rest))

@@ -5,6 +5,7 @@ mod block;
 use crate::error::{Error, Location, Problem};
 use crate::extension::{ExtensionState, AUX_INPUTS};
 use crate::flags::Flags;
+use crate::history::{Previous, SwitchOn};
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
 use crate::AXES;
@@ -107,7 +108,9 @@ impl<S: Copy + Default> CorrectorState<S> {
         !x.activation_flags.contains(Flags::NOT_POWERED_ON)
     }
 
-    /// Starts an activation from the raw temperature readings at switch-on.
+    /// Starts an activation from the raw temperature readings at switch-on, with nothing known of
+    /// the previous activation (a table keyed by history then takes a cold start, flagged
+    /// `HISTORY_UNKNOWN`; [`Self::power_on_after`] passes what was kept).
     ///
     /// Returns the flags that hold for the whole activation (e.g. an ambient outside the calibrated
     /// range). A non-finite reading is rejected, naming the axis, and the state is left unchanged.
@@ -115,6 +118,62 @@ impl<S: Copy + Default> CorrectorState<S> {
         &mut self,
         model: &M,
         switch_on_raw: [f32; AXES],
+    ) -> Result<[Flags; AXES], Error>
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        self.start(model, switch_on_raw, None, &mut [f32::NAN; AXES])
+    }
+
+    /// [`Self::power_on`] with what firmware kept of the previous activation across power-off
+    /// (`previous`, 24 bytes in retained RAM or flash; [`Previous::NOTHING`] at first): a table keyed
+    /// by heating history reads the activation's ambient and residual heat from it
+    /// ([`SwitchOn::estimate`]); other models ignore it. Writes this activation's ambient into
+    /// `previous` and clears its switch-off temperature, which [`Self::keep`] then records.
+    pub fn power_on_after<M>(
+        &mut self,
+        model: &M,
+        switch_on_raw: [f32; AXES],
+        previous: &mut [Previous; AXES],
+    ) -> Result<[Flags; AXES], Error>
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        let mut ambients = [f32::NAN; AXES];
+        let flags = self.start(model, switch_on_raw, Some(previous), &mut ambients)?;
+        for (kept, ambient_celsius) in previous.iter_mut().zip(ambients) {
+            *kept = Previous {
+                ambient_celsius,
+                switch_off_celsius: f32::NAN,
+            };
+        }
+        Ok(flags)
+    }
+
+    /// Records this activation's last good temperature per axis in `previous` (from
+    /// [`Self::power_on_after`]) as its switch-off temperature. Call it before power-off, or
+    /// periodically if power can go without warning: an activation whose switch-off temperature
+    /// was never recorded leaves the next start unknown (flagged, taken as fully cooled).
+    pub fn keep<M>(&self, model: &M, previous: &mut [Previous; AXES])
+    where
+        M: Model,
+    {
+        let settings = model.settings();
+        for (kept, axis) in previous.iter_mut().zip(&self.axes) {
+            if !axis.activation_flags.contains(Flags::NOT_POWERED_ON) {
+                kept.switch_off_celsius = settings.celsius(axis.last_raw);
+            }
+        }
+    }
+
+    fn start<M>(
+        &mut self,
+        model: &M,
+        switch_on_raw: [f32; AXES],
+        previous: Option<&[Previous; AXES]>,
+        ambients: &mut [f32; AXES],
     ) -> Result<[Flags; AXES], Error>
     where
         M: Model,
@@ -129,20 +188,28 @@ impl<S: Copy + Default> CorrectorState<S> {
         }
         let settings = model.settings();
         let mut flags = [Flags::NONE; AXES];
-        for (((state, axis), raw), flags) in self
+        for (a, (((state, axis), raw), flags)) in self
             .axes
             .iter_mut()
             .zip(model.axes())
             .zip(switch_on_raw)
             .zip(&mut flags)
+            .enumerate()
         {
+            let switch_on = SwitchOn::estimate(
+                settings.celsius(raw),
+                previous.and_then(|p| p.get(a)).copied(),
+            );
+            if let Some(ambient) = ambients.get_mut(a) {
+                *ambient = switch_on.ambient_celsius;
+            }
             *state = AxisState {
                 switch_on_raw: raw,
                 last_raw: raw,
                 ..AxisState::default()
             };
             let (initial_bias, mut activation) =
-                axis.power_on(settings, settings.celsius(raw), &mut state.model);
+                axis.power_on_after(settings, &switch_on, &mut state.model);
             if plausible(initial_bias) {
                 state.initial_bias_dps = initial_bias;
             } else {
@@ -479,6 +546,21 @@ impl<'a, M: Model> Corrector<'a, M> {
     /// See [`CorrectorState::power_on`].
     pub fn power_on(&mut self, switch_on_raw: [f32; AXES]) -> Result<[Flags; AXES], Error> {
         self.state.power_on(self.model, switch_on_raw)
+    }
+
+    /// See [`CorrectorState::power_on_after`].
+    pub fn power_on_after(
+        &mut self,
+        switch_on_raw: [f32; AXES],
+        previous: &mut [Previous; AXES],
+    ) -> Result<[Flags; AXES], Error> {
+        self.state
+            .power_on_after(self.model, switch_on_raw, previous)
+    }
+
+    /// See [`CorrectorState::keep`].
+    pub fn keep(&self, previous: &mut [Previous; AXES]) {
+        self.state.keep(self.model, previous);
     }
 
     /// See [`CorrectorState::power_off`].

@@ -45,9 +45,18 @@ impl Flags {
     /// nothing). (Temperature faults hold the temperature the terms read, under the flags above.)
     pub const EXTENSION_INPUT_INVALID: Self = Self(1 << 9);
 
+    /// A table keyed by heating history was powered on without what was kept of the previous
+    /// activation ([`crate::CorrectorState::power_on`] rather than `power_on_after`, or nothing
+    /// finite kept): the start is taken as fully cooled. Set on every sample of the activation.
+    pub const HISTORY_UNKNOWN: Self = Self(1 << 10);
+    /// A table keyed by heating history: the residual heat at switch-on lies outside the span of
+    /// the stored histories by more than [`Settings::rise_margin_celsius`](crate::Settings): the
+    /// nearest history's curve is used (clamp). Set on every sample of the activation.
+    pub const HISTORY_OUT_OF_SPAN: Self = Self(1 << 11);
+
     /// Every flag with its name, in bit order (for bindings, logs and reports: a flag added here is
     /// listed everywhere).
-    pub const ALL: [(Self, &'static str); 10] = [
+    pub const ALL: [(Self, &'static str); 12] = [
         (Self::AMBIENT_OUT_OF_RANGE, "AMBIENT_OUT_OF_RANGE"),
         (Self::RISE_OUT_OF_SPAN, "RISE_OUT_OF_SPAN"),
         (Self::PAST_LAST_REFERENCE, "PAST_LAST_REFERENCE"),
@@ -58,6 +67,8 @@ impl Flags {
         (Self::NOT_POWERED_ON, "NOT_POWERED_ON"),
         (Self::MODEL_INVALID, "MODEL_INVALID"),
         (Self::EXTENSION_INPUT_INVALID, "EXTENSION_INPUT_INVALID"),
+        (Self::HISTORY_UNKNOWN, "HISTORY_UNKNOWN"),
+        (Self::HISTORY_OUT_OF_SPAN, "HISTORY_OUT_OF_SPAN"),
     ];
 
     /// Flags that mean the correction of this sample is degraded (a hold or pass-through), as opposed

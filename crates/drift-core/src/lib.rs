@@ -23,6 +23,7 @@ mod corrector;
 mod error;
 mod extension;
 mod flags;
+mod history;
 mod interp;
 mod model;
 mod polynomial;
@@ -38,6 +39,7 @@ pub use extension::{
     Extension, ExtensionState, ExtraTerm, Term, TermInputs, TermValues, AUX_INPUTS, MAX_TERMS,
 };
 pub use flags::Flags;
+pub use history::{Previous, SwitchOn};
 pub use model::{AxisModel, Model, TemperatureBlock, BLOCK_SAMPLES};
 pub use polynomial::{
     PolynomialAxis, PolynomialAxisState, PolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,

@@ -4,6 +4,7 @@
 use crate::error::Error;
 use crate::extension::Extension;
 use crate::flags::Flags;
+use crate::history::SwitchOn;
 use crate::settings::Settings;
 use crate::AXES;
 
@@ -24,6 +25,17 @@ pub trait AxisModel {
         switch_on_celsius: f32,
         state: &mut Self::State,
     ) -> (f32, Flags);
+
+    /// [`Self::power_on`] with what firmware knows of the heating history (ambient and residual
+    /// heat at switch-on). Models that do not key anything by history (the default) ignore it.
+    fn power_on_after(
+        &self,
+        settings: &Settings,
+        switch_on: &SwitchOn,
+        state: &mut Self::State,
+    ) -> (f32, Flags) {
+        self.power_on(settings, switch_on.switch_on_celsius, state)
+    }
 
     /// The drift since switch-on (°/s, excluding the initial bias) at `since_power_on_ms`, for the
     /// current temperature (°C) and its rise since switch-on (°C), with envelope flags.

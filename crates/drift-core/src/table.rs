@@ -5,10 +5,11 @@ use heapless::Vec;
 use crate::error::{check_increasing, check_len, Error, Location, Problem};
 use crate::extension::Extension;
 use crate::flags::Flags;
+use crate::history::SwitchOn;
 use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
 use crate::stage::ambient::AmbientPosition;
-use crate::stage::heating::{cached_k, search, BlendedCurves, Knots};
+use crate::stage::heating::{by_history, cached_k, search, BlendedCurves, Knots};
 use crate::stage::since_power_on::{Moment, Segment, SegmentKind};
 use crate::AXES;
 
@@ -41,9 +42,21 @@ pub struct AmbientCurves<const R: usize, const C: usize> {
     pub ambient_celsius: f32,
     /// Initial (switch-on) bias at this temperature, °/s. Interpolated linearly between ambients.
     pub initial_bias_dps: f32,
-    /// Heating-dynamics curves, ordered so that at every reference time each curve's rise is
-    /// strictly greater than the previous curve's.
+    /// Heating-dynamics curves. Keyed by rise (the paper, `residual_heat_celsius` empty): ordered
+    /// so that at every reference time each curve's rise is strictly greater than the previous
+    /// curve's. Keyed by history: one activation history per curve, in the order of
+    /// `residual_heat_celsius`.
     pub curves: Vec<Curve<R>, C>,
+    /// Stage 3 keyed by heating history (optional): each curve's residual heat at switch-on (how
+    /// far its switch-on temperature stood above the ambient, °C), strictly increasing, the first
+    /// one the fully cooled start. Empty: stage 3 finds the curves by the current rise, as the
+    /// paper does. The same for every ambient of an axis: all empty or one per curve.
+    ///
+    /// Why: when a warm start heats faster than a cold one, the curves cross and the rise no longer
+    /// names the history (docs/closed-loop.md); the residual heat does, if the firmware keeps the
+    /// ambient across power-off ([`crate::CorrectorState::power_on_with_history`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub residual_heat_celsius: Vec<f32, C>,
 }
 
 /// The correlation table of one axis.
@@ -99,6 +112,14 @@ impl<const R: usize, const A: usize, const C: usize> ModifiedTables<R, A, C> {
 }
 
 impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
+    /// Whether stage 3 is keyed by the heating history (the curves carry their residual heat)
+    /// rather than by the rise.
+    pub fn keyed_by_history(&self) -> bool {
+        self.ambients
+            .first()
+            .is_some_and(|a| !a.residual_heat_celsius.is_empty())
+    }
+
     /// Checks this axis's table; `at` names the axis in errors.
     pub fn validate(&self, at: Location) -> Result<(), Error> {
         let references = self.reference_ms.len();
@@ -131,6 +152,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             at,
             self.ambients.iter().map(|a| a.ambient_celsius),
         )?;
+        let by_history = self.keyed_by_history();
         for (a, ambient) in self.ambients.iter().enumerate() {
             let at = at.ambient(a);
             if !ambient.initial_bias_dps.is_finite() {
@@ -156,6 +178,26 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
                     }
                 }
             }
+            if by_history {
+                check_len(
+                    "residual_heat_celsius",
+                    at,
+                    ambient.curves.len(),
+                    ambient.residual_heat_celsius.len(),
+                )?;
+                check_increasing(
+                    "residual_heat_celsius",
+                    at,
+                    ambient.residual_heat_celsius.iter().copied(),
+                )?;
+                continue;
+            }
+            check_len(
+                "residual_heat_celsius",
+                at,
+                0,
+                ambient.residual_heat_celsius.len(),
+            )?;
             // At every reference time the curves must be ordered by rise, for the heating stage's
             // bracket search.
             for j in 0..references {
@@ -196,6 +238,10 @@ pub struct ModifiedAxisState {
     segment_per_ms: f32,
     segment_lo: u8,
     segment_kind: SegmentKind,
+    /// Stage 3's cache: the bracket's lower and upper knots (see `stage::heating::TOP`). A table
+    /// keyed by history caches one (blended) curve and needs no upper one: there the second slot
+    /// holds the activation's history position instead ([`Self::history`]), so that a unit's state
+    /// stays within 256 bytes.
     knots: [Knots; 2],
     curve: u8,
 }
@@ -233,6 +279,24 @@ impl ModifiedAxisState {
         }
     }
 
+    /// Tables keyed by history: the stored history below the activation's residual heat and the
+    /// weight of the next one, fixed at switch-on.
+    fn history(&self) -> (u8, f32) {
+        let [_, [position, _]] = self.knots;
+        (
+            saturating_u8_of(position.k_dps_per_celsius),
+            position.rise_celsius,
+        )
+    }
+
+    fn set_history(&mut self, lo: u8, weight: f32) {
+        let position = CurvePoint {
+            rise_celsius: weight,
+            k_dps_per_celsius: f32::from(lo),
+        };
+        self.knots[1] = [position, position];
+    }
+
     fn set_segment(&mut self, segment: Segment) {
         self.segment_start_ms = segment.start_ms;
         self.segment_len_ms = segment.len_ms;
@@ -251,24 +315,76 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         switch_on_celsius: f32,
         state: &mut Self::State,
     ) -> (f32, Flags) {
-        let ambient = AmbientPosition::locate(
-            &self.ambients,
-            switch_on_celsius,
-            settings.ambient_margin_celsius,
-            |a| a.ambient_celsius,
-        );
+        self.power_on_after(
+            settings,
+            &SwitchOn::estimate(switch_on_celsius, None),
+            state,
+        )
+    }
+
+    fn power_on_after(
+        &self,
+        settings: &Settings,
+        switch_on: &SwitchOn,
+        state: &mut Self::State,
+    ) -> (f32, Flags) {
+        let by_history = self.keyed_by_history();
+        let margin = settings.ambient_margin_celsius;
+        let locate = |celsius| {
+            AmbientPosition::locate(&self.ambients, celsius, margin, |a| a.ambient_celsius)
+        };
+        // The paper indexes ambient by the switch-on temperature, residual heat included, as its
+        // calibration saw it; a table keyed by history was built against the ambient itself.
+        let (ambient, history) = if by_history {
+            let ambient = locate(switch_on.ambient_celsius);
+            let rise_margin = settings.rise_margin_celsius;
+            let history =
+                self.locate_history(&ambient, switch_on.residual_heat_celsius, rise_margin);
+            if history.out_of_range && switch_on.residual_heat_celsius > 0.0 {
+                // More residual heat than the calibration's shortest off-time left: the ambient
+                // rose during the off-time rather than the unit kept that much heat (the first
+                // start of a carried unit): a cold start at the switch-on temperature, flagged.
+                let ambient = locate(switch_on.switch_on_celsius);
+                let cold = self.locate_history(&ambient, 0.0, rise_margin);
+                (
+                    ambient,
+                    AmbientPosition {
+                        out_of_range: true,
+                        ..cold
+                    },
+                )
+            } else {
+                (ambient, history)
+            }
+        } else {
+            (
+                locate(switch_on.switch_on_celsius),
+                AmbientPosition::default(),
+            )
+        };
         *state = ModifiedAxisState::new(&ambient);
+        // The initial bias is the bias at the switch-on temperature, whatever the history.
+        let at_switch_on = locate(switch_on.switch_on_celsius);
         let bias_at = |i: u8| {
             self.ambients
                 .get(usize::from(i))
                 .map_or(f32::NAN, |a| a.initial_bias_dps)
         };
-        let initial_bias = ambient.blend(bias_at(ambient.lo), bias_at(ambient.hi));
-        let flags = if ambient.out_of_range {
+        let initial_bias = at_switch_on.blend(bias_at(at_switch_on.lo), bias_at(at_switch_on.hi));
+        let mut flags = if ambient.out_of_range {
             Flags::AMBIENT_OUT_OF_RANGE
         } else {
             Flags::NONE
         };
+        if by_history {
+            state.set_history(history.lo, history.weight);
+            if !switch_on.known {
+                flags |= Flags::HISTORY_UNKNOWN;
+            }
+            if history.out_of_range {
+                flags |= Flags::HISTORY_OUT_OF_SPAN;
+            }
+        }
         (initial_bias, flags)
     }
 
@@ -341,6 +457,12 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             state.ambient_weight,
             &segment,
         );
+        if self.keyed_by_history() {
+            let (lo, weight) = state.history();
+            let [cache, _] = &mut state.knots;
+            let k = by_history(&curves, moment, lo, weight, cache, &mut state.curve);
+            return (k, flags(false, segment.kind));
+        }
         let (k, beyond) = search(
             &curves,
             moment,
@@ -351,6 +473,39 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         );
         (k, flags(beyond, segment.kind))
     }
+}
+
+impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
+    /// Where the residual heat falls among the stored histories, whose labels are blended between
+    /// the two bracketing ambients as their curves are (stage 2). Once per activation.
+    fn locate_history(
+        &self,
+        ambient: &AmbientPosition,
+        residual_heat_celsius: f32,
+        margin_celsius: f32,
+    ) -> AmbientPosition {
+        let labels = |i: u8| {
+            self.ambients
+                .get(usize::from(i))
+                .map_or(&[][..], |a| a.residual_heat_celsius.as_slice())
+        };
+        let (lower, upper) = (labels(ambient.lo), labels(ambient.hi));
+        let mut blended: Vec<f32, C> = Vec::new();
+        for (c, &label) in lower.iter().enumerate() {
+            let upper = upper.get(c).copied().unwrap_or(f32::NAN);
+            let _ = blended.push(ambient.blend(label, upper));
+        }
+        AmbientPosition::locate(&blended, residual_heat_celsius, margin_celsius, |label| {
+            *label
+        })
+    }
+}
+
+/// A small index stored as an f32 (exact up to 2^24) back as a `u8`, saturating; NaN reads as 0.
+#[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+fn saturating_u8_of(index: f32) -> u8 {
+    // `as` saturates and maps NaN to 0: total, no panic; the index was a `u8` when stored.
+    index as u8
 }
 
 /// The modified model's envelope flags for one sample.

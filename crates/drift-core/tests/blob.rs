@@ -17,7 +17,7 @@ mod common;
 
 use common::fixture::{self, FixtureTables};
 use drift_core::blob::{decode, encode, BlobError, FORMAT_VERSION, HEADER_LEN, MAGIC};
-use drift_core::{ModifiedTables, PolynomialTables, Problem};
+use drift_core::{Model, ModifiedTables, PolynomialTables, Problem};
 use proptest::prelude::*;
 
 fn image() -> Vec<u8> {
@@ -289,6 +289,53 @@ fn version_2_images_still_load_with_unfiltered_aux_terms() {
     let len = encode(&tables, &mut buffer).unwrap();
     assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
     assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), tables);
+}
+
+/// The extended fixture as the version-3 build wrote it (`testdata/image-v3-extended.bin`, the
+/// `extended` image of `testdata/vectors.json` before version 4), committed as it was: it still
+/// loads, stage 3 keyed by rise (no residual heats), everything else as it was; the history-keyed
+/// fixture round-trips through the current version.
+#[test]
+fn version_3_images_still_load_keyed_by_rise() {
+    let v3 = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../testdata/image-v3-extended.bin"
+    ))
+    .unwrap();
+    assert_eq!(u16::from_le_bytes([v3[4], v3[5]]), 3);
+    let tables: FixtureTables = decode(&v3).unwrap();
+    assert!(tables.axes.iter().all(|axis| !axis.keyed_by_history()));
+    assert_eq!(tables, fixture::extended());
+    let by_history = fixture::by_history();
+    let mut buffer = vec![0; 64 * 1024];
+    let len = encode(&by_history, &mut buffer).unwrap();
+    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
+    let back: FixtureTables = decode(&buffer[..len]).unwrap();
+    assert!(back.axes.iter().all(|axis| axis.keyed_by_history()));
+    assert_eq!(back, by_history);
+}
+
+/// A history-keyed table whose residual heats do not fit its curves is refused, named.
+#[test]
+fn bad_residual_heats_are_named() {
+    let mut tables = fixture::by_history();
+    tables.axes[1].ambients[2].residual_heat_celsius.swap(3, 4);
+    let error = tables.validate().unwrap_err();
+    assert_eq!(error.field, "residual_heat_celsius");
+    assert_eq!(error.problem, Problem::NotIncreasing);
+    let mut tables = fixture::by_history();
+    tables.axes[0].ambients[1].residual_heat_celsius.pop();
+    assert_eq!(
+        tables.validate().unwrap_err().field,
+        "residual_heat_celsius"
+    );
+    // Residual heats on some ambients only: neither keyed by rise nor by history.
+    let mut tables = fixture::by_history();
+    tables.axes[2].ambients[2].residual_heat_celsius.clear();
+    assert_eq!(
+        tables.validate().unwrap_err().field,
+        "residual_heat_celsius"
+    );
 }
 
 #[test]

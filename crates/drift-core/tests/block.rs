@@ -21,7 +21,7 @@ mod common;
 use drift_core::blob::decode;
 use drift_core::{
     AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialAxis,
-    PolynomialTables, Sample, Settings, BLOCK_SAMPLES,
+    PolynomialTables, Previous, Sample, Settings, BLOCK_SAMPLES,
 };
 
 const PATH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/vectors.json");
@@ -114,6 +114,7 @@ fn the_shared_vectors_give_the_same_bits_in_blocks() {
     };
     let modified: ModifiedTables = decode(&image("modified")).unwrap();
     let extended: ModifiedTables = decode(&image("extended")).unwrap();
+    let by_history: ModifiedTables = decode(&image("by_history")).unwrap();
     let standard: PolynomialTables = decode(&image("standard")).unwrap();
     let third_order: PolynomialTables = decode(&image("third_order")).unwrap();
     for case in &file.cases {
@@ -131,7 +132,16 @@ fn the_shared_vectors_give_the_same_bits_in_blocks() {
             ($model:expr) => {{
                 let mut state = CorrectorState::new();
                 if let Some(raw) = switch_on {
-                    let _ = state.power_on($model, raw);
+                    let _ = match case.previous {
+                        Some(kept) => {
+                            let mut previous = kept.map(|[ambient, off]| Previous {
+                                ambient_celsius: f32::from_bits(ambient),
+                                switch_off_celsius: f32::from_bits(off),
+                            });
+                            state.power_on_after($model, raw, &mut previous)
+                        }
+                        None => state.power_on($model, raw),
+                    };
                 }
                 check($model, state, &samples, &case.name);
             }};
@@ -139,6 +149,7 @@ fn the_shared_vectors_give_the_same_bits_in_blocks() {
         match case.model.as_str() {
             "modified" => run!(&modified),
             "extended" => run!(&extended),
+            "by_history" => run!(&by_history),
             "standard" => run!(&standard),
             "third_order" => run!(&third_order),
             other => panic!("unknown model {other}"),
@@ -252,7 +263,9 @@ fn random_polynomial_activations_with_faults_give_the_same_bits_in_blocks() {
         let expected = flag != Flags::AMBIENT_OUT_OF_RANGE
             && flag != Flags::RISE_OUT_OF_SPAN
             && flag != Flags::PAST_LAST_REFERENCE
-            && flag != Flags::EXTENSION_INPUT_INVALID;
+            && flag != Flags::EXTENSION_INPUT_INVALID
+            && flag != Flags::HISTORY_UNKNOWN
+            && flag != Flags::HISTORY_OUT_OF_SPAN;
         assert_eq!(seen.contains(flag), expected, "{name}");
     }
 }

@@ -15,7 +15,8 @@
 )]
 
 use drift_core::{
-    AmbientCurves, AmbientPosition, AxisTable, Curve, CurvePoint, ModifiedAxisState, Settings,
+    AmbientCurves, AmbientPosition, AxisModel, AxisTable, Curve, CurvePoint, Flags,
+    ModifiedAxisState, Settings, SwitchOn,
 };
 use proptest::prelude::*;
 
@@ -51,6 +52,7 @@ fn table() -> impl Strategy<Value = Table> {
                         ambient_celsius: ambient,
                         initial_bias_dps: bias,
                         curves: heapless::Vec::new(),
+                        residual_heat_celsius: heapless::Vec::new(),
                     };
                     // Ordered by rise at every reference time: curve c sits at least RISE_GAP above c − 1.
                     let mut rise: Vec<f32> = (0..refs).map(|j| j as f32 * 0.5).collect();
@@ -226,5 +228,61 @@ proptest! {
             let there = k(&table, ambient.ambient_celsius, neighbour, rise);
             prop_assert!((there - here).abs() <= bound_per_ms + 1e-6, "jump {} at t {}", there - here, t);
         }
+    }
+
+    /// Keyed by history: at a calibration ambient, a stored history's residual heat and a
+    /// reference time, `k` is that history's stored value exactly, whatever the rise (the rise
+    /// does not choose the curve); between histories it lies between their values; any residual
+    /// heat, finite or not, gives a finite `k` and no panic.
+    #[test]
+    fn keyed_by_history_reads_the_history_not_the_rise(
+        table in table(),
+        a in 0usize..3,
+        c in 0usize..5,
+        j in 0usize..6,
+        rises in (-2.0f32..10.0, -2.0f32..10.0),
+        between_u in 0.0f32..1.0,
+        wild in prop_oneof![Just(f32::NAN), Just(f32::INFINITY), -5.0f32..50.0],
+    ) {
+        let mut table = table;
+        for ambient in &mut table.ambients {
+            let count = ambient.curves.len();
+            ambient.residual_heat_celsius = (0..count).map(|c| 0.4 * c as f32).collect();
+        }
+        prop_assert!(table.validate(drift_core::Location::axis(0)).is_ok());
+        let a = a % table.ambients.len();
+        let j = j % table.reference_ms.len();
+        let ambient = &table.ambients[a];
+        let c = c % ambient.curves.len();
+        let start = |heat: f32| {
+            let mut state = ModifiedAxisState::default();
+            let switch_on = SwitchOn {
+                switch_on_celsius: ambient.ambient_celsius + heat,
+                ambient_celsius: ambient.ambient_celsius,
+                residual_heat_celsius: heat,
+                known: true,
+            };
+            let (_, flags) = table.power_on_after(&settings(), &switch_on, &mut state);
+            (state, flags)
+        };
+        let ms = table.reference_ms[j];
+        let (state, flags) = start(ambient.residual_heat_celsius[c]);
+        prop_assert!(!flags.intersects(Flags::HISTORY_OUT_OF_SPAN | Flags::HISTORY_UNKNOWN));
+        let stored = ambient.curves[c].points[j].k_dps_per_celsius;
+        for rise in [rises.0, rises.1] {
+            let got = table.correlation(&settings(), &mut state.clone(), ms, rise);
+            prop_assert_eq!(got.0, stored);
+            prop_assert!(!got.1.contains(Flags::RISE_OUT_OF_SPAN));
+        }
+        if c + 1 < ambient.curves.len() {
+            let heat = 0.4 * (c as f32 + between_u);
+            let (state, _) = start(heat);
+            let got = table.correlation(&settings(), &mut state.clone(), ms, rises.0).0;
+            let (lo, hi) = (stored, ambient.curves[c + 1].points[j].k_dps_per_celsius);
+            prop_assert!(got >= lo.min(hi) - 1e-7 && got <= lo.max(hi) + 1e-7, "{got} not in {lo}..{hi}");
+        }
+        let (state, _) = start(wild);
+        let got = table.correlation(&settings(), &mut state.clone(), ms, rises.0).0;
+        prop_assert!(got.is_finite());
     }
 }

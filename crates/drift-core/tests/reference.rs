@@ -37,6 +37,8 @@ const TEMPERATURE_STUCK: u32 = 32;
 const RATE_INVALID: u32 = 64;
 const NOT_POWERED_ON: u32 = 128;
 const EXTENSION_INPUT_INVALID: u32 = 512;
+const HISTORY_UNKNOWN: u32 = 1024;
+const HISTORY_OUT_OF_SPAN: u32 = 2048;
 
 fn f(v: &Value) -> f64 {
     v.as_f64().unwrap()
@@ -100,6 +102,8 @@ struct State {
     repeats: u32,
     activation: u32,
     ambient: (usize, usize, f64),
+    /// Tables keyed by heating history: the bracketing histories and the blend, fixed at switch-on.
+    history: Option<(usize, usize, f64)>,
     poly_on: f64,
 }
 
@@ -121,7 +125,34 @@ fn poly(axis: &Value, celsius: f64, margin: f64) -> (f64, bool) {
     )
 }
 
-fn power_on(axis: &Axis, s: &Settings, raw: f64) -> State {
+/// The docs' estimate of (ambient, residual heat, known) at switch-on from what was kept of the
+/// previous activation, `(ambient, switch-off temperature)`.
+fn estimate(celsius: f64, previous: Option<(f64, f64)>) -> (f64, f64, bool) {
+    match previous {
+        Some((ambient, off)) if ambient.is_finite() && off.is_finite() => {
+            if celsius >= off {
+                (celsius, 0.0, true)
+            } else {
+                let ambient = ambient.min(celsius);
+                (ambient, celsius - ambient, true)
+            }
+        }
+        _ => (celsius, 0.0, false),
+    }
+}
+
+/// Where `x` falls among `knots`, with the side flag of `bracket` turned into "beyond the margin".
+fn locate(knots: &[f64], x: f64, margin: f64) -> (usize, usize, f64, bool) {
+    let (lo, hi, w, side) = bracket(knots, x);
+    let outside = match side {
+        -1 => x < knots[0] - margin,
+        1 => x > knots[knots.len() - 1] + margin,
+        _ => false,
+    };
+    (lo, hi, w, outside)
+}
+
+fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -> State {
     let celsius = (raw - s.zero) / s.per;
     let mut state = State {
         on_raw: raw,
@@ -131,22 +162,51 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64) -> State {
         repeats: 0,
         activation: 0,
         ambient: (0, 0, 0.0),
+        history: None,
         poly_on: 0.0,
     };
     match axis {
         Axis::Modified(table) => {
             let ambients = table["ambients"].as_array().unwrap();
             let temps: Vec<f64> = ambients.iter().map(|a| f(&a["ambient_celsius"])).collect();
-            let (lo, hi, w, side) = bracket(&temps, celsius);
-            let outside = match side {
-                -1 => celsius < temps[0] - s.ambient_margin,
-                1 => celsius > temps[temps.len() - 1] + s.ambient_margin,
-                _ => false,
+            let labels = |a: usize| list(&ambients[a]["residual_heat_celsius"]);
+            let keyed_by_history = !labels(0).is_empty();
+            let (mut at, mut heat) = (celsius, 0.0);
+            if keyed_by_history {
+                let (ambient, residual, known) = estimate(celsius, previous);
+                if !known {
+                    state.activation |= HISTORY_UNKNOWN;
+                }
+                (at, heat) = (ambient, residual);
+            }
+            let history_at = |at: f64, heat: f64| {
+                let (lo, hi, w, _) = locate(&temps, at, s.ambient_margin);
+                let blended: Vec<f64> = labels(lo)
+                    .iter()
+                    .zip(labels(hi))
+                    .map(|(l, u)| lerp(*l, u, w))
+                    .collect();
+                locate(&blended, heat, s.rise_margin)
             };
+            if keyed_by_history {
+                let (mut lo, mut hi, mut w, outside) = history_at(at, heat);
+                if outside {
+                    state.activation |= HISTORY_OUT_OF_SPAN;
+                    if heat > 0.0 {
+                        // More residual heat than any stored history: the ambient changed.
+                        (at, heat) = (celsius, 0.0);
+                        (lo, hi, w, _) = history_at(at, heat);
+                    }
+                }
+                state.history = Some((lo, hi, w));
+            }
+            let (lo, hi, w, outside) = locate(&temps, at, s.ambient_margin);
             if outside {
                 state.activation |= AMBIENT_OUT_OF_RANGE;
             }
             state.ambient = (lo, hi, w);
+            // The initial bias at the switch-on temperature, whatever the history.
+            let (lo, hi, w, _) = locate(&temps, celsius, s.ambient_margin);
             state.initial = lerp(
                 f(&ambients[lo]["initial_bias_dps"]),
                 f(&ambients[hi]["initial_bias_dps"]),
@@ -169,13 +229,12 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64) -> State {
 /// bracketing ambients with weight `w` (stage 2), then the blended curves bracketing `rise` are
 /// interpolated (stage 3). Returns (k, rise beyond the span by more than the margin).
 fn k_at(
-    lower: &Value,
-    upper: &Value,
-    w: f64,
+    (lower, upper, w): (&Value, &Value, f64),
     refs: &[f64],
     ms: f64,
     rise: f64,
     margin: f64,
+    history: Option<(usize, usize, f64)>,
 ) -> (f64, bool) {
     let at_time = |values: &[f64], is_rise: bool| -> f64 {
         if ms < refs[0] {
@@ -210,6 +269,10 @@ fn k_at(
     };
     let rises = blended("rise_celsius", true);
     let ks = blended("k_dps_per_celsius", false);
+    if let Some((lo, hi, w)) = history {
+        // Keyed by history: the rise does not choose the curves.
+        return (lerp(ks[lo], ks[hi], w), false);
+    }
     let n = rises.len();
     if rise < rises[0] {
         return (ks[0], rise < rises[0] - margin);
@@ -273,13 +336,12 @@ fn correct(
                     }
                     let (lo, hi, w) = st.ambient;
                     let (k, out) = k_at(
-                        &ambients[lo],
-                        &ambients[hi],
-                        w,
+                        (&ambients[lo], &ambients[hi], w),
                         &refs,
                         ms,
                         rise,
                         s.rise_margin,
+                        st.history,
                     );
                     if out {
                         flags |= RISE_OUT_OF_SPAN;
@@ -329,7 +391,13 @@ fn vectors_agree_with_an_independent_f64_reference() {
         );
         let mut states: Vec<State> = match switch_on {
             Some(raw) if powered => (0..3)
-                .map(|i| power_on(&axes[i], &s, f64::from(raw[i])))
+                .map(|i| {
+                    let previous = case.previous.map(|kept| {
+                        let [ambient, off] = kept[i].map(|b| f64::from(f32::from_bits(b)));
+                        (ambient, off)
+                    });
+                    power_on(&axes[i], &s, f64::from(raw[i]), previous)
+                })
                 .collect(),
             _ => Vec::new(),
         };

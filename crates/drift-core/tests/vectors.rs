@@ -18,7 +18,7 @@ mod common;
 
 use common::format::{Case, VectorFile};
 use drift_core::blob::{decode, Image};
-use drift_core::{Corrector, Model, ModifiedTables, PolynomialTables, Sample};
+use drift_core::{Corrector, Model, ModifiedTables, PolynomialTables, Previous, Sample};
 
 const PATH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/vectors.json");
 
@@ -57,12 +57,12 @@ fn same(expected: u32, got: u32) -> bool {
 fn check_case<M: Model>(model: &M, case: &Case) -> usize {
     let mut corrector = Corrector::new(model).unwrap();
     if let Some(raw) = case.switch_on_raw {
-        assert_eq!(
-            corrector.power_on(raw.map(f32::from_bits)).is_err(),
-            case.power_on_fails,
-            "{}",
-            case.name
-        );
+        let raw = raw.map(f32::from_bits);
+        let started = match kept(case) {
+            Some(mut previous) => corrector.power_on_after(raw, &mut previous),
+            None => corrector.power_on(raw),
+        };
+        assert_eq!(started.is_err(), case.power_on_fails, "{}", case.name);
     }
     let mut mismatches = 0;
     for (i, (input, expected)) in case.samples.iter().zip(&case.expected).enumerate() {
@@ -95,6 +95,16 @@ fn check_case<M: Model>(model: &M, case: &Case) -> usize {
     mismatches
 }
 
+/// The case's kept previous activation, as drift-core takes it.
+fn kept(case: &Case) -> Option<[Previous; 3]> {
+    case.previous.map(|kept| {
+        kept.map(|[ambient, off]| Previous {
+            ambient_celsius: f32::from_bits(ambient),
+            switch_off_celsius: f32::from_bits(off),
+        })
+    })
+}
+
 fn model<M: Image>(file: &VectorFile, name: &str) -> M {
     let named = file.models.iter().find(|m| m.name == name).unwrap();
     decode::<M>(&unhex(&named.image_hex)).unwrap()
@@ -107,6 +117,8 @@ fn corrector_reproduces_vectors_bit_for_bit() {
     let standard: PolynomialTables = model(&file, "standard");
     let third_order: PolynomialTables = model(&file, "third_order");
     let extended: ModifiedTables = model(&file, "extended");
+    let by_history: ModifiedTables = model(&file, "by_history");
+    assert!(by_history.axes.iter().all(|axis| axis.keyed_by_history()));
     let mut total = 0;
     let mut samples = 0;
     for case in &file.cases {
@@ -116,6 +128,7 @@ fn corrector_reproduces_vectors_bit_for_bit() {
             "standard" => check_case(&standard, case),
             "third_order" => check_case(&third_order, case),
             "extended" => check_case(&extended, case),
+            "by_history" => check_case(&by_history, case),
             other => panic!("unknown model {other}"),
         };
     }

@@ -121,6 +121,7 @@ fn axis_table(
             ambient_celsius: sp.ambient_celsius[axis] as f32,
             initial_bias_dps: sp.initial_bias_dps[axis] as f32,
             curves: heapless::Vec::new(),
+            residual_heat_celsius: heapless::Vec::new(),
         };
         if ambient.ambient_celsius <= last_ambient {
             return Err(format!(

@@ -1,6 +1,7 @@
 //! Stage 3: heating dynamics. The unit does not know how long it was off; the current temperature
 //! rise picks the two stored activation curves whose rises bracket it, and `k` is interpolated
-//! between them by rise.
+//! between them by rise. A table keyed by history instead reads the two curves whose histories
+//! bracket the activation's residual heat at switch-on ([`by_history`]).
 
 use crate::error::saturating_u8;
 use crate::interp::lerp;
@@ -180,6 +181,54 @@ pub(crate) fn search<const R: usize>(
         saturating_u8(lo).min(TOP - 1)
     };
     interpolate(lower, upper, top, rise_celsius, margin_celsius)
+}
+
+/// Stage 3 of a table keyed by history: `k` at `moment` from curves `history_lo` and the next one,
+/// blended by `history_weight` (fixed for the activation). Refills the lower cached knots (`cache`)
+/// so that [`cached_k`] serves the rest of the segment with no change to the paper's path: the
+/// cached knots are the blend's, with a NaN rise (every rise comparison there is false, so it
+/// returns the cached `k`, unflagged, as for a rise above the last curve) under the `TOP`
+/// sentinel, which also keeps it from reading the upper knots.
+#[inline(always)]
+pub(crate) fn by_history<const R: usize>(
+    curves: &BlendedCurves<'_, R>,
+    moment: Moment,
+    history_lo: u8,
+    history_weight: f32,
+    cache: &mut Knots,
+    curve: &mut u8,
+) -> f32 {
+    let lo = usize::from(history_lo);
+    let [lower, lower_change] = curves.knots(lo);
+    let blend = |lower: f32, upper: f32| {
+        if history_weight > 0.0 {
+            lerp(lower, upper, history_weight)
+        } else {
+            // Also when there is no next curve (clamped to the last history): its NaN stays out.
+            lower
+        }
+    };
+    let [upper, upper_change] = if history_weight > 0.0 {
+        curves.knots(lo.saturating_add(1))
+    } else {
+        [lower, lower_change]
+    };
+    let blended = [
+        CurvePoint {
+            rise_celsius: f32::NAN,
+            k_dps_per_celsius: blend(lower.k_dps_per_celsius, upper.k_dps_per_celsius),
+        },
+        CurvePoint {
+            rise_celsius: 0.0,
+            k_dps_per_celsius: blend(
+                lower_change.k_dps_per_celsius,
+                upper_change.k_dps_per_celsius,
+            ),
+        },
+    ];
+    *cache = blended;
+    *curve = TOP;
+    at_time(moment, blended).k_dps_per_celsius
 }
 
 /// `k` inside the bracket `lower`..`upper` (`top`: `lower` is the last curve, no upper), clamped

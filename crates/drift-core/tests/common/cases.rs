@@ -5,7 +5,7 @@
 //! f64 restatement of the method, so the file is not merely self-consistent.
 
 use drift_core::blob::{encode, Image};
-use drift_core::{Corrector, Model, Sample};
+use drift_core::{Corrector, Model, Previous, Sample};
 
 use super::fixture;
 use super::format::{Case, NamedModel, VectorFile};
@@ -38,6 +38,9 @@ struct Scenario {
     tamper: fn(usize, u32, &mut [f32; 3], &mut [f32; 3]),
     /// Auxiliary inputs per (sample index, ms), for the extended model; None: `correct` without.
     aux: Option<fn(usize, u32) -> [f32; 4]>,
+    /// What was kept of the previous activation per axis, `[ambient °C, switch-off °C]`: starts
+    /// with `power_on_after` instead of `power_on`.
+    previous: Option<[[f32; 2]; 3]>,
 }
 
 /// Supply voltage sagging and recovering, an accelerometer turned over half-way, and one NaN
@@ -79,6 +82,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(500, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-on-calibration-ambient",
@@ -89,6 +93,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(1000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-ambient-below-range",
@@ -99,6 +104,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(4000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-ambient-above-range",
@@ -109,6 +115,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(4000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-rise-out-of-span",
@@ -119,6 +126,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(2000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-past-last-reference",
@@ -129,6 +137,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(3000, 300_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-temperature-faults",
@@ -149,6 +158,7 @@ fn scenarios() -> Vec<Scenario> {
                 }
             },
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-rate-faults",
@@ -165,6 +175,7 @@ fn scenarios() -> Vec<Scenario> {
                 _ => {}
             },
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-not-powered-on",
@@ -175,6 +186,7 @@ fn scenarios() -> Vec<Scenario> {
             times: (0..10).map(|i| i * 100).collect(),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "modified-power-on-rejects-nan",
@@ -185,6 +197,7 @@ fn scenarios() -> Vec<Scenario> {
             times: (0..10).map(|i| i * 100).collect(),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "standard-nominal",
@@ -195,6 +208,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(2000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "standard-out-of-range",
@@ -205,6 +219,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(4000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "third-order-nominal",
@@ -215,6 +230,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(2000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
         },
         Scenario {
             name: "extended-with-aux",
@@ -225,6 +241,7 @@ fn scenarios() -> Vec<Scenario> {
             times: every(1000, 120_000),
             tamper: untouched,
             aux: Some(supply_and_gravity),
+            previous: None,
         },
         Scenario {
             name: "extended-temperature-faults",
@@ -242,6 +259,7 @@ fn scenarios() -> Vec<Scenario> {
                 }
             },
             aux: Some(supply_and_gravity),
+            previous: None,
         },
         Scenario {
             name: "extended-without-aux",
@@ -252,6 +270,62 @@ fn scenarios() -> Vec<Scenario> {
             times: every(5000, 120_000),
             tamper: untouched,
             aux: None,
+            previous: None,
+        },
+        Scenario {
+            name: "history-warm-start",
+            description: "tables keyed by heating history: switched on at 33 °C after a short off-time at a 31 °C ambient (X, Y) and 30.5 °C (Z): stage 2 at the ambient, stage 3 at 2.0 / 2.2 / 2.5 °C of residual heat, between stored histories",
+            model: "by_history",
+            switch_on_celsius: Some([33.0, 33.2, 33.0]),
+            final_rise: [3.0, 2.5, 3.5],
+            times: every(1000, 150_000),
+            tamper: untouched,
+            aux: None,
+            previous: Some([[31.0, 36.0], [31.0, 35.5], [30.5, 35.0]]),
+        },
+        Scenario {
+            name: "history-unknown",
+            description: "tables keyed by history powered on with plain power_on (nothing kept): a cold start at the switch-on temperature, flagged HISTORY_UNKNOWN",
+            model: "by_history",
+            switch_on_celsius: Some([27.0, 27.0, 27.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(4000, 120_000),
+            tamper: untouched,
+            aux: None,
+            previous: None,
+        },
+        Scenario {
+            name: "history-ambient-changed",
+            description: "tables keyed by history: X switched on above its last switch-off temperature (the ambient rose: cold start); Y with 13 °C of apparent residual heat, beyond every stored history (the ambient rose: cold start, flagged HISTORY_OUT_OF_SPAN); Z colder than its last ambient (the ambient fell: cold start at the new ambient)",
+            model: "by_history",
+            switch_on_celsius: Some([33.0, 33.0, 33.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(4000, 120_000),
+            tamper: untouched,
+            aux: None,
+            previous: Some([[25.0, 28.0], [20.0, 40.0], [35.0, 39.0]]),
+        },
+        Scenario {
+            name: "history-nothing-finite-kept",
+            description: "tables keyed by history, power_on_after with a NaN kept ambient on Y (nothing usable kept there: cold start, flagged HISTORY_UNKNOWN on Y only)",
+            model: "by_history",
+            switch_on_celsius: Some([31.0, 31.0, 31.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(5000, 60_000),
+            tamper: untouched,
+            aux: None,
+            previous: Some([[30.0, 34.0], [f32::NAN, 34.0], [30.0, 34.0]]),
+        },
+        Scenario {
+            name: "modified-ignores-history",
+            description: "the paper's tables (keyed by rise) powered on with power_on_after: what was kept is ignored, the outputs are power_on's",
+            model: "modified",
+            switch_on_celsius: Some([33.0, 33.2, 32.9]),
+            final_rise: [4.1, 3.3, 5.2],
+            times: every(2000, 120_000),
+            tamper: untouched,
+            aux: None,
+            previous: Some([[31.0, 36.0], [31.0, 35.5], [30.5, 35.0]]),
         },
     ]
 }
@@ -271,7 +345,16 @@ where
         .map(|c| c.map(|c| (c * 200.0).round()));
     let mut power_on_fails = false;
     if let Some(raw) = switch_on_raw {
-        power_on_fails = corrector.power_on(raw).is_err();
+        power_on_fails = match scenario.previous {
+            Some(kept) => {
+                let mut previous = kept.map(|[ambient_celsius, switch_off_celsius]| Previous {
+                    ambient_celsius,
+                    switch_off_celsius,
+                });
+                corrector.power_on_after(raw, &mut previous).is_err()
+            }
+            None => corrector.power_on(raw).is_err(),
+        };
     }
     let base_raw = switch_on_raw
         .unwrap_or([6000.0; 3])
@@ -318,6 +401,9 @@ where
         description: scenario.description.into(),
         model: scenario.model.into(),
         switch_on_raw: switch_on_raw.map(bits3),
+        previous: scenario
+            .previous
+            .map(|kept| kept.map(|pair| pair.map(f32::to_bits))),
         power_on_fails,
         samples,
         expected,
@@ -343,6 +429,7 @@ pub fn build() -> VectorFile {
     let standard = fixture::standard();
     let third_order = fixture::third_order();
     let extended = fixture::extended();
+    let by_history = fixture::by_history();
     let cases = scenarios()
         .iter()
         .enumerate()
@@ -350,6 +437,7 @@ pub fn build() -> VectorFile {
             "modified" => run(&modified, scenario, i as u64 + 1),
             "standard" => run(&standard, scenario, i as u64 + 1),
             "extended" => run(&extended, scenario, i as u64 + 1),
+            "by_history" => run(&by_history, scenario, i as u64 + 1),
             _ => run(&third_order, scenario, i as u64 + 1),
         })
         .collect();
@@ -359,7 +447,7 @@ pub fn build() -> VectorFile {
         description: vec![
             "Shared test vectors for every implementation of the gyrodrift corrector (Rust host, Cortex-M4 firmware, Python).".into(),
             "Each model is given as its firmware image (canonical, bit-exact) and as JSON (readable).".into(),
-            "Each case: optional power_on(switch_on_raw), then correct() per sample (correct_with_aux(aux[i]) when the case has aux), in order, on one fresh state.".into(),
+            "Each case: optional power_on(switch_on_raw) (power_on_after(switch_on_raw, previous) when the case has previous: per axis [ambient °C, switch-off °C]), then correct() per sample (correct_with_aux(aux[i]) when the case has aux), in order, on one fresh state.".into(),
             "samples: [since_power_on_ms, rate x,y,z (°/s), temperature_raw x,y,z]; expected: [corrected x,y,z, bias x,y,z, flags x,y,z].".into(),
             "Floats are IEEE-754 binary32 bit patterns. Expected outputs must match bit for bit; a NaN matches any NaN.".into(),
             "Regenerate with: GYRODRIFT_BLESS=1 cargo test -p drift-core --test vectors".into(),
@@ -369,6 +457,7 @@ pub fn build() -> VectorFile {
             named("standard", "polynomial", &standard),
             named("third_order", "polynomial", &third_order),
             named("extended", "modified", &extended),
+            named("by_history", "modified", &by_history),
         ],
         cases,
     }

@@ -66,6 +66,7 @@ pub fn modified() -> FixtureTables {
                 ambient_celsius: ambient,
                 initial_bias_dps: round5(bias0 + bias_slope * (f64::from(ambient) - 30.0)),
                 curves: heapless::Vec::new(),
+                residual_heat_celsius: heapless::Vec::new(),
             };
             for c in 0..CURVES {
                 let mut curve = Curve::default();
@@ -162,4 +163,20 @@ pub fn extended() -> FixtureTables {
         terms: heapless::Vec::from_slice(&terms).unwrap(),
     };
     modified().with_extension(extension).unwrap()
+}
+
+/// The modified fixture with stage 3 keyed by heating history: curve `c` is the history that left
+/// `0.2 · c` °C of residual heat at switch-on (a little more at warmer ambients, as a unit that
+/// heats less there cools less too).
+pub fn by_history() -> FixtureTables {
+    let mut tables = modified();
+    for axis in &mut tables.axes {
+        for ambient in &mut axis.ambients {
+            let scale = 1.0 + 0.01 * (ambient.ambient_celsius - 30.0);
+            ambient.residual_heat_celsius = (0..CURVES)
+                .map(|c| round5(0.2 * c as f64 * f64::from(scale)))
+                .collect();
+        }
+    }
+    tables
 }

@@ -46,6 +46,11 @@ pub struct Case {
     /// Raw switch-on temperature per axis (f32 bits); `null` means: samples arrive without any
     /// `power_on`.
     pub switch_on_raw: Option<[u32; 3]>,
+    /// What was kept of the previous activation, per axis `[ambient °C, switch-off °C]` (f32
+    /// bits): when present, the case starts with `power_on_after(switch_on_raw, previous)` rather
+    /// than `power_on` (tables keyed by heating history read it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub previous: Option<[[u32; 2]; 3]>,
     /// Whether `power_on` must fail (then the samples pass through, flagged not powered on).
     pub power_on_fails: bool,
     /// Samples: `[since_power_on_ms, rate x, y, z, temperature_raw x, y, z]` (floats as bits).

@@ -1,0 +1,125 @@
+//! The heating history at switch-on, as firmware can know it without a clock: what it kept of the
+//! previous activation across power-off.
+//!
+//! The paper's stage 3 finds the history by the rise; when warm starts heat faster than cold ones
+//! the curves cross and the rise names the wrong history (docs/closed-loop.md). A table keyed by
+//! history ([`crate::AmbientCurves::residual_heat_celsius`]) reads it from here instead.
+
+/// What firmware keeps of one axis's last activation across power-off (8 bytes per axis), outside
+/// the corrector's state: [`crate::CorrectorState::power_on_after`] reads and updates it,
+/// [`crate::CorrectorState::keep`] records the switch-off temperature.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Previous {
+    /// The ambient estimated for that activation, °C.
+    pub ambient_celsius: f32,
+    /// The last good temperature reading of that activation, °C.
+    pub switch_off_celsius: f32,
+}
+
+impl Previous {
+    /// Nothing kept (the first activation): the next start is taken as fully cooled, flagged.
+    pub const NOTHING: [Self; crate::AXES] = [Self {
+        ambient_celsius: f32::NAN,
+        switch_off_celsius: f32::NAN,
+    }; crate::AXES];
+}
+
+/// The ambient and the residual heat an activation switched on with, estimated from the switch-on
+/// temperature and what was kept of the previous activation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SwitchOn {
+    /// The temperature at switch-on, °C.
+    pub switch_on_celsius: f32,
+    /// The ambient, °C: where stage 2 of a history-keyed table looks.
+    pub ambient_celsius: f32,
+    /// How far the switch-on temperature stands above it, °C (≥ 0): where stage 3 looks.
+    pub residual_heat_celsius: f32,
+    /// False when nothing was kept (or it was not finite): then the start is taken as fully cooled,
+    /// which is what the paper's cold start is.
+    pub known: bool,
+}
+
+impl SwitchOn {
+    /// The estimate. A unit cannot be warmer than the ambient it last saw unless its own heat is
+    /// still in it, and it cannot be warmer than when it was switched off by its own heat alone:
+    ///
+    /// - nothing kept: ambient = switch-on temperature, no residual heat, not known;
+    /// - switched on at or above the previous switch-off temperature: the ambient rose during the
+    ///   off-time; ambient = switch-on temperature, no residual heat;
+    /// - otherwise: ambient = the lower of the previous ambient and the switch-on temperature,
+    ///   residual heat = switch-on temperature − ambient.
+    ///
+    /// An ambient that rises during the off-time by less than the unit's own rise reads as residual
+    /// heat: only a clock kept across power-off would tell the two apart.
+    pub fn estimate(switch_on_celsius: f32, previous: Option<Previous>) -> Self {
+        let cold = |known| Self {
+            switch_on_celsius,
+            ambient_celsius: switch_on_celsius,
+            residual_heat_celsius: 0.0,
+            known,
+        };
+        let Some(previous) =
+            previous.filter(|p| p.ambient_celsius.is_finite() && p.switch_off_celsius.is_finite())
+        else {
+            return cold(false);
+        };
+        if switch_on_celsius >= previous.switch_off_celsius {
+            return cold(true);
+        }
+        let ambient = previous.ambient_celsius.min(switch_on_celsius);
+        Self {
+            switch_on_celsius,
+            ambient_celsius: ambient,
+            residual_heat_celsius: switch_on_celsius - ambient,
+            known: true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn previous(ambient: f32, off: f32) -> Option<Previous> {
+        Some(Previous {
+            ambient_celsius: ambient,
+            switch_off_celsius: off,
+        })
+    }
+
+    #[test]
+    fn nothing_kept_is_a_cold_start_not_known() {
+        let s = SwitchOn::estimate(30.5, None);
+        assert_eq!(
+            (s.ambient_celsius, s.residual_heat_celsius, s.known),
+            (30.5, 0.0, false)
+        );
+        let s = SwitchOn::estimate(30.5, previous(f32::NAN, 35.0));
+        assert!(!s.known);
+    }
+
+    #[test]
+    fn short_off_time_keeps_the_ambient_and_reads_residual_heat() {
+        let s = SwitchOn::estimate(32.0, previous(30.0, 35.0));
+        assert_eq!(
+            (s.ambient_celsius, s.residual_heat_celsius, s.known),
+            (30.0, 2.0, true)
+        );
+    }
+
+    #[test]
+    fn colder_than_the_ambient_lowers_it() {
+        let s = SwitchOn::estimate(28.0, previous(30.0, 35.0));
+        assert_eq!((s.ambient_celsius, s.residual_heat_celsius), (28.0, 0.0));
+    }
+
+    #[test]
+    fn warmer_than_at_switch_off_means_the_ambient_rose() {
+        let s = SwitchOn::estimate(36.0, previous(30.0, 35.0));
+        assert_eq!(
+            (s.ambient_celsius, s.residual_heat_celsius, s.known),
+            (36.0, 0.0, true)
+        );
+    }
+}
