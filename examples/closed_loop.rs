@@ -25,7 +25,7 @@ const EFFECTS: [&str; 8] = [
 
 fn print(r: &Row) {
     println!(
-        "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {:.4} |",
+        "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} |",
         r.effect,
         r.seed,
         r.axis,
@@ -43,18 +43,25 @@ fn print(r: &Row) {
         r.before.0,
         r.after.0,
         r.floor.0,
+        r.by_history.0,
+        if r.before.0 > r.floor.0 {
+            format!("{:.1}×", r.history_drift_cut())
+        } else {
+            "– (floor above)".to_owned()
+        },
     );
 }
 
 const USAGE: &str = "closed_loop [--seeds 1] [--first-seed 1] [--sessions 6] [--scale 1] \
-[--effects none,thermal_lag,…] [--calibration 30,40]";
-const FLAGS: [&str; 6] = [
+[--effects none,thermal_lag,…] [--calibration 30,40] [--clock yes|no]";
+const FLAGS: [&str; 7] = [
     "--seeds",
     "--first-seed",
     "--sessions",
     "--scale",
     "--effects",
     "--calibration",
+    "--clock",
 ];
 
 fn main() -> anyhow::Result<()> {
@@ -85,9 +92,18 @@ fn main() -> anyhow::Result<()> {
         calibration: value("--calibration").map_or(Ok(defaults.calibration), |s| {
             s.split(',').map(|t| t.trim().parse::<f64>()).collect()
         })?,
+        clock: match value("--clock").as_deref() {
+            None | Some("yes") => true,
+            Some("no") => false,
+            Some(other) => anyhow::bail!("--clock takes yes or no, got `{other}`"),
+        },
     };
     plan.check()?;
-    eprintln!("calibration set points {:?} °C", plan.calibration);
+    eprintln!(
+        "calibration set points {:?} °C; history-keyed firmware {} a clock",
+        plan.calibration,
+        if plan.clock { "with" } else { "without" }
+    );
     let effects: Vec<String> = value("--effects").map_or_else(
         || EFFECTS.map(String::from).to_vec(),
         |s| s.split(',').map(String::from).collect(),
@@ -95,8 +111,8 @@ fn main() -> anyhow::Result<()> {
     let work = tempfile::tempdir()?;
     let settings = drift_fit::FitSettings::default();
     let mut rows: Vec<Row> = Vec::new();
-    println!("| effect | seed | axis | top candidate | significant | terms admitted | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift |");
-    println!("|---|---:|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| effect | seed | axis | top candidate | significant | terms admitted | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift | drift keyed by history | drift excess cut by history |");
+    println!("|---|---:|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for effect in &effects {
         for seed in first_seed..first_seed + seeds {
             eprintln!("{effect}, seed {seed} …");

@@ -22,6 +22,10 @@ use crate::output::write_atomic;
 pub enum Stored {
     /// The paper's tables (`modified.bin`).
     Modified,
+    /// The paper's curves with stage 3 keyed by heating history (`by_history.bin`); each unit's
+    /// activations run in recording order, each starting from what its firmware kept of the one
+    /// before.
+    ByHistory,
     /// The paper's standard polynomial (`standard.bin`).
     Standard,
     /// The 3rd-order polynomial (`third_order.bin`).
@@ -32,6 +36,7 @@ impl Stored {
     fn file_name(self) -> &'static str {
         match self {
             Self::Modified => "modified.bin",
+            Self::ByHistory => "by_history.bin",
             Self::Standard => "standard.bin",
             Self::ThirdOrder => "third_order.bin",
         }
@@ -118,6 +123,9 @@ fn check_all<M: Model + Image>(
                 entry.insert((image, check))
             }
         };
+        // A recording's activations in order, each starting from what the firmware kept of the
+        // one before; nothing is known of the time between recordings.
+        check.forget_history();
         for segment in &recording.segments {
             check.add(segment);
         }
@@ -202,7 +210,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let settings = load_settings(args.settings.as_deref())?;
     let steps = Steps::new(args.quiet);
     let results = match args.model {
-        Stored::Modified => check_all::<ModifiedTables>(args, &files, &settings, &limits, &steps)?,
+        Stored::Modified | Stored::ByHistory => {
+            check_all::<ModifiedTables>(args, &files, &settings, &limits, &steps)?
+        }
         Stored::Standard | Stored::ThirdOrder => {
             check_all::<PolynomialTables>(args, &files, &settings, &limits, &steps)?
         }

@@ -258,7 +258,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         }
         let before_after = if closed.extended.is_some() {
-            closed.before_after(fitted, &options.fit)
+            closed.before_after(fitted, &options.fit, true)
         } else {
             Vec::new()
         };

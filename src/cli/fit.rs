@@ -42,7 +42,7 @@ fn image<M: Image>(model: &M) -> anyhow::Result<Vec<u8>> {
     Ok(buffer)
 }
 
-/// Writes each unit's models as `<out>/<unit>/{modified,standard,third_order}.{json,bin}`.
+/// Writes each unit's models as `<out>/<unit>/{modified,by_history,standard,third_order}.{json,bin}`.
 ///
 /// Every file is encoded in memory first, so an encoding error leaves the folder untouched; each
 /// file is then replaced atomically (`write_atomic`), so none is ever half-written.
@@ -55,6 +55,13 @@ pub fn write_tables(out: &Path, fitted: &[FittedUnit]) -> anyhow::Result<()> {
             serde_json::to_string_pretty(&unit.modified)?.into_bytes(),
         ));
         files.push((dir.join("modified.bin"), image(&unit.modified)?));
+        // The same curves with stage 3 keyed by heating history (firmware that keeps what it knew
+        // of the previous activation: `power_on_after`).
+        files.push((
+            dir.join("by_history.json"),
+            serde_json::to_string_pretty(&unit.by_history)?.into_bytes(),
+        ));
+        files.push((dir.join("by_history.bin"), image(&unit.by_history)?));
         for (name, model) in [
             ("standard", &unit.standard),
             ("third_order", &unit.third_order),

@@ -23,6 +23,15 @@ impl Previous {
         ambient_celsius: f32::NAN,
         switch_off_celsius: f32::NAN,
     }; crate::AXES];
+
+    /// Known to have cooled fully (a clock says the unit was off longer than the calibration's
+    /// cool-down): the next start is cold, at whatever ambient it finds, and not flagged. Without
+    /// it, an ambient that rose during the off-time by less than the unit's own rise reads as
+    /// residual heat ([`SwitchOn::estimate`]).
+    pub const COOLED: [Self; crate::AXES] = [Self {
+        ambient_celsius: f32::NAN,
+        switch_off_celsius: f32::NEG_INFINITY,
+    }; crate::AXES];
 }
 
 /// The ambient and the residual heat an activation switched on with, estimated from the switch-on
@@ -45,6 +54,7 @@ impl SwitchOn {
     /// still in it, and it cannot be warmer than when it was switched off by its own heat alone:
     ///
     /// - nothing kept: ambient = switch-on temperature, no residual heat, not known;
+    /// - known to have cooled fully ([`Previous::COOLED`]): the same, known;
     /// - switched on at or above the previous switch-off temperature: the ambient rose during the
     ///   off-time; ambient = switch-on temperature, no residual heat;
     /// - otherwise: ambient = the lower of the previous ambient and the switch-on temperature,
@@ -97,6 +107,15 @@ mod tests {
         );
         let s = SwitchOn::estimate(30.5, previous(f32::NAN, 35.0));
         assert!(!s.known);
+    }
+
+    #[test]
+    fn cooled_is_a_known_cold_start_at_any_ambient() {
+        let s = SwitchOn::estimate(33.0, Some(Previous::COOLED[0]));
+        assert_eq!(
+            (s.ambient_celsius, s.residual_heat_celsius, s.known),
+            (33.0, 0.0, true)
+        );
     }
 
     #[test]

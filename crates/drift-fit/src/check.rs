@@ -8,10 +8,10 @@
 //! One pass, recording by recording: [`UnitCheck::add`] corrects one activation and keeps only its
 //! figures, so a long campaign is checked in the memory of one recording.
 
-use drift_core::{Flags, Model, Term};
+use drift_core::{Flags, Model, Previous, Term};
 use drift_recording::{Segment, SegmentLabels};
 
-use crate::evaluate::{correct_segment, metric, switch_on_raw};
+use crate::evaluate::{cooled_before, correct_segment_after, kept_after, metric, switch_on_raw};
 use crate::settings::FitSettings;
 
 /// What a calibration must still achieve on the recordings checked. Every figure is a mean over
@@ -121,6 +121,8 @@ pub struct UnitCheck<M: Model> {
     model: M,
     settings: FitSettings,
     activations: Vec<CheckedActivation>,
+    /// What the unit's firmware keeps across power-off, after the last activation added.
+    previous: [Previous; 3],
 }
 
 /// A model the check cannot run: its extended model reads an auxiliary input, and neither the
@@ -150,6 +152,7 @@ impl<M: Model> UnitCheck<M> {
             model,
             settings: settings.clone(),
             activations: Vec::new(),
+            previous: Previous::NOTHING,
         })
     }
 
@@ -158,12 +161,21 @@ impl<M: Model> UnitCheck<M> {
         &self.unit_id
     }
 
-    /// Corrects one activation as the firmware would and keeps its figures.
+    /// Corrects one activation as the firmware would and keeps its figures. Activations are added
+    /// in the order the unit lived them: firmware keeps what it knew of each one for the next
+    /// switch-on (`power_on_after`; only tables keyed by history read it), and knows from the
+    /// recording's off-time when the unit cooled fully ([`cooled_before`]).
     pub fn add(&mut self, segment: &Segment) {
         let window = self.settings.lowpass_window_samples;
         let (uncorrected_drift_dps, _) = metric(&segment.rate_dps, window);
         let switch_on = switch_on_raw(segment, &self.settings);
-        let (corrected, flags) = correct_segment(&self.model, segment, switch_on);
+        if cooled_before(segment, &self.settings) {
+            self.previous = Previous::COOLED;
+        }
+        let (corrected, flags) =
+            correct_segment_after(&self.model, segment, switch_on, Some(&self.previous));
+        let core = self.model.settings();
+        self.previous = kept_after(&self.previous, segment, &self.settings, core);
         let (corrected_drift_dps, residual_rms_dps) = metric(&corrected, window);
         self.activations.push(CheckedActivation {
             labels: segment.labels.clone(),
@@ -172,6 +184,12 @@ impl<M: Model> UnitCheck<M> {
             residual_rms_dps,
             flags,
         });
+    }
+
+    /// Starts the next activation with nothing kept (a new recording: what happened to the unit
+    /// between recordings is not known).
+    pub fn forget_history(&mut self) {
+        self.previous = Previous::NOTHING;
     }
 
     /// The activations checked so far.

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, Diagnoser};
 use crate::error::FitError;
-use crate::evaluate::{metric, switch_on_raw};
+use crate::evaluate::{correct_segment_after, kept_before, metric, switch_on_raw};
 use crate::extend::{correct_with_terms, extend, Extended, TermPlan};
 use crate::fit::FittedUnit;
 use crate::roles::Roles;
@@ -41,6 +41,12 @@ pub struct BeforeAfter {
     pub drift_dps: [(f64, f64); 3],
     /// Per axis, RMS of the 1-s mean, °/s: before, after.
     pub rms_dps: [(f64, f64); 3],
+    /// Per axis, the drift metric with the paper's curves keyed by heating history
+    /// ([`FittedUnit::by_history`], fed what firmware would have kept of the unit's previous
+    /// activation), °/s.
+    pub by_history_drift_dps: [f64; 3],
+    /// Per axis, the RMS with the curves keyed by heating history, °/s.
+    pub by_history_rms_dps: [f64; 3],
 }
 
 /// Splits `segments` (one unit's) by role, diagnoses the paper model `fitted` on the training
@@ -93,14 +99,40 @@ impl Closed<'_> {
 
     /// The error before (paper's model `fitted`) and after (the extended model; the paper's model
     /// when nothing was admitted) on every held-out activation.
-    pub fn before_after(&self, fitted: &FittedUnit, settings: &FitSettings) -> Vec<BeforeAfter> {
+    ///
+    /// The history-keyed model runs through the unit's whole life in order, as its firmware would
+    /// have lived it; `clock`: the firmware also knows when the unit cooled fully
+    /// ([`crate::evaluate::kept_before`]).
+    pub fn before_after(
+        &self,
+        fitted: &FittedUnit,
+        settings: &FitSettings,
+        clock: bool,
+    ) -> Vec<BeforeAfter> {
         let plan = self.admitted();
         let window = settings.lowpass_window_samples;
-        self.roles
+        // The unit's whole life in order, as its firmware would have lived it: every activation
+        // passes what it kept on to the next.
+        let roles = &self.roles;
+        let life: Vec<&Segment> = roles
+            .calibration
+            .iter()
+            .chain(&roles.training)
+            .chain(&roles.held_out)
+            .copied()
+            .collect();
+        let kept = kept_before(&life, settings, &fitted.by_history.settings, clock);
+        let kept_held_out = &kept[roles.calibration.len() + roles.training.len()..];
+        roles
             .held_out
             .iter()
-            .map(|segment| {
+            .zip(kept_held_out)
+            .map(|(segment, previous)| {
                 let on = switch_on_raw(segment, settings);
+                let (history_drift, history_rms) = metric(
+                    &correct_segment_after(&fitted.by_history, segment, on, Some(previous)).0,
+                    window,
+                );
                 let (drift_before, rms_before) = metric(
                     &correct_with_terms(&fitted.modified, &plan, segment, on),
                     window,
@@ -116,6 +148,8 @@ impl Closed<'_> {
                     series_kind: segment.labels.series_kind.as_str(),
                     drift_dps: std::array::from_fn(|a| (drift_before[a], drift_after[a])),
                     rms_dps: std::array::from_fn(|a| (rms_before[a], rms_after[a])),
+                    by_history_drift_dps: history_drift,
+                    by_history_rms_dps: history_rms,
                 }
             })
             .collect()

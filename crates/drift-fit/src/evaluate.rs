@@ -6,7 +6,7 @@
 //! same low-frequency component (the unit is static, so the true rate is zero); unlike the drift,
 //! it includes the error of the initial bias.
 
-use drift_core::{Corrector, Model, Sample};
+use drift_core::{Corrector, Model, Previous, Sample, SwitchOn};
 use drift_recording::{temperature_reading, Segment, SegmentLabels};
 
 use crate::fit::FittedUnit;
@@ -24,15 +24,19 @@ pub enum ModelKind {
     ThirdOrder,
     /// The paper's modified method.
     Modified,
+    /// The paper's tables with stage 3 keyed by heating history, fed what firmware would have
+    /// kept of the unit's previous activation ([`kept_before`]).
+    ByHistory,
 }
 
 impl ModelKind {
     /// Every model, in report order.
-    pub const ALL: [ModelKind; 4] = [
+    pub const ALL: [ModelKind; 5] = [
         Self::Uncorrected,
         Self::Standard,
         Self::ThirdOrder,
         Self::Modified,
+        Self::ByHistory,
     ];
 
     /// Name used in reports.
@@ -42,6 +46,7 @@ impl ModelKind {
             Self::Standard => "standard",
             Self::ThirdOrder => "3rd-order",
             Self::Modified => "modified",
+            Self::ByHistory => "by-history",
         }
     }
 }
@@ -140,6 +145,16 @@ pub fn correct_segment<M: Model>(
     segment: &Segment,
     switch_on: [f32; 3],
 ) -> ([Vec<f32>; 3], [u16; 3]) {
+    correct_segment_after(model, segment, switch_on, None)
+}
+
+/// [`correct_segment`] started with `power_on_after(previous)` when `previous` is given.
+pub fn correct_segment_after<M: Model>(
+    model: &M,
+    segment: &Segment,
+    switch_on: [f32; 3],
+    previous: Option<&[Previous; 3]>,
+) -> ([Vec<f32>; 3], [u16; 3]) {
     let n = segment.len();
     let mut corrected: [Vec<f32>; 3] = [
         Vec::with_capacity(n),
@@ -153,7 +168,11 @@ pub fn correct_segment<M: Model>(
             [drift_core::Flags::MODEL_INVALID.0; 3],
         );
     };
-    if corrector.power_on(switch_on).is_err() {
+    let started = match previous {
+        Some(previous) => corrector.power_on_after(switch_on, &mut previous.clone()),
+        None => corrector.power_on(switch_on),
+    };
+    if started.is_err() {
         return (
             segment.rate_dps.clone(),
             [drift_core::Flags::NOT_POWERED_ON.0; 3],
@@ -170,11 +189,86 @@ pub fn correct_segment<M: Model>(
     (corrected, flags)
 }
 
-/// Evaluates every model on one activation.
+/// Whether firmware with a clock would know the unit cooled fully before `segment`: off at least
+/// the calibration's cool-down (`independent_after_min`, the off-time after which the fit counts a
+/// start as independent), by the recording's off-time.
+pub fn cooled_before(segment: &Segment, settings: &FitSettings) -> bool {
+    segment
+        .labels
+        .off_before_s
+        .is_some_and(|s| s >= settings.independent_after_min * 60.0)
+}
+
+/// What firmware that keeps its history across power-off would know at each activation's
+/// switch-on (for [`evaluate_after`]), in the order of `segments`: the unit's activations in order
+/// of switch-on time (one unit per call), each one's ambient estimated from the one before
+/// (`drift_core::SwitchOn::estimate`, as `power_on_after` does) and the previous activation's
+/// last good temperature reading as its switch-off temperature. The first activation has nothing
+/// kept ([`Previous::NOTHING`]). With `clock`, the firmware also knows when the unit was off
+/// longer than the calibration's cool-down ([`cooled_before`]): then [`Previous::COOLED`].
+pub fn kept_before(
+    segments: &[&Segment],
+    settings: &FitSettings,
+    core: &drift_core::Settings,
+    clock: bool,
+) -> Vec<[Previous; 3]> {
+    let mut order: Vec<usize> = (0..segments.len()).collect();
+    order.sort_by_key(|&i| segments[i].power_on_ns);
+    let mut kept = vec![Previous::NOTHING; segments.len()];
+    let mut previous = Previous::NOTHING;
+    for i in order {
+        if clock && cooled_before(segments[i], settings) {
+            previous = Previous::COOLED;
+        }
+        kept[i] = previous;
+        previous = kept_after(&previous, segments[i], settings, core);
+    }
+    kept
+}
+
+/// What firmware keeps after `segment` for the next switch-on, having kept `previous` before it:
+/// per axis the ambient `power_on_after` estimates (`drift_core::SwitchOn::estimate`) and the
+/// last good temperature reading, as the corrector's `keep` records it (the switch-on reading if
+/// none followed).
+pub fn kept_after(
+    previous: &[Previous; 3],
+    segment: &Segment,
+    settings: &FitSettings,
+    core: &drift_core::Settings,
+) -> [Previous; 3] {
+    let switch_on = switch_on_raw(segment, settings);
+    std::array::from_fn(|axis| {
+        let estimate = SwitchOn::estimate(core.celsius(switch_on[axis]), Some(previous[axis]));
+        let last = segment.temperature_raw[axis]
+            .iter()
+            .rev()
+            .map(|&r| temperature_reading(r))
+            .find(|r| r.is_finite())
+            .unwrap_or(switch_on[axis]);
+        Previous {
+            ambient_celsius: estimate.ambient_celsius,
+            switch_off_celsius: core.celsius(last),
+        }
+    })
+}
+
+/// Evaluates every model on one activation, with nothing kept of the previous one (the
+/// history-keyed model then takes a cold start, flagged).
 pub fn evaluate(
     fitted: &FittedUnit,
     segment: &Segment,
     settings: &FitSettings,
+) -> ActivationResult {
+    evaluate_after(fitted, segment, settings, &Previous::NOTHING)
+}
+
+/// Evaluates every model on one activation; the history-keyed model starts with `previous`
+/// ([`kept_before`]).
+pub fn evaluate_after(
+    fitted: &FittedUnit,
+    segment: &Segment,
+    settings: &FitSettings,
+    previous: &[Previous; 3],
 ) -> ActivationResult {
     let window = settings.lowpass_window_samples;
     let switch_on = switch_on_raw(segment, settings);
@@ -186,6 +280,9 @@ pub fn evaluate(
                 ModelKind::Standard => correct_segment(&fitted.standard, segment, switch_on),
                 ModelKind::ThirdOrder => correct_segment(&fitted.third_order, segment, switch_on),
                 ModelKind::Modified => correct_segment(&fitted.modified, segment, switch_on),
+                ModelKind::ByHistory => {
+                    correct_segment_after(&fitted.by_history, segment, switch_on, Some(previous))
+                }
             };
             let (drift_dps, residual_rms_dps) = metric(&rates, window);
             ModelResult {

@@ -8,7 +8,7 @@ use drift_core::{
 
 use crate::analyse::Analysed;
 use crate::baselines;
-use crate::curves::{group, CurveKey, SetPointCurves};
+use crate::curves::{group, AveragedCurve, CurveKey, SetPointCurves};
 use crate::error::FitError;
 use crate::history_order::{crossings, Crossing};
 use crate::knots::{choose, k_window, mean_window};
@@ -30,6 +30,10 @@ pub struct FittedUnit {
     pub unit_id: String,
     /// The paper's ("modified") tables.
     pub modified: ModifiedTables,
+    /// The same curves with stage 3 keyed by heating history (each curve labelled by the residual
+    /// heat it switched on with) instead of by rise: for firmware that keeps what it knew of the
+    /// previous activation across power-off (`drift_core::CorrectorState::power_on_after`).
+    pub by_history: ModifiedTables,
     /// The paper's standard calibration (Lagrange through the set points).
     pub standard: PolynomialTables,
     /// The least-squares polynomial baseline (3rd order by default).
@@ -97,8 +101,43 @@ fn strictly_increasing(values: &mut [f32]) -> usize {
     nudged
 }
 
-/// The paper's table of one axis (reference times, then per set point the curves' rise and `k`
-/// there, sorted by rise) and the notes it leaves; the error says why there is none.
+/// How stage 3 finds its curves in a fitted table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stage3 {
+    /// The paper's: by the current rise (curves sorted by rise at every reference time).
+    ByRise,
+    /// By the residual heat at switch-on (curves in order of it, labelled with it).
+    ByHistory,
+}
+
+/// The residual heat curve `c` of `sp` switched on with on `axis`, °C: how far its mean switch-on
+/// temperature stood above the set point's ambient (the independent starts' mean), which is what
+/// firmware estimates from what it kept of the previous activation.
+fn residual_heat(sp: &SetPointCurves, c: usize, axis: usize) -> f64 {
+    sp.curves[c].switch_on_celsius[axis] - sp.ambient_celsius[axis]
+}
+
+/// The curves' order for a table keyed by history, the same at every set point (stage 2 blends
+/// curve `c` of one ambient with curve `c` of the next): by residual heat averaged over the set
+/// points, as indices into each set point's curves (which share their keys and order).
+fn history_order(set_points: &[SetPointCurves], axis: usize) -> Vec<usize> {
+    let count = set_points.first().map_or(0, |sp| sp.curves.len());
+    let mean = |c: usize| {
+        set_points
+            .iter()
+            .map(|sp| residual_heat(sp, c, axis))
+            .sum::<f64>()
+            / set_points.len().max(1) as f64
+    };
+    let mut order: Vec<usize> = (0..count).collect();
+    order.sort_by(|&a, &b| mean(a).total_cmp(&mean(b)));
+    order
+}
+
+/// The table of one axis (reference times, then per set point the curves' rise and `k` there):
+/// sorted by rise at every reference time for the paper's stage 3, or in order of residual heat,
+/// labelled with it, for a stage 3 keyed by history; with the notes it leaves. The error says why
+/// there is none.
 ///
 /// Boxed: the table (~50 KB) crosses rayon's join, whose frames hold its result, and rayon's
 /// worker threads have 2 MiB stacks.
@@ -107,6 +146,7 @@ fn axis_table(
     axis: usize,
     first: usize,
     settings: &FitSettings,
+    stage3: Stage3,
 ) -> Result<(Box<Table>, Vec<String>), String> {
     let window = settings.reference_window_points;
     let mut table = Box::<Table>::default();
@@ -115,6 +155,7 @@ fn axis_table(
     for &j in &knots {
         let _ = table.reference_ms.push(j as u32 * settings.grid_ms);
     }
+    let order = history_order(set_points, axis);
     let mut last_ambient = f32::NEG_INFINITY;
     for sp in set_points {
         let mut ambient = AmbientCurves {
@@ -130,11 +171,15 @@ fn axis_table(
             ));
         }
         last_ambient = ambient.ambient_celsius;
-        // Points per reference time, then sorted by rise there (stage 3 needs them ordered).
+        let curves: Vec<&AveragedCurve> = match stage3 {
+            Stage3::ByRise => sp.curves.iter().collect(),
+            Stage3::ByHistory => order.iter().map(|&c| &sp.curves[c]).collect(),
+        };
+        // Points per reference time.
         let mut columns: Vec<Vec<(f32, f32)>> = knots
             .iter()
             .map(|&j| {
-                sp.curves
+                curves
                     .iter()
                     .map(|c| {
                         (
@@ -145,21 +190,42 @@ fn axis_table(
                     .collect()
             })
             .collect();
-        for (j, column) in columns.iter_mut().enumerate() {
-            column.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut rises: Vec<f32> = column.iter().map(|p| p.0).collect();
-            let nudged = strictly_increasing(&mut rises);
-            if nudged > 0 {
-                notes.push(format!(
-                    "axis {axis}, {} °C, reference {j}: {nudged} tied rises nudged",
-                    sp.set_point_celsius
-                ));
+        match stage3 {
+            Stage3::ByRise => {
+                // Sorted by rise at every reference time: the paper's stage 3 searches them.
+                for (j, column) in columns.iter_mut().enumerate() {
+                    column.sort_by(|a, b| a.0.total_cmp(&b.0));
+                    let mut rises: Vec<f32> = column.iter().map(|p| p.0).collect();
+                    let nudged = strictly_increasing(&mut rises);
+                    if nudged > 0 {
+                        notes.push(format!(
+                            "axis {axis}, {} °C, reference {j}: {nudged} tied rises nudged",
+                            sp.set_point_celsius
+                        ));
+                    }
+                    for (point, rise) in column.iter_mut().zip(rises) {
+                        point.0 = rise;
+                    }
+                }
             }
-            for (point, rise) in column.iter_mut().zip(rises) {
-                point.0 = rise;
+            Stage3::ByHistory => {
+                let mut heats: Vec<f32> = order
+                    .iter()
+                    .map(|&c| residual_heat(sp, c, axis) as f32)
+                    .collect();
+                let nudged = strictly_increasing(&mut heats);
+                if nudged > 0 {
+                    notes.push(format!(
+                        "axis {axis}, {} °C, keyed by history: {nudged} residual heats out of the other set points' order nudged up",
+                        sp.set_point_celsius
+                    ));
+                }
+                for heat in heats {
+                    let _ = ambient.residual_heat_celsius.push(heat);
+                }
             }
         }
-        for c in 0..sp.curves.len() {
+        for c in 0..curves.len() {
             let mut curve = Curve::default();
             for column in &columns {
                 let (rise, k) = column[c];
@@ -279,7 +345,13 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
     let core_settings = Settings::default();
     // The axes' tables and the baselines are independent: all on rayon's threads at once.
     let (tables, (standard, third_order)) = rayon::join(
-        || per_axis(|axis| axis_table(&set_points, axis, first, settings)),
+        || {
+            per_axis(|axis| {
+                let by_rise = axis_table(&set_points, axis, first, settings, Stage3::ByRise)?;
+                let by_history = axis_table(&set_points, axis, first, settings, Stage3::ByHistory)?;
+                Ok::<_, String>((by_rise, by_history))
+            })
+        },
         || {
             rayon::join(
                 || baselines::standard(&by_set_point, core_settings),
@@ -288,21 +360,31 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
         },
     );
     let mut axes: [Table; 3] = Default::default();
-    for (table, fitted) in axes.iter_mut().zip(tables) {
-        let (fitted, axis_notes) = fitted.map_err(insufficient)?;
+    let mut history_axes: [Table; 3] = Default::default();
+    for ((table, history_table), fitted) in axes.iter_mut().zip(&mut history_axes).zip(tables) {
+        let ((fitted, axis_notes), (by_history, history_notes)) = fitted.map_err(insufficient)?;
         *table = *fitted;
+        *history_table = *by_history;
         notes.extend(axis_notes);
+        notes.extend(history_notes);
     }
     let modified = ModifiedTables {
         settings: core_settings,
         axes,
         extension: drift_core::Extension::NONE,
     };
-    modified.validate().map_err(|source| FitError::Table {
-        unit: unit_id.clone(),
-        model: "modified",
-        source,
-    })?;
+    let by_history = ModifiedTables {
+        settings: core_settings,
+        axes: history_axes,
+        extension: drift_core::Extension::NONE,
+    };
+    for (model, tables) in [("modified", &modified), ("by_history", &by_history)] {
+        tables.validate().map_err(|source| FitError::Table {
+            unit: unit_id.clone(),
+            model,
+            source,
+        })?;
+    }
 
     for (model, tables) in [("standard", &standard), ("third_order", &third_order)] {
         tables.validate().map_err(|source| FitError::Table {
@@ -314,6 +396,7 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
     Ok(FittedUnit {
         unit_id,
         modified,
+        by_history,
         standard,
         third_order,
         curve_keys: common.into_iter().collect(),

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use crate::analyse::{analyse, Analysed};
 use crate::error::FitError;
-use crate::evaluate::{evaluate, ActivationResult};
+use crate::evaluate::{evaluate_after, kept_before, ActivationResult};
 use crate::fit::{fit_unit, FittedUnit};
 use crate::settings::FitSettings;
 use crate::summary::Split;
@@ -244,10 +244,16 @@ pub fn run(
         else {
             continue;
         };
+        // What firmware keeping its history across power-off knows at each switch-on: the
+        // recording's activations in order (one unit per recording), with a clock that tells a
+        // full cool-down; nothing is known of the time between recordings.
+        let segments: Vec<&Segment> = recording.segments.iter().collect();
+        let kept = kept_before(&segments, settings, &fitted.by_history.settings, true);
         let results: Vec<(Split, ActivationResult)> = recording
             .segments
             .par_iter()
-            .filter_map(|segment| {
+            .zip(kept.par_iter())
+            .filter_map(|(segment, previous)| {
                 let labels = &segment.labels;
                 // The set point the activation belongs to: in a field session whose ambient
                 // ramps, the switch-on label is the ambient of the moment (31.7, 35.2 … in a
@@ -275,7 +281,7 @@ pub fn run(
                 } else {
                     return None;
                 };
-                Some((split, evaluate(model, segment, settings)))
+                Some((split, evaluate_after(model, segment, settings, previous)))
             })
             .collect();
         outcome.results.extend(results);

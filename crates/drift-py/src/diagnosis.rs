@@ -106,7 +106,7 @@ pub fn diagnose_unit(
             )));
         }
         let before_after = if closed.extended.is_some() {
-            closed.before_after(unit, settings)
+            closed.before_after(unit, settings, true)
         } else {
             Vec::new()
         };

@@ -138,6 +138,14 @@ impl PyFittedUnit {
         PyModifiedTables(Arc::new(self.unit.modified.clone()))
     }
 
+    /// The same curves with stage 3 keyed by heating history (each curve labelled by the residual
+    /// heat it switched on with): for firmware that keeps what it knew of the previous activation
+    /// (`Corrector.power_on_after`).
+    #[getter]
+    fn by_history(&self) -> PyModifiedTables {
+        PyModifiedTables(Arc::new(self.unit.by_history.clone()))
+    }
+
     /// The paper's standard calibration (Lagrange polynomial through the set points).
     #[getter]
     fn standard(&self) -> PyPolynomialTables {
@@ -179,7 +187,8 @@ impl PyFittedUnit {
     }
 
     /// Corrects one activation with every model (drift-core's f32 corrector) and measures the
-    /// paper's drift metric; `split` labels the result for `summarise`.
+    /// paper's drift metric; `split` labels the result for `summarise`. The history-keyed model
+    /// ("by-history") runs with nothing kept of a previous activation (a cold start, flagged).
     #[pyo3(signature = (segment, *, split = None))]
     fn evaluate(
         &self,
@@ -226,8 +235,8 @@ impl PyFittedUnit {
         )
     }
 
-    /// Writes `<folder>/<unit_id>/{modified,standard,third_order}.{json,bin}` as `gyrodrift fit`
-    /// does; returns the unit's folder.
+    /// Writes `<folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin}` as
+    /// `gyrodrift fit` does; returns the unit's folder.
     fn save(&self, folder: &Bound<'_, PyAny>) -> Result<PathBuf, Error> {
         let dir = args::path("folder", folder)?.join(&self.unit.unit_id);
         std::fs::create_dir_all(&dir).map_err(|source| Error::File {
@@ -235,12 +244,19 @@ impl PyFittedUnit {
             path: dir.clone(),
             source,
         })?;
-        let modified = &self.unit.modified;
-        model_io::write(
-            &dir.join("modified.json"),
-            model_io::to_json("ModifiedTables", modified)?.as_bytes(),
-        )?;
-        model_io::write(&dir.join("modified.bin"), &model_io::to_image(modified)?)?;
+        for (name, tables) in [
+            ("modified", &self.unit.modified),
+            ("by_history", &self.unit.by_history),
+        ] {
+            model_io::write(
+                &dir.join(format!("{name}.json")),
+                model_io::to_json("ModifiedTables", tables)?.as_bytes(),
+            )?;
+            model_io::write(
+                &dir.join(format!("{name}.bin")),
+                &model_io::to_image(tables)?,
+            )?;
+        }
         for (name, model) in [
             ("standard", &self.unit.standard),
             ("third_order", &self.unit.third_order),

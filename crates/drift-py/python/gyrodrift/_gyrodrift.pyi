@@ -729,7 +729,8 @@ class ActivationResult:
         """The activation's labels."""
     @property
     def drift_dps(self) -> dict[str, tuple[float, float, float]]:
-        """Per model ("uncorrected", "standard", "3rd-order", "modified"): drift per axis, °/s —
+        """Per model ("uncorrected", "standard", "3rd-order", "modified", "by-history"): drift per
+        axis, °/s —
         max − min of the 1-s low-frequency rate over the activation (the paper's metric)."""
     @property
     def residual_rms_dps(self) -> dict[str, tuple[float, float, float]]:
@@ -791,6 +792,11 @@ class FittedUnit:
     def modified(self) -> ModifiedTables:
         """The paper's ("modified") tables."""
     @property
+    def by_history(self) -> ModifiedTables:
+        """The same curves with stage 3 keyed by heating history (each curve labelled by the
+        residual heat it switched on with): for firmware that keeps what it knew of the previous
+        activation (`Corrector.power_on_after`)."""
+    @property
     def standard(self) -> PolynomialTables:
         """The paper's standard calibration (Lagrange polynomial through the set points)."""
     @property
@@ -810,7 +816,10 @@ class FittedUnit:
         """Things the fit decided that a reader should know (dropped curves, nudged ties)."""
     def evaluate(self, segment: Segment, *, split: str | None = None) -> ActivationResult:
         """Corrects one activation with every model and measures the paper's metric; `split`
-        ("validation" by default) labels the result for `summarise`. The GIL is released."""
+        ("validation" by default) labels the result for `summarise`. The history-keyed model
+        ("by-history") runs with nothing kept of a previous activation (a cold start, flagged
+        HISTORY_UNKNOWN); `gyrodrift report` chains a recording's activations. The GIL is
+        released."""
     def diagnose(
         self,
         segments: _Source,
@@ -826,8 +835,8 @@ class FittedUnit:
         on the held-out activations. The GIL is released. Raises `InputError` (no activation of
         this unit to diagnose) or `FitError`."""
     def save(self, folder: _Path) -> Path:
-        """Writes <folder>/<unit_id>/{modified,standard,third_order}.{json,bin} as `gyrodrift fit`
-        does; returns the unit's folder. Raises `FileError`."""
+        """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} as
+        `gyrodrift fit` does; returns the unit's folder. Raises `FileError`."""
 
 def fit(
     source: _Source,
