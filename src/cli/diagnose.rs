@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use drift_fit::closing::{close, Closed};
+use drift_fit::closing::{close, BeforeAfter, Closed};
 use drift_fit::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_fit::pipeline;
 use drift_fit::FittedUnit;
@@ -37,11 +37,11 @@ pub struct Args {
 
 /// Where the tables' own history lookup fails, as Markdown: no per-sample candidate can carry it
 /// (the lookup picks the wrong curve), so it is said before the ranking.
-fn crossings_markdown(fitted: &FittedUnit) -> String {
+fn crossings_markdown(fitted: &FittedUnit, held_out: &[BeforeAfter]) -> String {
     if fitted.crossings.is_empty() {
         return String::from("The calibration curves keep the paper's order (a warmer start rises less at every moment), so stage 3 can tell heating histories apart by the rise.\n\n");
     }
-    let mut md = String::from("## The tables' history lookup\n\nStage 3 finds an activation's heating history by its rise, which assumes a warmer start rises less. In these calibration curves warmer starts rise more (worst pair per set point and axis); stage 3 then reads the drift/rise ratio of another history on every activation. No term of the candidates below repairs a wrong lookup: an input that names the history (the off-time before switch-on) would. `examples/stage3_oracle.rs` measures what it costs.\n\n| set point | axis | warmer start | colder start | switched on warmer by | rises more by | at | pairs crossing |\n|---:|---|---|---|---:|---:|---:|---:|\n");
+    let mut md = String::from("## The tables' history lookup\n\nStage 3 finds an activation's heating history by its rise, which assumes a warmer start rises less. In these calibration curves warmer starts rise more (worst pair per set point and axis); stage 3 then reads the drift/rise ratio of another history on every activation. No term of the candidates below repairs a wrong lookup; the same curves keyed by the residual heat at switch-on (`by_history.bin` of `gyrodrift fit`, for firmware that keeps what it knew of the previous activation) choose them by history instead: their error on the held-out activations follows the table. `examples/stage3_oracle.rs` measures what the lookup costs.\n\n| set point | axis | warmer start | colder start | switched on warmer by | rises more by | at | pairs crossing |\n|---:|---|---|---|---:|---:|---:|---:|\n");
     for c in &fitted.crossings {
         let _ = writeln!(
             md,
@@ -57,7 +57,39 @@ fn crossings_markdown(fitted: &FittedUnit) -> String {
             c.compared_pairs
         );
     }
-    md.push('\n');
+    md.push_str(&history_table(held_out));
+    md
+}
+
+/// Mean drift per set point, series kind and axis of the held-out activations with stage 3 keyed
+/// by rise (the paper's) and by history.
+fn history_table(held_out: &[BeforeAfter]) -> String {
+    let mut groups: BTreeMap<String, Vec<&BeforeAfter>> = BTreeMap::new();
+    for r in held_out {
+        groups
+            .entry(format!("{:+.1} °C {}", r.set_point_celsius, r.series_kind))
+            .or_default()
+            .push(r);
+    }
+    let mut md = String::from("\n| held out | activations | drift keyed by rise X / Y / Z | drift keyed by history X / Y / Z |\n|---|---:|---|---|\n");
+    for (key, rows) in &groups {
+        let n = rows.len() as f64;
+        let mean = |f: &dyn Fn(&BeforeAfter) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+        let three = |f: &dyn Fn(&BeforeAfter, usize) -> f64| {
+            (0..3)
+                .map(|a| format!("{:.4}", mean(&|r| f(r, a))))
+                .collect::<Vec<_>>()
+                .join(" / ")
+        };
+        let _ = writeln!(
+            md,
+            "| {key} | {} | {} | {} |",
+            rows.len(),
+            three(&|r, a| r.drift_dps[a].0),
+            three(&|r, a| r.by_history_drift_dps[a]),
+        );
+    }
+    md.push_str("\nDrift in °/s (max − min of the 1-s mean per activation); keyed by history, each activation starts from what firmware kept of the one before (with a clock that tells a full cool-down).\n\n");
     md
 }
 
@@ -214,7 +246,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 roles.held_out.len()
             );
         }
-        md.push_str(&crossings_markdown(fitted));
+        let before_after = closed.before_after(fitted, &options.fit, true);
+        md.push_str(&crossings_markdown(fitted, &before_after));
         md.push_str(&markdown(axes, args.top));
         println!("{unit}:");
         for crossing in &fitted.crossings {
@@ -258,7 +291,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         }
         let before_after = if closed.extended.is_some() {
-            closed.before_after(fitted, &options.fit, true)
+            before_after
         } else {
             Vec::new()
         };
