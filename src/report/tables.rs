@@ -9,7 +9,13 @@ use drift_fit::FittedUnit;
 use super::of_split;
 
 const AXES: [&str; 3] = ["X", "Y", "Z"];
-const MODELS: [&str; 4] = ["standard", "modified", "3rd-order", "uncorrected"];
+const MODELS: [&str; 5] = [
+    "standard",
+    "modified",
+    "by-history",
+    "3rd-order",
+    "uncorrected",
+];
 
 fn find<'a>(
     records: &'a [Record],

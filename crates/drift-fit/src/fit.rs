@@ -216,7 +216,7 @@ fn axis_table(
                 let nudged = strictly_increasing(&mut heats);
                 if nudged > 0 {
                     notes.push(format!(
-                        "axis {axis}, {} °C, keyed by history: {nudged} residual heats out of the other set points' order nudged up",
+                        "axis {axis}, {} °C, keyed by history: {nudged} residual heat(s) nudged up to keep the order the curves share across set points",
                         sp.set_point_celsius
                     ));
                 }
