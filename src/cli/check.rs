@@ -147,13 +147,13 @@ const AXES: [&str; 3] = ["X", "Y", "Z"];
 /// The verdicts as a Markdown table (printed, and the heart of `check.md`).
 fn table(results: &[UnitResult]) -> String {
     let mut md = String::from(
-        "| unit | axis | activations | uncorrected drift | drift left | worst | removed | residual RMS | ambient out of range | rise out of span | past last reference | faults | verdict |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
+        "| unit | axis | activations | uncorrected drift | drift left | worst | removed | residual RMS | ambient out of range | rise out of span | past last reference | history unknown or out of span | faults | verdict |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
     );
     for unit in results {
         for v in &unit.axes {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.0} % | {:.4} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.0} % | {:.4} | {} | {} | {} | {} | {} | {} |",
                 unit.unit_id,
                 AXES[v.axis],
                 v.activations,
@@ -165,6 +165,7 @@ fn table(results: &[UnitResult]) -> String {
                 v.ambient_out_of_range,
                 v.rise_out_of_span,
                 v.past_last_reference,
+                v.history_unknown_or_out_of_span,
                 v.faulty,
                 if v.passed() {
                     "pass".to_owned()

@@ -102,6 +102,9 @@ pub struct AxisVerdict {
     pub rise_out_of_span: usize,
     /// Activations that ran past the last reference time (`k` held): longer than calibrated.
     pub past_last_reference: usize,
+    /// Tables keyed by history: activations that started with nothing kept of the previous one
+    /// or with a residual heat beyond the stored histories (a cold start was taken).
+    pub history_unknown_or_out_of_span: usize,
     /// Activations with a fault flag (sensor or tables).
     pub faulty: usize,
     /// Why the axis fails the limits; empty when it passes.
@@ -267,6 +270,7 @@ fn verdict(activations: &[CheckedActivation], axis: usize, limits: &Limits) -> A
         ambient_out_of_range: count(Flags::AMBIENT_OUT_OF_RANGE),
         rise_out_of_span: count(Flags::RISE_OUT_OF_SPAN),
         past_last_reference: count(Flags::PAST_LAST_REFERENCE),
+        history_unknown_or_out_of_span: count(Flags::HISTORY_UNKNOWN | Flags::HISTORY_OUT_OF_SPAN),
         faulty: count(FAULT_FLAGS),
         failures,
     }

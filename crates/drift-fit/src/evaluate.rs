@@ -298,3 +298,88 @@ pub fn evaluate_after(
         models,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use drift_recording::{SegmentLabels, SeriesKind};
+
+    use super::*;
+
+    /// An activation switched on at `power_on_s` after `off_before_s` off, its temperature
+    /// readings going from `on` to `off` °C (200 raw units per °C).
+    fn activation(power_on_s: u64, off_before_s: f64, on: f64, off: f64) -> Segment {
+        let raw = |c: f64| (c * 200.0).round() as i16;
+        let temperatures = vec![raw(on), raw((on + off) / 2.0), raw(off)];
+        Segment {
+            labels: SegmentLabels {
+                unit_id: "U".into(),
+                set_point_celsius: 30.0,
+                session_set_point_celsius: None,
+                series_kind: SeriesKind::Protocol,
+                series: 1,
+                repeat: 1,
+                activation: 1,
+                interval_min: None,
+                off_before_s: Some(off_before_s),
+            },
+            sample_rate_hz: 1000,
+            power_on_ns: power_on_s * 1_000_000_000,
+            since_power_on: vec![0, 1, 2],
+            rate_dps: [vec![0.0; 3], vec![0.0; 3], vec![0.0; 3]],
+            temperature_raw: [0, 1, 2].map(|_| temperatures.clone()),
+            aux: BTreeMap::new(),
+        }
+    }
+
+    #[test]
+    fn what_firmware_keeps_follows_the_units_life_in_time_order() {
+        let settings = FitSettings {
+            switch_on_window_ms: 1,
+            ..FitSettings::default()
+        };
+        let core = drift_core::Settings::default();
+        // Given out of order: the chain follows switch-on time.
+        let cold = activation(0, 3600.0, 30.0, 34.0);
+        let warm = activation(400, 60.0, 32.0, 35.0);
+        let rose = activation(800, 60.0, 36.0, 38.0);
+        // An hour off while the ambient rose to 37 °C, still below the last switch-off (38 °C).
+        let soaked = activation(9000, 3600.0, 37.0, 39.0);
+        let segments = [&warm, &soaked, &cold, &rose];
+        let without_clock = kept_before(&segments, &settings, &core, false);
+        let with_clock = kept_before(&segments, &settings, &core, true);
+        let ambient = |p: &[Previous; 3]| p[0].ambient_celsius;
+        let off = |p: &[Previous; 3]| p[0].switch_off_celsius;
+        // The first activation in time: nothing kept, or cooled by the clock.
+        assert!(ambient(&without_clock[2]).is_nan() && off(&without_clock[2]).is_nan());
+        assert_eq!(off(&with_clock[2]), f32::NEG_INFINITY);
+        // After the cold start: its ambient (its switch-on) and its last reading.
+        assert_eq!((ambient(&with_clock[0]), off(&with_clock[0])), (30.0, 34.0));
+        // The warm start keeps the ambient (residual heat 2 °C).
+        assert_eq!((ambient(&with_clock[3]), off(&with_clock[3])), (30.0, 35.0));
+        // Switched on above its last switch-off temperature: the ambient rose to 36 °C.
+        assert_eq!(
+            (ambient(&without_clock[1]), off(&without_clock[1])),
+            (36.0, 38.0)
+        );
+        // Before the soaked start the clock says the unit cooled: a cold start at 37 °C. Without
+        // it the 1 °C the ambient rose reads as residual heat on the kept 36 °C ambient.
+        assert_eq!(off(&with_clock[1]), f32::NEG_INFINITY);
+        let start = |kept: &[Previous; 3]| SwitchOn::estimate(37.0, Some(kept[0]));
+        assert_eq!(
+            (
+                start(&with_clock[1]).ambient_celsius,
+                start(&with_clock[1]).residual_heat_celsius
+            ),
+            (37.0, 0.0)
+        );
+        assert_eq!(
+            (
+                start(&without_clock[1]).ambient_celsius,
+                start(&without_clock[1]).residual_heat_celsius
+            ),
+            (36.0, 1.0)
+        );
+    }
+}

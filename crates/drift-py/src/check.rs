@@ -103,6 +103,7 @@ pub fn check<'py, M: Model + Clone + Send + Sync>(
                     "ambient_out_of_range": v.ambient_out_of_range,
                     "rise_out_of_span": v.rise_out_of_span,
                     "past_last_reference": v.past_last_reference,
+                    "history_unknown_or_out_of_span": v.history_unknown_or_out_of_span,
                     "faulty": v.faulty,
                     "failures": v.failures,
                 })

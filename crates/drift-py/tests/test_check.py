@@ -26,6 +26,7 @@ FIELDS = {
     "ambient_out_of_range",
     "rise_out_of_span",
     "past_last_reference",
+    "history_unknown_or_out_of_span",
     "faulty",
     "failures",
 }

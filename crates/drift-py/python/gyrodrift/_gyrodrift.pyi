@@ -214,8 +214,8 @@ class ModifiedTables:
         static) as the firmware would, and returns one record per axis: `unit_id`, `axis`,
         `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
-        `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`, `faulty` (activation
-        counts) and `failures` (why the axis misses a limit). Limits: mean drift left ≤
+        `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
+        `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the axis misses a limit). Limits: mean drift left ≤
         `max_drift` °/s, residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
@@ -324,8 +324,8 @@ class PolynomialTables:
         static) as the firmware would, and returns one record per axis: `unit_id`, `axis`,
         `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
-        `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`, `faulty` (activation
-        counts) and `failures` (why the axis misses a limit). Limits: mean drift left ≤
+        `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
+        `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the axis misses a limit). Limits: mean drift left ≤
         `max_drift` °/s, residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
