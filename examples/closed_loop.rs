@@ -135,9 +135,10 @@ fn main() -> anyhow::Result<()> {
             )
         };
         println!(
-            "{effect}: diagnosis significant on {}; a term admitted on {}; scale {}, calibration at {:?} °C, {} field activations measured and {} trained on per run",
+            "{effect}: diagnosis significant on {}; a term admitted on {}; stage 3 keyed by history chosen on {}; scale {}, calibration at {:?} °C, {} field activations measured and {} trained on per run",
             share(&|r| r.significant),
             share(&|r| !r.admitted.is_empty()),
+            share(&|r| r.history_chosen),
             plan.scale,
             plan.calibration,
             of.first().map_or(0, |r| r.field_activations),

@@ -159,6 +159,9 @@ pub struct Row {
     pub admitted: Vec<String>,
     /// Terms proposed by the diagnosis that the guard left out on this axis.
     pub left_out: Vec<String>,
+    /// Whether stage 3 keyed by history was chosen on the training activations
+    /// (`drift_fit::closing::Stage3Choice`).
+    pub history_chosen: bool,
     /// The paper's model.
     pub before: (f64, f64),
     /// The extended model (the paper's model when nothing was admitted).
@@ -177,7 +180,11 @@ pub struct Row {
 impl Row {
     /// The terms column: admitted terms, and those the guard left out.
     pub fn terms(&self) -> String {
-        let (admitted, left_out) = (self.admitted.join(", "), self.left_out.join(", "));
+        let mut admitted = self.admitted.clone();
+        if self.history_chosen {
+            admitted.push("stage 3 keyed by history".to_owned());
+        }
+        let (admitted, left_out) = (admitted.join(", "), self.left_out.join(", "));
         match (admitted.is_empty(), left_out.is_empty()) {
             (true, true) => "–".to_owned(),
             (false, true) => admitted,
@@ -333,6 +340,19 @@ pub fn run(
             if a.admitted { "admitted" } else { "left out" }
         );
     }
+    let stage3 = closed.choose_stage3(&base, settings, plan_size.clock);
+    for choice in &stage3 {
+        if choice.curves_cross {
+            eprintln!(
+                "  stage 3 on {}: {} training activations, drift keyed by rise {:.4}, by history {:.4} °/s → {}",
+                choice.axis,
+                choice.training_activations,
+                choice.training_drift_by_rise_dps,
+                choice.training_drift_by_history_dps,
+                if choice.keyed_by_history { "keyed by history" } else { "kept by rise" }
+            );
+        }
+    }
     let held_out = closed.before_after(&base, settings, plan_size.clock);
     // The +33 °C protocol activations, on stderr only: the paper's own validation, where the
     // histories are the calibration's. An error that shows there too is the tables' interpolation
@@ -444,6 +464,7 @@ pub fn run(
                 significant: top.is_some_and(|c| c.significant),
                 admitted: terms(axes[a].axis, true),
                 left_out: terms(axes[a].axis, false),
+                history_chosen: stage3[a].keyed_by_history,
                 before: avg(&before[a]),
                 after: avg(&after[a]),
                 by_history: avg(&by_history[a]),

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use drift_fit::closing::{close, BeforeAfter, Closed};
+use drift_fit::closing::{close, BeforeAfter, Closed, Stage3Choice};
 use drift_fit::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_fit::pipeline;
 use drift_fit::FittedUnit;
@@ -37,7 +37,11 @@ pub struct Args {
 
 /// Where the tables' own history lookup fails, as Markdown: no per-sample candidate can carry it
 /// (the lookup picks the wrong curve), so it is said before the ranking.
-fn crossings_markdown(fitted: &FittedUnit, held_out: &[BeforeAfter]) -> String {
+fn crossings_markdown(
+    fitted: &FittedUnit,
+    stage3: &[Stage3Choice; 3],
+    held_out: &[BeforeAfter],
+) -> String {
     if fitted.crossings.is_empty() {
         return String::from("The calibration curves keep the paper's order (a warmer start rises less at every moment), so stage 3 can tell heating histories apart by the rise.\n\n");
     }
@@ -55,6 +59,23 @@ fn crossings_markdown(fitted: &FittedUnit, held_out: &[BeforeAfter]) -> String {
             f64::from(c.at_ms) / 1000.0,
             c.crossing_pairs,
             c.compared_pairs
+        );
+    }
+    md.push_str("\nThe choice, made on the training activations (field-like use at the calibration set points; the held-out ones below are only measured):\n\n| axis | curves cross | training activations | drift keyed by rise | drift keyed by history | stage 3 |\n|---|---|---:|---:|---:|---|\n");
+    for c in stage3 {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {:.4} | {:.4} | {} |",
+            c.axis,
+            if c.curves_cross { "yes" } else { "no" },
+            c.training_activations,
+            c.training_drift_by_rise_dps,
+            c.training_drift_by_history_dps,
+            if c.keyed_by_history {
+                "**keyed by history**"
+            } else {
+                "keyed by rise"
+            }
         );
     }
     md.push_str(&history_table(held_out));
@@ -247,7 +268,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             );
         }
         let before_after = closed.before_after(fitted, &options.fit, true);
-        md.push_str(&crossings_markdown(fitted, &before_after));
+        let stage3 = closed.choose_stage3(fitted, &options.fit, true);
+        md.push_str(&crossings_markdown(fitted, &stage3, &before_after));
         md.push_str(&markdown(axes, args.top));
         println!("{unit}:");
         for crossing in &fitted.crossings {
@@ -303,6 +325,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "axes": axes,
             "proposed_terms": closed.proposed.terms.iter().map(|t| &t.candidate).collect::<Vec<_>>(),
             "admissions": closed.extended.as_ref().map(|e| &e.admissions),
+            "stage3": stage3,
             "before_after": before_after,
         }));
     }

@@ -3,6 +3,7 @@
 //! error before and after on the held-out activations. The command line (`gyrodrift diagnose
 //! [--extend]`), the Python module and the closed-loop experiment all run this.
 
+use drift_core::Previous;
 use drift_recording::Segment;
 use serde::Serialize;
 
@@ -49,6 +50,27 @@ pub struct BeforeAfter {
     pub by_history_rms_dps: [f64; 3],
 }
 
+/// Whether stage 3 keyed by heating history ([`FittedUnit::by_history`]) replaces the paper's
+/// lookup by rise on one axis: only where the fit found the calibration curves crossing on that
+/// axis (the rise no longer names the history), and only if on the training activations (field-like
+/// use at the calibration set points; never the held-out ones) it leaves less drift than the
+/// paper's lookup — the guard's rule for a term, applied to a lookup.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Stage3Choice {
+    /// `X`, `Y` or `Z`.
+    pub axis: &'static str,
+    /// Whether the fit found crossing curves on this axis ([`FittedUnit::crossings`]).
+    pub curves_cross: bool,
+    /// Training activations compared (0 when the curves do not cross: nothing is tried).
+    pub training_activations: usize,
+    /// Their mean drift with the paper's lookup, °/s.
+    pub training_drift_by_rise_dps: f64,
+    /// Their mean drift keyed by history, °/s.
+    pub training_drift_by_history_dps: f64,
+    /// The choice.
+    pub keyed_by_history: bool,
+}
+
 /// Splits `segments` (one unit's) by role, diagnoses the paper model `fitted` on the training
 /// activations (or, without any, on every activation the fit did not see), and with `extend`
 /// fits the guarded extended model.
@@ -90,6 +112,64 @@ pub fn close<'a>(
 }
 
 impl Closed<'_> {
+    /// The unit's activations in the order its firmware lived them, with what it kept before
+    /// each (`clock`: it also knows a full cool-down), as indices into calibration, training and
+    /// held-out activations in that order.
+    fn lived(&self, fitted: &FittedUnit, settings: &FitSettings, clock: bool) -> Vec<[Previous; 3]> {
+        let roles = &self.roles;
+        let life: Vec<&Segment> = roles
+            .calibration
+            .iter()
+            .chain(&roles.training)
+            .chain(&roles.held_out)
+            .copied()
+            .collect();
+        kept_before(&life, settings, &fitted.by_history.settings, clock)
+    }
+
+    /// Per axis, whether stage 3 keyed by history replaces the paper's lookup ([`Stage3Choice`]),
+    /// decided on the training activations.
+    pub fn choose_stage3(
+        &self,
+        fitted: &FittedUnit,
+        settings: &FitSettings,
+        clock: bool,
+    ) -> [Stage3Choice; 3] {
+        let cross = |axis: usize| fitted.crossings.iter().any(|c| c.axis == axis);
+        let kept = self.lived(fitted, settings, clock);
+        let training = &self.roles.training;
+        let kept_training = &kept[self.roles.calibration.len()..][..training.len()];
+        let window = settings.lowpass_window_samples;
+        let mut sums = [(0.0, 0.0); 3];
+        if (0..3).any(cross) {
+            for (segment, previous) in training.iter().zip(kept_training) {
+                let on = switch_on_raw(segment, settings);
+                let (rise, _) = metric(&correct_segment_after(&fitted.modified, segment, on, None).0, window);
+                let (history, _) = metric(
+                    &correct_segment_after(&fitted.by_history, segment, on, Some(previous)).0,
+                    window,
+                );
+                for a in 0..3 {
+                    sums[a].0 += rise[a];
+                    sums[a].1 += history[a];
+                }
+            }
+        }
+        std::array::from_fn(|a| {
+            let n = if cross(a) { training.len() } else { 0 };
+            let mean = |sum: f64| if n == 0 { f64::NAN } else { sum / n as f64 };
+            let (by_rise, by_history) = (mean(sums[a].0), mean(sums[a].1));
+            Stage3Choice {
+                axis: ["X", "Y", "Z"][a],
+                curves_cross: cross(a),
+                training_activations: n,
+                training_drift_by_rise_dps: by_rise,
+                training_drift_by_history_dps: by_history,
+                keyed_by_history: n > 0 && by_history < by_rise,
+            }
+        })
+    }
+
     /// The terms the guard admitted (empty without an extended model).
     pub fn admitted(&self) -> TermPlan {
         self.extended
@@ -114,14 +194,7 @@ impl Closed<'_> {
         // The unit's whole life in order, as its firmware would have lived it: every activation
         // passes what it kept on to the next.
         let roles = &self.roles;
-        let life: Vec<&Segment> = roles
-            .calibration
-            .iter()
-            .chain(&roles.training)
-            .chain(&roles.held_out)
-            .copied()
-            .collect();
-        let kept = kept_before(&life, settings, &fitted.by_history.settings, clock);
+        let kept = self.lived(fitted, settings, clock);
         let kept_held_out = &kept[roles.calibration.len() + roles.training.len()..];
         roles
             .held_out
