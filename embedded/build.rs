@@ -43,12 +43,13 @@ fn main() {
             "standard" => "ModelName::Standard",
             "third_order" => "ModelName::ThirdOrder",
             "extended" => "ModelName::Extended",
+            "by_history" => "ModelName::ByHistory",
             other => panic!("unknown model {other}"),
         };
         writeln!(
             code,
-            "Case {{ name: {:?}, model: {model}, switch_on_raw: {:?}, power_on_fails: {}, samples: &{:?}, expected: &{:?}, aux: &{:?} }},",
-            case.name, case.switch_on_raw, case.power_on_fails, case.samples, case.expected, case.aux
+            "Case {{ name: {:?}, model: {model}, switch_on_raw: {:?}, previous: {:?}, power_on_fails: {}, samples: &{:?}, expected: &{:?}, aux: &{:?} }},",
+            case.name, case.switch_on_raw, case.previous, case.power_on_fails, case.samples, case.expected, case.aux
         )
         .unwrap();
     }

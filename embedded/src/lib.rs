@@ -2,7 +2,7 @@
 //! a stack-use probe.
 #![no_std]
 
-use drift_core::ModifiedTables;
+use drift_core::{ModifiedTables, Previous};
 
 pub mod stack;
 
@@ -21,6 +21,8 @@ pub enum ModelName {
     ThirdOrder,
     /// The paper's tables plus the extended model's extra terms.
     Extended,
+    /// The paper's tables with stage 3 keyed by heating history (residual heat at switch-on).
+    ByHistory,
 }
 
 /// One test-vector case (see `testdata/vectors.json`).
@@ -31,6 +33,9 @@ pub struct Case {
     pub model: ModelName,
     /// Raw switch-on temperatures (f32 bits), if the case powers on.
     pub switch_on_raw: Option<[u32; 3]>,
+    /// What was kept of the previous activation, per axis `[ambient °C, switch-off °C]` (f32
+    /// bits): when present, the case starts with `power_on_after` rather than `power_on`.
+    pub previous: Option<[[u32; 2]; 3]>,
     /// Whether power-on must fail.
     pub power_on_fails: bool,
     /// `[ms, rate x y z, raw x y z]`, floats as bits.
@@ -39,6 +44,18 @@ pub struct Case {
     pub expected: &'static [[u32; 9]],
     /// Auxiliary inputs per sample (floats as bits); empty: corrected without.
     pub aux: &'static [[u32; 4]],
+}
+
+impl Case {
+    /// The case's kept previous activation, as drift-core takes it.
+    pub fn kept(&self) -> Option<[Previous; 3]> {
+        self.previous.map(|kept| {
+            kept.map(|[ambient, off]| Previous {
+                ambient_celsius: f32::from_bits(ambient),
+                switch_off_celsius: f32::from_bits(off),
+            })
+        })
+    }
 }
 
 include!(concat!(env!("OUT_DIR"), "/vectors.rs"));

@@ -54,7 +54,7 @@ pub struct AmbientCurves<const R: usize, const C: usize> {
     ///
     /// Why: when a warm start heats faster than a cold one, the curves cross and the rise no longer
     /// names the history (docs/closed-loop.md); the residual heat does, if the firmware keeps the
-    /// ambient across power-off ([`crate::CorrectorState::power_on_with_history`]).
+    /// ambient across power-off ([`crate::CorrectorState::power_on_after`]).
     #[cfg_attr(feature = "serde", serde(default))]
     pub residual_heat_celsius: Vec<f32, C>,
 }

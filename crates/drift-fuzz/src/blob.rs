@@ -29,7 +29,8 @@ pub fn prepare(mode: u8, bytes: &mut [u8]) {
     }
 }
 
-fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8]) {
+/// `ambients`: how many ambient tables the model holds over its axes (0 for the polynomial).
+fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8], ambients: fn(&M) -> usize) {
     let Ok(model) = decode::<M>(bytes) else {
         return;
     };
@@ -42,7 +43,8 @@ fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8]) {
     // canonical image is never longer than the one decoded.
     // A version-1 image of the paper's tables is re-encoded as the current version, which adds
     // the (empty) extension: postcard writes its length, one byte. A version-2 image gains each
-    // auxiliary term's time constant (0: one byte each).
+    // auxiliary term's time constant (0: one byte each). Versions 1 to 3 gain, per ambient, the
+    // (empty) residual-heat labels of version 4: their length, one byte each.
     let version = u16::from_le_bytes([bytes[4], bytes[5]]);
     let aux_terms = model
         .extension()
@@ -51,8 +53,9 @@ fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8]) {
         .filter(|t| matches!(t.term, drift_core::Term::Aux { .. }))
         .count();
     let upgrade = match (version, M::KIND) {
-        (1, Kind::Modified) => 1,
-        (2, Kind::Modified) => aux_terms,
+        (1, Kind::Modified) => 1 + ambients(&model),
+        (2, Kind::Modified) => aux_terms + ambients(&model),
+        (3, Kind::Modified) => ambients(&model),
         _ => 0,
     };
     assert!(
@@ -82,8 +85,14 @@ pub fn run(data: &[u8]) {
     };
     let mut bytes = image.to_vec();
     prepare(mode, &mut bytes);
-    check::<ModifiedTables>(&bytes);
+    check::<ModifiedTables>(&bytes, ambients);
     // A small firmware capacity: over-capacity counts must be refused, not truncated.
-    check::<ModifiedTables<8, 4, 8>>(&bytes);
-    check::<PolynomialTables>(&bytes);
+    check::<ModifiedTables<8, 4, 8>>(&bytes, ambients);
+    check::<PolynomialTables>(&bytes, |_| 0);
+}
+
+fn ambients<const R: usize, const A: usize, const C: usize>(
+    tables: &ModifiedTables<R, A, C>,
+) -> usize {
+    tables.axes.iter().map(|axis| axis.ambients.len()).sum()
 }

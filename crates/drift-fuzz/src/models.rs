@@ -1,5 +1,5 @@
-//! Valid models for the corrector target: the three models of the shared test vectors
-//! (`testdata/vectors.json`), decoded from their firmware images once.
+//! Valid models for the corrector target: the shared test vectors' models
+//! (`testdata/vectors.json`) that the target drives, decoded from their firmware images once.
 
 use std::sync::OnceLock;
 
@@ -8,7 +8,8 @@ use drift_core::{ModifiedTables, PolynomialTables};
 
 const VECTORS: &str = include_str!("../../../testdata/vectors.json");
 
-/// The shared vectors' models: the paper's tables and the two polynomial baselines.
+/// The shared vectors' models: the paper's tables, the two polynomial baselines and the paper's
+/// tables with stage 3 keyed by heating history.
 pub struct Models {
     /// The modified (paper's) tables.
     pub modified: ModifiedTables,
@@ -16,6 +17,8 @@ pub struct Models {
     pub standard: PolynomialTables,
     /// The 3rd-order least-squares baseline.
     pub third_order: PolynomialTables,
+    /// The paper's tables with stage 3 keyed by heating history (`power_on_after`, `keep`).
+    pub by_history: ModifiedTables,
 }
 
 fn unhex(hex: &str) -> Vec<u8> {
@@ -30,7 +33,7 @@ fn unhex(hex: &str) -> Vec<u8> {
 }
 
 /// The firmware images of the shared vectors' models, by name (`modified`, `standard`,
-/// `third_order`): the seeds of the blob target.
+/// `third_order`, `extended`, `by_history`): the seeds of the blob target.
 pub fn images() -> Vec<(String, Vec<u8>)> {
     let file: serde_json::Value = serde_json::from_str(VECTORS).unwrap_or_default();
     file["models"]
@@ -67,6 +70,7 @@ pub fn models() -> &'static Models {
             modified: decode(&image("modified")).unwrap_or_else(|e| bad("modified", e)),
             standard: decode(&image("standard")).unwrap_or_else(|e| bad("standard", e)),
             third_order: decode(&image("third_order")).unwrap_or_else(|e| bad("third_order", e)),
+            by_history: decode(&image("by_history")).unwrap_or_else(|e| bad("by_history", e)),
         }
     })
 }

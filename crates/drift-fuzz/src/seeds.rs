@@ -170,5 +170,52 @@ pub fn corrector() -> Vec<Vec<u8>> {
         ops.extend_from_slice(&[0; 14]);
         out.push(ops);
     }
+    out.push(corrector_by_history());
     out
+}
+
+/// The tables keyed by heating history: a warm start after a given previous activation, keep,
+/// power off, a restart after what was kept, and one start after NaN and infinite kept values.
+fn corrector_by_history() -> Vec<u8> {
+    let mut ops = vec![3u8];
+    let samples = |ops: &mut Vec<u8>, first: u16| {
+        for step in first..first + 20 {
+            ops.push(9);
+            ops.extend_from_slice(&(step * 1500).to_le_bytes());
+            for _ in 0..3 {
+                ops.extend_from_slice(&((step as i16) * 7).to_le_bytes());
+                ops.extend_from_slice(&(1600 + step * 5).to_le_bytes());
+            }
+        }
+    };
+    // power_on_after, given: switch-on 33 °C (6600 raw), ambient 31 °C, switch-off 36 °C
+    // (kept values are 10 °C + n/64).
+    ops.push(7);
+    for _ in 0..3 {
+        ops.extend_from_slice(&1600u16.to_le_bytes());
+    }
+    for _ in 0..3 {
+        ops.extend_from_slice(&(21 * 64u16).to_le_bytes());
+        ops.extend_from_slice(&(26 * 64u16).to_le_bytes());
+    }
+    samples(&mut ops, 0);
+    ops.push(5); // keep
+    ops.push(8); // power off
+    ops.push(6); // power_on_after with what was kept
+    for _ in 0..3 {
+        ops.extend_from_slice(&1650u16.to_le_bytes());
+    }
+    samples(&mut ops, 0);
+    ops.push(5);
+    // power_on_after, given as raw bits: NaN, ±∞ and extreme kept values.
+    ops.push(0x87);
+    for value in [6600.0f32, 6640.0, 6580.0] {
+        ops.extend_from_slice(&value.to_le_bytes());
+    }
+    for value in [f32::NAN, 36.0, 31.0, f32::INFINITY, -3.4e38, 3.4e38] {
+        ops.extend_from_slice(&value.to_le_bytes());
+    }
+    samples(&mut ops, 20);
+    ops.push(0x85); // keep (the raw-bits bit changes nothing)
+    ops
 }

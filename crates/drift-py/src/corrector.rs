@@ -6,11 +6,11 @@
 use std::sync::Arc;
 
 use drift_core::{
-    AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialTables, Sample,
-    AUX_INPUTS,
+    AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialTables, Previous,
+    Sample, AUX_INPUTS,
 };
-use numpy::ndarray::{Array2, ArrayView1};
-use numpy::{IntoPyArray, PyArray2};
+use numpy::ndarray::{Array2, ArrayView1, ArrayView2};
+use numpy::{IntoPyArray, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 
 use crate::args;
@@ -152,6 +152,24 @@ impl Engine {
         }
     }
 
+    fn power_on_after(
+        &mut self,
+        raw: [f32; 3],
+        previous: &mut [Previous; 3],
+    ) -> Result<[Flags; 3], drift_core::Error> {
+        match self {
+            Self::Modified(model, state) => state.power_on_after(&**model, raw, previous),
+            Self::Polynomial(model, state) => state.power_on_after(&**model, raw, previous),
+        }
+    }
+
+    fn keep(&self, previous: &mut [Previous; 3]) {
+        match self {
+            Self::Modified(model, state) => state.keep(&**model, previous),
+            Self::Polynomial(model, state) => state.keep(&**model, previous),
+        }
+    }
+
     fn power_off(&mut self) {
         match self {
             Self::Modified(_, state) => state.power_off(),
@@ -236,6 +254,67 @@ fn not_contiguous(error: numpy::AsSliceError) -> Error {
     Error::Input(format!("`out` arrays must be C-contiguous: {error}"))
 }
 
+/// `power_on_after`'s result: the activation's flags per axis and what to keep now, `(3, 2)`.
+type Started<'py> = ((u16, u16, u16), Bound<'py, PyArray2<f32>>);
+
+/// What the error messages call a kept previous activation.
+const PREVIOUS_SHAPE: &str =
+    "a float32 or float64 array of shape (3, 2): per axis X, Y, Z, [ambient °C, switch-off °C]";
+
+/// A `(3, 2)` float array (or nested sequence) of what was kept of the previous activation, as
+/// drift-core takes it (float64 rounded to f32 per value, as `astype(np.float32)` does).
+fn previous_arg(name: &str, value: &Bound<'_, PyAny>) -> Result<[Previous; 3], Error> {
+    fn read<T: Copy + Into<f64>>(view: &ArrayView2<'_, T>) -> Option<[[f64; 2]; 3]> {
+        if view.shape() != [3, 2] {
+            return None;
+        }
+        let at = |row: usize, column: usize| view.get((row, column)).map(|v| (*v).into());
+        let row = |r: usize| Some([at(r, 0)?, at(r, 1)?]);
+        Some([row(0)?, row(1)?, row(2)?])
+    }
+    let wrong = || {
+        Error::Input(format!(
+            "`{name}` must be {PREVIOUS_SHAPE}, got {}",
+            describe(value)
+        ))
+    };
+    let values = if let Ok(array) = value.cast::<PyArray2<f32>>() {
+        let array = array
+            .try_readonly()
+            .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))?;
+        read(&array.as_array()).ok_or_else(wrong)?
+    } else if let Ok(array) = value.cast::<PyArray2<f64>>() {
+        let array = array
+            .try_readonly()
+            .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))?;
+        read(&array.as_array()).ok_or_else(wrong)?
+    } else if value.cast::<numpy::PyUntypedArray>().is_ok() {
+        // Another dtype or number of dimensions: not read through Python's sequence protocol.
+        return Err(wrong());
+    } else {
+        value.extract::<[[f64; 2]; 3]>().map_err(|_| wrong())?
+    };
+    #[allow(clippy::cast_possible_truncation)]
+    Ok(values.map(|[ambient, off]| Previous {
+        ambient_celsius: ambient as f32,
+        switch_off_celsius: off as f32,
+    }))
+}
+
+/// `previous` as a new `(3, 2)` float32 array.
+fn previous_array<'py>(
+    py: Python<'py>,
+    previous: &[Previous; 3],
+) -> Result<Bound<'py, PyArray2<f32>>, Error> {
+    let values = previous
+        .iter()
+        .flat_map(|p| [p.ambient_celsius, p.switch_off_celsius])
+        .collect();
+    Array2::from_shape_vec((3, 2), values)
+        .map(|array| array.into_pyarray(py))
+        .map_err(|error| Error::Input(format!("internal: previous shape (3, 2): {error}")))
+}
+
 fn to_array<'py, T: numpy::Element>(
     py: Python<'py>,
     values: Vec<T>,
@@ -305,6 +384,40 @@ impl PyCorrector {
             ))
         })?;
         Ok(triple(flags.map(|f| f.0)))
+    }
+
+    /// `power_on` with what was kept of the previous activation (`previous`, `(3, 2)`: per axis
+    /// `[ambient °C, switch-off °C]`; all NaN when nothing was kept): a table keyed by heating
+    /// history reads the activation's ambient and residual heat from it, other models ignore it.
+    /// Returns the activation's flags and what to keep now (a new float32 `(3, 2)` array: this
+    /// activation's ambient, switch-off NaN until `keep`); `previous` itself is not modified.
+    fn power_on_after<'py>(
+        &mut self,
+        py: Python<'py>,
+        switch_on_raw: &Bound<'py, PyAny>,
+        previous: &Bound<'py, PyAny>,
+    ) -> Result<Started<'py>, Error> {
+        let raw = args::per_axis("switch_on_raw", switch_on_raw)?;
+        let mut kept = previous_arg("previous", previous)?;
+        let flags = self.engine.power_on_after(raw, &mut kept).map_err(|error| {
+            Error::Input(format!(
+                "`switch_on_raw` must be finite on every axis, got {raw:?} ({error}); the state is unchanged"
+            ))
+        })?;
+        Ok((triple(flags.map(|f| f.0)), previous_array(py, &kept)?))
+    }
+
+    /// `previous` (`(3, 2)`, as `power_on_after` returned it) with this activation's last good
+    /// temperature per axis recorded as its switch-off temperature, as a new float32 `(3, 2)`
+    /// array; unchanged while not powered on. `previous` itself is not modified.
+    fn keep<'py>(
+        &self,
+        py: Python<'py>,
+        previous: &Bound<'py, PyAny>,
+    ) -> Result<Bound<'py, PyArray2<f32>>, Error> {
+        let mut kept = previous_arg("previous", previous)?;
+        self.engine.keep(&mut kept);
+        previous_array(py, &kept)
     }
 
     /// Ends the activation: samples pass through, flagged NOT_POWERED_ON, until the next power_on.

@@ -32,6 +32,9 @@ class Case:
     bias: np.ndarray  # (n, 3) float32
     flags: np.ndarray  # (n, 3) uint16
     aux: np.ndarray | None = None  # (n, 4) float32: the auxiliary inputs, when the case passes them
+    # (3, 2) float32: what was kept of the previous activation, per axis [ambient °C, switch-off °C];
+    # when present the case starts with `power_on_after` rather than `power_on`.
+    previous: np.ndarray | None = None
 
 
 def f32(bits: Any) -> np.ndarray:
@@ -85,6 +88,7 @@ def parse_case(case: dict[str, Any]) -> Case:
         bias=f32(np.ascontiguousarray(expected[:, 3:6])),
         flags=expected[:, 6:9].astype(np.uint16),
         aux=f32(np.asarray(case["aux"], dtype=np.uint32).reshape(-1, 4)) if "aux" in case else None,
+        previous=f32(np.asarray(case["previous"], dtype=np.uint32)) if "previous" in case else None,
     )
 
 
@@ -101,14 +105,24 @@ def same_bits(expected: np.ndarray, got: np.ndarray) -> np.ndarray:
 
 
 def powered_corrector(model: Model, case: Case) -> gyrodrift.Corrector:
-    """A fresh corrector, powered on as the case says (a rejected power_on leaves it off)."""
+    """A fresh corrector, powered on as the case says (a rejected power_on leaves it off):
+    `power_on_after` with the case's kept previous activation when it has one, else `power_on`."""
     corrector = gyrodrift.Corrector(model)
     if case.switch_on_raw is not None:
+        raw = case.switch_on_raw
+        previous = case.previous
+
+        def start() -> None:
+            if previous is None:
+                corrector.power_on(raw)
+            else:
+                corrector.power_on_after(raw, previous)
+
         if case.power_on_fails:
             with pytest.raises(gyrodrift.InputError):
-                corrector.power_on(case.switch_on_raw)
+                start()
         else:
-            corrector.power_on(case.switch_on_raw)
+            start()
     return corrector
 
 

@@ -26,6 +26,8 @@ def test_flag_names_and_bits() -> None:
         "NOT_POWERED_ON",
         "MODEL_INVALID",
         "EXTENSION_INPUT_INVALID",
+        "HISTORY_UNKNOWN",
+        "HISTORY_OUT_OF_SPAN",
     ]
     assert [m.name for m in Flags] == names
     for name in names:
@@ -33,6 +35,8 @@ def test_flag_names_and_bits() -> None:
     values = [f.value for f in Flags]
     assert values == [1 << i for i in range(len(names))]  # distinct single bits, as in drift-core
     assert Flags.EXTENSION_INPUT_INVALID.value == 1 << 9
+    assert len(names) == 12
+    assert (Flags.HISTORY_UNKNOWN.value, Flags.HISTORY_OUT_OF_SPAN.value) == (1 << 10, 1 << 11)
 
 
 def test_faults_mask() -> None:

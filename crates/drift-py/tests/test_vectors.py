@@ -21,7 +21,17 @@ def check_batch(case: Case, corrected: np.ndarray, bias: np.ndarray, flags: np.n
 
 
 def test_vectors_cover_every_model_and_enough_samples(cases: list[Case], models: dict[str, Model]) -> None:
-    assert {c.model for c in cases} == set(models) == {"modified", "standard", "third_order", "extended"}
+    assert (
+        {c.model for c in cases}
+        == set(models)
+        == {
+            "modified",
+            "standard",
+            "third_order",
+            "extended",
+            "by_history",
+        }
+    )
     assert sum(len(c.times) for c in cases) > 1000
     with_aux = [c for c in cases if c.aux is not None]
     assert {c.model for c in with_aux} == {"extended"}
@@ -37,6 +47,87 @@ def test_extended_cases_exercise_the_extension(cases: list[Case], models: dict[s
     assert isinstance(extended, gyrodrift.ModifiedTables) and len(extended.extension) == 4
     flags = np.concatenate([c.flags for c in cases if c.model == "extended"])
     assert (flags & gyrodrift.Flags.EXTENSION_INPUT_INVALID).any()
+
+
+def test_history_cases_start_with_what_was_kept(cases: list[Case], models: dict[str, Model]) -> None:
+    """Guards the tests below against passing vacuously: cases with a kept previous activation
+    exist (history-keyed and not), `powered_corrector` starts them with `power_on_after`, and they
+    exercise both history flags."""
+    with_previous = [c for c in cases if c.previous is not None]
+    assert {c.model for c in with_previous} == {"by_history", "modified"}
+    assert all(c.previous is not None and c.previous.shape == (3, 2) for c in with_previous)
+    flags = np.concatenate([c.flags for c in cases if c.model == "by_history"])
+    for flag in (gyrodrift.Flags.HISTORY_UNKNOWN, gyrodrift.Flags.HISTORY_OUT_OF_SPAN):
+        assert (flags & flag).any(), flag
+    # The same samples started with `power_on` instead differ: the kept values are read.
+    case = next(c for c in with_previous if c.model == "by_history" and c.switch_on_raw is not None)
+    cold = gyrodrift.Corrector(models[case.model])
+    cold.power_on(case.switch_on_raw)
+    corrected, _, _ = cold.correct_batch(case.times, case.rate, case.temperature)
+    assert not same_bits(case.corrected, corrected).all()
+
+
+def test_power_on_after_returns_what_to_keep(cases: list[Case], models: dict[str, Model]) -> None:
+    """`power_on_after` returns the flags and a new (3, 2) float32 array (this activation's ambient,
+    switch-off NaN); `keep` records the last good temperature as switch-off; neither modifies its
+    argument. float64 arrays and nested lists (exact widenings) give the same bits."""
+    case = next(c for c in cases if c.model == "by_history" and c.name == "history-warm-start")
+    assert case.previous is not None and case.switch_on_raw is not None
+    raw, previous = case.switch_on_raw, case.previous
+    given = previous.copy()
+    corrector = gyrodrift.Corrector(models[case.model])
+    flags, kept = corrector.power_on_after(raw, previous)
+    assert previous.tobytes() == given.tobytes()
+    assert len(flags) == 3 and all(isinstance(f, int) for f in flags)
+    assert kept.shape == (3, 2) and kept.dtype == np.float32
+    assert np.isfinite(kept[:, 0]).all() and np.isnan(kept[:, 1]).all()
+    for other in (previous.astype(np.float64), previous.tolist(), np.asfortranarray(previous), previous.T.T):
+        again_flags, again_kept = gyrodrift.Corrector(models[case.model]).power_on_after(raw, other)
+        assert again_flags == flags and again_kept.tobytes() == kept.tobytes()
+    corrected, _, _ = corrector.correct_batch(case.times, case.rate, case.temperature)
+    assert same_bits(case.corrected, corrected).all()
+    after = corrector.keep(kept)
+    assert np.isnan(kept[:, 1]).all()  # not modified
+    assert after.shape == (3, 2) and after.dtype == np.float32
+    assert after[:, 0].tobytes() == kept[:, 0].tobytes()
+    finite = np.isfinite(case.temperature)
+    last_raw = np.array([case.temperature[finite[:, a], a][-1] for a in range(3)], np.float32)
+    last_good = last_raw / np.float32(200.0)  # the fixture's raw_per_celsius, zero at 0 raw
+    assert np.isfinite(after[:, 1]).all()
+    np.testing.assert_allclose(after[:, 1], last_good, rtol=1e-6)
+    corrector.power_off()
+    assert corrector.keep(after).tobytes() == after.tobytes()  # not powered on: unchanged
+
+
+@pytest.mark.parametrize(
+    "previous",
+    [
+        np.zeros((2, 3), np.float32),
+        np.zeros((3, 3), np.float64),
+        np.zeros(6, np.float32),
+        np.zeros((3, 2), np.int64),
+        [[1.0, 2.0], [3.0, 4.0]],
+        "nothing",
+    ],
+)
+def test_previous_of_the_wrong_shape_is_refused(previous: Any, models: dict[str, Model]) -> None:
+    corrector = gyrodrift.Corrector(models["by_history"])
+    with pytest.raises(ValueError, match=r"`previous` must be .*shape \(3, 2\)"):
+        corrector.power_on_after([6600.0, 6600.0, 6600.0], previous)
+    assert not corrector.is_powered_on
+    with pytest.raises(gyrodrift.InputError, match=r"`previous` must be .*shape \(3, 2\)"):
+        corrector.keep(previous)
+
+
+def test_power_on_after_refuses_a_non_finite_switch_on(models: dict[str, Model]) -> None:
+    corrector = gyrodrift.Corrector(models["by_history"])
+    nothing = np.full((3, 2), np.nan, np.float32)
+    with pytest.raises(gyrodrift.InputError, match="switch_on_raw"):
+        corrector.power_on_after([6600.0, np.nan, 6600.0], nothing)
+    assert not corrector.is_powered_on
+    flags, kept = corrector.power_on_after([6600.0, 6600.0, 6600.0], nothing)
+    assert all(f & gyrodrift.Flags.HISTORY_UNKNOWN for f in flags)
+    assert (kept[:, 0] == np.float32(33.0)).all()
 
 
 def test_batch_reproduces_every_case(cases: list[Case], models: dict[str, Model]) -> None:

@@ -10,8 +10,8 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use drift_core::blob::decode;
-use drift_core::{AxisModel, Corrector, Model, PolynomialTables, Sample};
-use gyrodrift_embedded::{FirmwareTables, EXTENDED, MODIFIED, STANDARD};
+use drift_core::{AxisModel, Corrector, Model, PolynomialTables, Previous, Sample};
+use gyrodrift_embedded::{FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, STANDARD};
 use panic_semihosting as _;
 
 /// Samples corrected between two markers.
@@ -77,6 +77,29 @@ where
     gyrodrift_marker(id + 1);
 }
 
+/// As `measure`, started with `power_on_after` from a kept previous activation: a warm start
+/// (ambient 31 °C, between the 30 and 40 °C calibration ambients; switch-on 33 °C, so ~2 °C of
+/// residual heat, between two stored histories: both blends active).
+fn measure_after<M: Model>(model: &M, samples: &[Sample], id: u32)
+where
+    M::Axis: AxisModel,
+{
+    let Ok(mut corrector) = Corrector::new(model) else {
+        return;
+    };
+    let mut previous = [Previous {
+        ambient_celsius: 31.0,
+        switch_off_celsius: 36.0,
+    }; 3];
+    let _ = corrector.power_on_after([6600.0, 6640.0, 6580.0], &mut previous);
+    gyrodrift_marker(id);
+    for sample in samples {
+        black_box(corrector.correct(black_box(sample)));
+    }
+    gyrodrift_marker(id + 1);
+    corrector.keep(black_box(&mut previous));
+}
+
 /// As `measure`, with auxiliary inputs (supply voltage, gravity) for the extended model.
 fn measure_with_aux<M: Model>(model: &M, samples: &[Sample], id: u32)
 where
@@ -101,8 +124,9 @@ fn main() -> ! {
     let modified: Result<FirmwareTables, _> = decode(black_box(MODIFIED));
     let standard: Result<PolynomialTables, _> = decode(black_box(STANDARD));
     let extended: Result<FirmwareTables, _> = decode(black_box(EXTENDED));
-    match (modified, standard, extended) {
-        (Ok(modified), Ok(standard), Ok(extended)) => {
+    let by_history: Result<FirmwareTables, _> = decode(black_box(BY_HISTORY));
+    match (modified, standard, extended, by_history) {
+        (Ok(modified), Ok(standard), Ok(extended), Ok(by_history)) => {
             hprintln!("samples per interval: {}", SAMPLES);
             hprintln!("interval 1: modified model, samples 1 s apart (worst case)");
             measure(&modified, &samples, 1);
@@ -121,6 +145,14 @@ fn main() -> ! {
             measure_with_aux(&extended, &samples, 9);
             hprintln!("interval 11: modified model + 4 extra terms (extended), 1000 Hz windows");
             measure_with_aux(&extended, &at_1khz, 11);
+            hprintln!(
+                "interval 13: modified model, stage 3 keyed by history (by_history, power_on_after), samples 1 s apart"
+            );
+            measure_after(&by_history, &samples, 13);
+            hprintln!(
+                "interval 15: modified model, stage 3 keyed by history (by_history, power_on_after), 1000 Hz windows"
+            );
+            measure_after(&by_history, &at_1khz, 15);
             debug::exit(debug::EXIT_SUCCESS);
         }
         _ => {

@@ -123,6 +123,12 @@ class Flags(enum.IntFlag):
     EXTENSION_INPUT_INVALID = _gyrodrift.EXTENSION_INPUT_INVALID
     """Extended model: an auxiliary input an extra term reads is NaN/inf or was not passed
     (`aux=None`): that term holds its last filtered value (0 before any)."""
+    HISTORY_UNKNOWN = _gyrodrift.HISTORY_UNKNOWN
+    """Tables keyed by heating history, powered on without what was kept of the previous activation
+    (`power_on`, or nothing finite kept for the axis in `power_on_after`): taken as a cold start."""
+    HISTORY_OUT_OF_SPAN = _gyrodrift.HISTORY_OUT_OF_SPAN
+    """Tables keyed by heating history: the residual heat at switch-on lies outside the stored
+    histories' span (beyond the rise margin): the nearest history's curve is used (clamp)."""
 
     @classmethod
     def faults(cls) -> Flags:

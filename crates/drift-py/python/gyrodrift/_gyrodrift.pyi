@@ -22,6 +22,8 @@ __all__ = [
     "EXTENSION_INPUT_INVALID",
     "FAULTS",
     "FLAGS",
+    "HISTORY_OUT_OF_SPAN",
+    "HISTORY_UNKNOWN",
     "MAX_EXTRA_TERMS",
     "MODEL_INVALID",
     "NOT_POWERED_ON",
@@ -68,6 +70,7 @@ __all__ = [
 _Path: TypeAlias = str | os.PathLike[str]
 _Floats3: TypeAlias = Sequence[float] | NDArray[np.floating]
 _Model: TypeAlias = ModifiedTables | PolynomialTables
+_Previous: TypeAlias = NDArray[np.floating] | Sequence[Sequence[float]]
 _Floats: TypeAlias = NDArray[np.float32] | NDArray[np.float64]
 _Floats4: TypeAlias = Sequence[float] | NDArray[np.floating]
 _TermKind: TypeAlias = Literal["temperature_rate", "aux", "axis_rise", "rise_squared"]
@@ -85,6 +88,8 @@ RATE_INVALID: Final[int]
 NOT_POWERED_ON: Final[int]
 MODEL_INVALID: Final[int]
 EXTENSION_INPUT_INVALID: Final[int]
+HISTORY_UNKNOWN: Final[int]
+HISTORY_OUT_OF_SPAN: Final[int]
 FAULTS: Final[int]
 FLAGS: Final[tuple[tuple[str, int], ...]]
 """Every flag drift-core defines, `(name, value)` in bit order (drift_core::Flags::ALL)."""
@@ -373,6 +378,27 @@ class Corrector:
 
         Returns the flags that hold for the whole activation, per axis. A NaN or infinite reading
         raises `InputError` naming the axis, and the state is unchanged.
+        """
+    def power_on_after(
+        self, switch_on_raw: _Floats3, previous: _Previous
+    ) -> tuple[tuple[int, int, int], NDArray[np.float32]]:
+        """`power_on` with what was kept of the previous activation across power-off.
+
+        `previous`: float32 or float64 array (or nested sequence) of shape (3, 2), per axis X, Y, Z
+        `[ambient °C, switch-off °C]` (all NaN when nothing was kept: the first activation). A
+        table keyed by heating history reads the activation's ambient and residual heat from it
+        (HISTORY_UNKNOWN where nothing finite was kept); other models ignore it. Returns
+        `(flags, kept)`: the activation's flags per axis, as `power_on`, and what to keep now, a
+        new float32 (3, 2) array (this activation's ambient, switch-off NaN until `keep`).
+        `previous` itself is not modified. A NaN or infinite `switch_on_raw` raises `InputError`
+        and the state is unchanged; a wrong shape or dtype raises `InputError` (a `ValueError`)
+        naming `previous` and the shape expected.
+        """
+    def keep(self, previous: _Previous) -> NDArray[np.float32]:
+        """`previous` (as `power_on_after` returned it) with this activation's last good
+        temperature per axis recorded as its switch-off temperature, as a new float32 (3, 2)
+        array; unchanged while not powered on. Call it before power-off (or periodically).
+        `previous` itself is not modified.
         """
     def power_off(self) -> None:
         """Ends the activation: samples pass through, flagged NOT_POWERED_ON, until `power_on`."""
