@@ -115,7 +115,12 @@ impl Closed<'_> {
     /// The unit's activations in the order its firmware lived them, with what it kept before
     /// each (`clock`: it also knows a full cool-down), as indices into calibration, training and
     /// held-out activations in that order.
-    fn lived(&self, fitted: &FittedUnit, settings: &FitSettings, clock: bool) -> Vec<[Previous; 3]> {
+    fn lived(
+        &self,
+        fitted: &FittedUnit,
+        settings: &FitSettings,
+        clock: bool,
+    ) -> Vec<[Previous; 3]> {
         let roles = &self.roles;
         let life: Vec<&Segment> = roles
             .calibration
@@ -144,7 +149,10 @@ impl Closed<'_> {
         if (0..3).any(cross) {
             for (segment, previous) in training.iter().zip(kept_training) {
                 let on = switch_on_raw(segment, settings);
-                let (rise, _) = metric(&correct_segment_after(&fitted.modified, segment, on, None).0, window);
+                let (rise, _) = metric(
+                    &correct_segment_after(&fitted.modified, segment, on, None).0,
+                    window,
+                );
                 let (history, _) = metric(
                     &correct_segment_after(&fitted.by_history, segment, on, Some(previous)).0,
                     window,

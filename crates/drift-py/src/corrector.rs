@@ -263,7 +263,7 @@ const PREVIOUS_SHAPE: &str =
 
 /// A `(3, 2)` float array (or nested sequence) of what was kept of the previous activation, as
 /// drift-core takes it (float64 rounded to f32 per value, as `astype(np.float32)` does).
-fn previous_arg(name: &str, value: &Bound<'_, PyAny>) -> Result<[Previous; 3], Error> {
+pub(crate) fn previous_arg(name: &str, value: &Bound<'_, PyAny>) -> Result<[Previous; 3], Error> {
     fn read<T: Copy + Into<f64>>(view: &ArrayView2<'_, T>) -> Option<[[f64; 2]; 3]> {
         if view.shape() != [3, 2] {
             return None;

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use drift_fit::analyse::{analyse, Analysed};
-use drift_fit::evaluate::evaluate as evaluate_segment;
+use drift_fit::evaluate::{evaluate_after, kept_before};
 use drift_fit::pipeline::{self, Options};
 use drift_fit::summary::Split;
 use drift_fit::{fit_unit, FitSettings, FittedUnit};
@@ -188,13 +188,16 @@ impl PyFittedUnit {
 
     /// Corrects one activation with every model (drift-core's f32 corrector) and measures the
     /// paper's drift metric; `split` labels the result for `summarise`. The history-keyed model
-    /// ("by-history") runs with nothing kept of a previous activation (a cold start, flagged).
-    #[pyo3(signature = (segment, *, split = None))]
+    /// ("by-history") starts from `previous` (what firmware kept of the previous activation, a
+    /// `(3, 2)` array as `Corrector.power_on_after` takes and `Corrector.keep` returns); without
+    /// it, with nothing kept (a cold start, flagged).
+    #[pyo3(signature = (segment, *, split = None, previous = None))]
     fn evaluate(
         &self,
         py: Python<'_>,
         segment: &Bound<'_, PyAny>,
         split: Option<&Bound<'_, PyAny>>,
+        previous: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PyActivationResult> {
         let segment = segment.cast::<PySegment>().map_err(|_| {
             Error::Input(format!(
@@ -206,9 +209,55 @@ impl PyFittedUnit {
             Some(v) if !v.is_none() => split_from(v)?,
             _ => Split::Validation,
         };
+        let previous = match previous {
+            Some(v) if !v.is_none() => crate::corrector::previous_arg("previous", v)?,
+            _ => drift_core::Previous::NOTHING,
+        };
         let segment = Arc::clone(&segment.get().segment);
-        let result = py.detach(|| evaluate_segment(&self.unit, &segment, &self.settings));
+        let result = py.detach(|| evaluate_after(&self.unit, &segment, &self.settings, &previous));
         Ok(PyActivationResult { split, result })
+    }
+
+    /// Corrects a recording's activations (`segments`, one unit's) with every model, as
+    /// `gyrodrift report` does: the history-keyed model starts each from what firmware kept of the
+    /// one before in switch-on order, knowing a full cool-down from the recorded off-time; results
+    /// in the order given. The GIL is released.
+    #[pyo3(signature = (segments, *, split = None))]
+    fn evaluate_series(
+        &self,
+        py: Python<'_>,
+        segments: &Bound<'_, PyAny>,
+        split: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Vec<PyActivationResult>> {
+        let split = match split {
+            Some(v) if !v.is_none() => split_from(v)?,
+            _ => Split::Validation,
+        };
+        let mut owned = Vec::new();
+        for (i, item) in segments.try_iter()?.enumerate() {
+            let item = item?;
+            let segment = item.cast::<PySegment>().map_err(|_| {
+                Error::Input(format!(
+                    "`segments[{i}]` must be a gyrodrift.Segment, got {}",
+                    describe(&item)
+                ))
+            })?;
+            owned.push(Arc::clone(&segment.get().segment));
+        }
+        let results = py.detach(|| {
+            let refs: Vec<&drift_recording::Segment> = owned.iter().map(|s| &**s).collect();
+            let kept = kept_before(&refs, &self.settings, &self.unit.by_history.settings, true);
+            refs.iter()
+                .zip(&kept)
+                .map(|(segment, previous)| {
+                    evaluate_after(&self.unit, segment, &self.settings, previous)
+                })
+                .collect::<Vec<_>>()
+        });
+        Ok(results
+            .into_iter()
+            .map(|result| PyActivationResult { split, result })
+            .collect())
     }
 
     /// Diagnoses what the paper's model leaves in the residual of this unit's activations among

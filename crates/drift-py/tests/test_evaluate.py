@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 import gyrodrift
@@ -41,7 +43,7 @@ def test_per_activation_evaluation_and_summarise_agree(
 ) -> None:  # type: ignore[no-untyped-def]
     unit = evaluation.fitted[0]
     validation = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0"))
-    results = [unit.evaluate(segment) for segment in validation.segments]
+    results = unit.evaluate_series(validation.segments)
     assert {r.split for r in results} == {"validation"}
     assert set(results[0].drift_dps) == {"uncorrected", "standard", "3rd-order", "modified", "by-history"}
     expected = [r for r in evaluation.records if r["split"] == "validation"]
@@ -79,3 +81,23 @@ def test_paper_table(evaluation: gyrodrift.Evaluation) -> None:
                         ["| standard", "+40 °C", "held-out repeat"]]  # fmt: skip
     assert [r[0] for r in rows] == ["| standard"] * 3 + ["| modified"] * 3 + ["| standard / modified"] * 3
     assert lines[-1].endswith("× |")
+
+
+def test_the_history_keyed_model_starts_from_what_was_kept(
+    campaign_dir: Path, evaluation: gyrodrift.Evaluation
+) -> None:
+    """`previous` reaches the history-keyed model only: without it the start is unknown (flagged),
+    from a known full cool-down it is known; a bad shape is named."""
+    unit = evaluation.fitted[0]
+    segment = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0")).segments[0]
+    unknown = unit.evaluate(segment)
+    assert unit.evaluate_series([segment])[0].drift_dps["modified"] == unknown.drift_dps["modified"]
+    history_unknown = gyrodrift.Flags.HISTORY_UNKNOWN
+    assert all(f & history_unknown for f in unknown.flags["by-history"])
+    assert not any(f & history_unknown for f in unknown.flags["modified"])
+    cooled = np.array([[np.nan, -np.inf]] * 3)
+    known = unit.evaluate(segment, previous=cooled)
+    assert not any(f & history_unknown for f in known.flags["by-history"])
+    assert known.drift_dps["modified"] == unknown.drift_dps["modified"]
+    with pytest.raises(ValueError, match="previous"):
+        unit.evaluate(segment, previous=np.zeros((2, 3)))

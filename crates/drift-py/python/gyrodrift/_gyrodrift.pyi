@@ -840,12 +840,26 @@ class FittedUnit:
     @property
     def notes(self) -> list[str]:
         """Things the fit decided that a reader should know (dropped curves, nudged ties)."""
-    def evaluate(self, segment: Segment, *, split: str | None = None) -> ActivationResult:
+    def evaluate(
+        self,
+        segment: Segment,
+        *,
+        split: str | None = None,
+        previous: _Previous | None = None,
+    ) -> ActivationResult:
         """Corrects one activation with every model and measures the paper's metric; `split`
         ("validation" by default) labels the result for `summarise`. The history-keyed model
-        ("by-history") runs with nothing kept of a previous activation (a cold start, flagged
-        HISTORY_UNKNOWN); `gyrodrift report` chains a recording's activations. The GIL is
-        released."""
+        ("by-history") starts from `previous`, what firmware kept of the previous activation (a
+        (3, 2) array, per axis [ambient °C, switch-off °C], as `Corrector.power_on_after` takes
+        and `Corrector.keep` returns); without it, with nothing kept (a cold start, flagged
+        HISTORY_UNKNOWN). The GIL is released. Raises `InputError` for a bad `previous`."""
+    def evaluate_series(
+        self, segments: Sequence[Segment], *, split: str | None = None
+    ) -> list[ActivationResult]:
+        """Corrects a recording's activations (one unit's) with every model, as `gyrodrift report`
+        does: the history-keyed model starts each from what firmware kept of the one before in
+        switch-on order, knowing a full cool-down from the recorded off-time; results in the order
+        given. The GIL is released. Raises `InputError` for an item that is not a Segment."""
     def diagnose(
         self,
         segments: _Source,
