@@ -69,11 +69,15 @@ impl SwitchOn {
             residual_heat_celsius: 0.0,
             known,
         };
-        let Some(previous) =
-            previous.filter(|p| p.ambient_celsius.is_finite() && p.switch_off_celsius.is_finite())
-        else {
+        let Some(previous) = previous else {
             return cold(false);
         };
+        if previous.switch_off_celsius == f32::NEG_INFINITY {
+            return cold(true);
+        }
+        if !(previous.ambient_celsius.is_finite() && previous.switch_off_celsius.is_finite()) {
+            return cold(false);
+        }
         if switch_on_celsius >= previous.switch_off_celsius {
             return cold(true);
         }

@@ -363,8 +363,13 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
             )
         };
         *state = ModifiedAxisState::new(&ambient);
-        // The initial bias is the bias at the switch-on temperature, whatever the history.
-        let at_switch_on = locate(switch_on.switch_on_celsius);
+        // The initial bias is the bias at the switch-on temperature, whatever the history (the
+        // paper's tables located the ambient there already: one search per switch-on, not two).
+        let at_switch_on = if by_history {
+            locate(switch_on.switch_on_celsius)
+        } else {
+            ambient
+        };
         let bias_at = |i: u8| {
             self.ambients
                 .get(usize::from(i))

@@ -374,6 +374,7 @@ mod tests {
             ),
             (37.0, 0.0)
         );
+        assert!(start(&with_clock[1]).known);
         assert_eq!(
             (
                 start(&without_clock[1]).ambient_celsius,

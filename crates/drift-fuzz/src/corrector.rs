@@ -19,8 +19,8 @@
 //! the temperature input is not finite; `power_on_after` leaves a non-NaN ambient and a cleared
 //! (NaN) switch-off temperature in `Previous`, `keep` changes only the switch-off temperatures, and
 //! only while powered on (to a non-NaN value); the history flags appear only with the
-//! history-keyed tables, `HISTORY_UNKNOWN` exactly when nothing finite was kept for the axis (or
-//! after a plain `power_on`), and every sample of an activation carries its history flags.
+//! history-keyed tables, `HISTORY_UNKNOWN` exactly when nothing finite was kept for the axis and no
+//! full cool-down was (`Previous::COOLED`), or after a plain `power_on`, and every sample of an activation carries its history flags.
 
 use drift_core::{AxisModel, Corrector, Flags, Model, Previous, Sample, AXES};
 
@@ -141,8 +141,10 @@ where
             Ok(flags) => {
                 assert!(raw.iter().all(|r| r.is_finite()), "accepted {raw:?}");
                 for (axis, (flags, given)) in flags.iter().zip(given).enumerate() {
-                    let known =
-                        given.ambient_celsius.is_finite() && given.switch_off_celsius.is_finite();
+                    // A switch-off at −∞ is a clock's "fully cooled" (`Previous::COOLED`): known.
+                    let known = given.switch_off_celsius == f32::NEG_INFINITY
+                        || (given.ambient_celsius.is_finite()
+                            && given.switch_off_celsius.is_finite());
                     if self.by_history {
                         assert_eq!(
                             flags.contains(Flags::HISTORY_UNKNOWN),
