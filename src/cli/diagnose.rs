@@ -85,13 +85,7 @@ fn crossings_markdown(
 /// Mean drift per set point, series kind and axis of the held-out activations with stage 3 keyed
 /// by rise (the paper's) and by history.
 fn history_table(held_out: &[BeforeAfter]) -> String {
-    let mut groups: BTreeMap<String, Vec<&BeforeAfter>> = BTreeMap::new();
-    for r in held_out {
-        groups
-            .entry(format!("{:+.1} °C {}", r.set_point_celsius, r.series_kind))
-            .or_default()
-            .push(r);
-    }
+    let groups = super::extend::by_set_point_and_kind(held_out);
     let mut md = String::from("\n| held out | activations | drift keyed by rise X / Y / Z | drift keyed by history X / Y / Z |\n|---|---:|---|---|\n");
     for (key, rows) in &groups {
         let n = rows.len() as f64;

@@ -103,8 +103,8 @@ pub fn run(
     Ok(md)
 }
 
-/// Means per set point, series kind and axis of the held-out activations' errors.
-fn before_after_table(results: &[BeforeAfter]) -> String {
+/// The held-out activations' results by set point and series kind (`+33.0 °C field`), in order.
+pub fn by_set_point_and_kind(results: &[BeforeAfter]) -> BTreeMap<String, Vec<&BeforeAfter>> {
     let mut groups: BTreeMap<String, Vec<&BeforeAfter>> = BTreeMap::new();
     for r in results {
         groups
@@ -112,6 +112,12 @@ fn before_after_table(results: &[BeforeAfter]) -> String {
             .or_default()
             .push(r);
     }
+    groups
+}
+
+/// Means per set point, series kind and axis of the held-out activations' errors.
+fn before_after_table(results: &[BeforeAfter]) -> String {
+    let groups = by_set_point_and_kind(results);
     let mut md = String::from("\nError on the held-out activations (nothing was fitted or chosen on them):\n\n| set point | axis | activations | RMS before | RMS after | drift before | drift after |\n|---|---|---:|---:|---:|---:|---:|\n");
     for (key, rows) in &groups {
         let n = rows.len() as f64;
