@@ -59,11 +59,15 @@ def test_fitted_models_save_like_the_command_line(campaign_dir: Path, tmp_path: 
     (unit,) = gyrodrift.fit(campaign_dir)
     folder = unit.save(tmp_path)
     assert folder == tmp_path / "GIU-01"
-    names = [
-        f"{model}.{kind}" for model in ("modified", "standard", "third_order") for kind in ("bin", "json")
-    ]
+    names = sorted(
+        f"{model}.{kind}"
+        for model in ("modified", "by_history", "standard", "third_order")
+        for kind in ("bin", "json")
+    )
     assert sorted(p.name for p in folder.iterdir()) == names
     assert gyrodrift.ModifiedTables.load_image(folder / "modified.bin") == unit.modified
+    assert gyrodrift.ModifiedTables.load_image(folder / "by_history.bin") == unit.by_history
+    assert unit.by_history != unit.modified
     assert gyrodrift.PolynomialTables.load_json(folder / "third_order.json") == unit.third_order
 
 
