@@ -221,7 +221,8 @@ class ModifiedTables:
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
         `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
         `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the
-        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
+        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤
+        `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
     @property
@@ -331,7 +332,8 @@ class PolynomialTables:
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
         `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
         `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the
-        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
+        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤
+        `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
     def __eq__(self, other: object, /) -> bool: ...
