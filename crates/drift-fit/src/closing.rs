@@ -141,12 +141,12 @@ impl Closed<'_> {
         clock: bool,
     ) -> [Stage3Choice; 3] {
         let cross = |axis: usize| fitted.crossings.iter().any(|c| c.axis == axis);
-        let kept = self.lived(fitted, settings, clock);
         let training = &self.roles.training;
-        let kept_training = &kept[self.roles.calibration.len()..][..training.len()];
         let window = settings.lowpass_window_samples;
         let mut sums = [(0.0, 0.0); 3];
         if (0..3).any(cross) {
+            let kept = self.lived(fitted, settings, clock);
+            let kept_training = &kept[self.roles.calibration.len()..][..training.len()];
             for (segment, previous) in training.iter().zip(kept_training) {
                 let on = switch_on_raw(segment, settings);
                 let (rise, _) = metric(

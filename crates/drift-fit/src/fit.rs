@@ -120,7 +120,7 @@ fn residual_heat(sp: &SetPointCurves, c: usize, axis: usize) -> f64 {
 /// The curves' order for a table keyed by history, the same at every set point (stage 2 blends
 /// curve `c` of one ambient with curve `c` of the next): by residual heat averaged over the set
 /// points, as indices into each set point's curves (which share their keys and order).
-fn history_order(set_points: &[SetPointCurves], axis: usize) -> Vec<usize> {
+fn order_by_residual_heat(set_points: &[SetPointCurves], axis: usize) -> Vec<usize> {
     let count = set_points.first().map_or(0, |sp| sp.curves.len());
     let mean = |c: usize| {
         set_points
@@ -155,7 +155,7 @@ fn axis_table(
     for &j in &knots {
         let _ = table.reference_ms.push(j as u32 * settings.grid_ms);
     }
-    let order = history_order(set_points, axis);
+    let order = order_by_residual_heat(set_points, axis);
     let mut last_ambient = f32::NEG_INFINITY;
     for sp in set_points {
         let mut ambient = AmbientCurves {
