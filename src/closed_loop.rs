@@ -164,7 +164,8 @@ pub struct Row {
     pub history_chosen: bool,
     /// The paper's model.
     pub before: (f64, f64),
-    /// The extended model (the paper's model when nothing was admitted).
+    /// The loop's model: stage 3 keyed as chosen, with the admitted terms (the paper's model when
+    /// neither changed it).
     pub after: (f64, f64),
     /// The paper's curves with stage 3 keyed by heating history (what firmware kept of the
     /// previous activation).
@@ -309,7 +310,7 @@ pub fn run(
     for crossing in &base.crossings {
         eprintln!("  tables: {}", crossing.note());
     }
-    let closed = close(&base, &all, calibration, settings, true)?;
+    let closed = close(&base, &all, calibration, settings, true, plan_size.clock)?;
     eprintln!(
         "  {} field activations at the calibration set points inside the calibrated ambient range, {} outside held out",
         closed.roles.training.len(),
@@ -340,20 +341,20 @@ pub fn run(
             if a.admitted { "admitted" } else { "left out" }
         );
     }
-    let stage3 = closed.choose_stage3(&base, settings, plan_size.clock);
+    let stage3 = closed.stage3.clone();
     for choice in &stage3 {
-        if choice.curves_cross {
-            eprintln!(
-                "  stage 3 on {}: {} training activations, drift keyed by rise {:.4}, by history {:.4} °/s → {}",
-                choice.axis,
-                choice.training_activations,
-                choice.training_drift_by_rise_dps,
-                choice.training_drift_by_history_dps,
-                if choice.keyed_by_history { "keyed by history" } else { "kept by rise" }
-            );
-        }
+        eprintln!(
+            "  stage 3 on {}{}: {} training activations, drift keyed by rise {:.4}, by history {:.4} °/s (p {:.1e}) → {}",
+            choice.axis,
+            if choice.curves_cross { " (curves cross)" } else { "" },
+            choice.training_activations,
+            choice.training_drift_by_rise_dps,
+            choice.training_drift_by_history_dps,
+            choice.p_value,
+            if choice.keyed_by_history { "keyed by history" } else { "kept by rise" }
+        );
     }
-    let held_out = closed.before_after(&base, settings, plan_size.clock);
+    let held_out = closed.before_after(&base, settings);
     // The +33 °C protocol activations, on stderr only: the paper's own validation, where the
     // histories are the calibration's. An error that shows there too is the tables' interpolation
     // between ambients; one that shows only in the field comes from use differing from calibration.

@@ -1,7 +1,8 @@
 //! The closed loop on data with an undeclared effect, end to end: a supply-voltage sensitivity the
 //! fitter is never told about is found by the diagnosis on field-like activations at the
 //! calibration set points, admitted by the guard, and cuts the error on +33 °C field activations
-//! nothing was fitted or chosen on; without a hidden effect the loop keeps the paper's model.
+//! nothing was fitted or chosen on; without a hidden effect the loop admits no term, and changes
+//! the paper's model only by keying stage 3 by history where the training activations chose it.
 //! (`docs/closed-loop.md` has the full table over every effect and many seeds.)
 
 use drift_fit::FitSettings;
@@ -40,10 +41,16 @@ fn a_hidden_supply_sensitivity_is_found_admitted_and_cuts_the_validation_error()
 }
 
 #[test]
-fn without_a_hidden_effect_the_paper_model_is_kept() {
+fn without_a_hidden_effect_no_term_is_admitted_nor_anything_significant() {
     let rows = rows("none", 3);
     for r in &rows {
-        assert!(r.admitted.is_empty(), "{r:#?}");
-        assert_eq!(r.before, r.after, "{r:#?}");
+        assert!(r.admitted.is_empty() && !r.significant, "{r:#?}");
+        if r.history_chosen {
+            // Chosen on the training activations; on the held-out field ones it is measured, and
+            // it must not cost drift beyond noise (the paper's metric, °/s).
+            assert!(r.after.0 <= r.before.0 * 1.1, "{r:#?}");
+        } else {
+            assert_eq!(r.before, r.after, "{r:#?}");
+        }
     }
 }

@@ -42,9 +42,20 @@ fn crossings_markdown(
     stage3: &[Stage3Choice; 3],
     held_out: &[BeforeAfter],
 ) -> String {
-    if fitted.crossings.is_empty() {
-        return String::from("The calibration curves keep the paper's order (a warmer start rises less at every moment), so stage 3 can tell heating histories apart by the rise.\n\n");
+    let mut md = if fitted.crossings.is_empty() {
+        String::from("The calibration curves keep the paper's order (a warmer start rises less at every moment), so stage 3 can tell heating histories apart by the rise.\n\n")
+    } else {
+        crossings_table(fitted)
+    };
+    md.push_str(&stage3_table(stage3));
+    if !held_out.is_empty() {
+        md.push_str(&history_table(held_out));
     }
+    md
+}
+
+/// Where the calibration curves cross, as Markdown.
+fn crossings_table(fitted: &FittedUnit) -> String {
     let mut md = String::from("## The tables' history lookup\n\nStage 3 finds an activation's heating history by its rise, which assumes a warmer start rises less. In these calibration curves warmer starts rise more (worst pair per set point and axis); stage 3 then reads the drift/rise ratio of another history on every activation. No term of the candidates below repairs a wrong lookup; the same curves keyed by the residual heat at switch-on (`by_history.bin` of `gyrodrift fit`, for firmware that keeps what it knew of the previous activation) choose them by history instead: their error on the held-out activations follows the table. `examples/stage3_oracle.rs` measures what the lookup costs.\n\n| set point | axis | warmer start | colder start | switched on warmer by | rises more by | at | pairs crossing |\n|---:|---|---|---|---:|---:|---:|---:|\n");
     for c in &fitted.crossings {
         let _ = writeln!(
@@ -61,16 +72,25 @@ fn crossings_markdown(
             c.compared_pairs
         );
     }
-    md.push_str("\nThe choice, made on the training activations (field-like use at the calibration set points; the held-out ones below are only measured):\n\n| axis | curves cross | training activations | drift keyed by rise | drift keyed by history | stage 3 |\n|---|---|---:|---:|---:|---|\n");
+    md
+}
+
+/// The stage-3 choice per axis, as Markdown.
+fn stage3_table(stage3: &[Stage3Choice; 3]) -> String {
+    if stage3.iter().all(|c| c.training_activations == 0) {
+        return String::from("\n## Stage 3: keyed by rise or by heating history\n\nNo field-like activations at the calibration set points to choose on: stage 3 keeps the paper's lookup by rise on every axis (`gyrodrift simulate --field` records some).\n\n");
+    }
+    let mut md = String::from("\n## Stage 3: keyed by rise or by heating history\n\nChosen per axis on the training activations (field-like use at the calibration set points; the held-out ones are only measured): keyed by history where that leaves significantly less drift (paired by activation, one-sided, 5 %). The diagnosis below looks behind the chosen model.\n\n| axis | curves cross | training activations | drift keyed by rise | drift keyed by history | p | stage 3 |\n|---|---|---:|---:|---:|---:|---|\n");
     for c in stage3 {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {:.4} | {:.4} | {} |",
+            "| {} | {} | {} | {:.4} | {:.4} | {:.1e} | {} |",
             c.axis,
             if c.curves_cross { "yes" } else { "no" },
             c.training_activations,
             c.training_drift_by_rise_dps,
             c.training_drift_by_history_dps,
+            c.p_value,
             if c.keyed_by_history {
                 "**keyed by history**"
             } else {
@@ -78,7 +98,7 @@ fn crossings_markdown(
             }
         );
     }
-    md.push_str(&history_table(held_out));
+    md.push('\n');
     md
 }
 
@@ -110,7 +130,7 @@ fn history_table(held_out: &[BeforeAfter]) -> String {
 
 /// The ranking as Markdown.
 pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
-    let mut md = String::from("## Diagnosis of the residual after the paper's model\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: one-sided test of the held-out improvement per activation, Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
+    let mut md = String::from("## Diagnosis of the residual after the paper's model (stage 3 keyed as chosen above)\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: one-sided test of the held-out improvement per activation at the candidate's level (p) and of the whole residual, offsets and shape together (p whole: what a firmware term changes), both under Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
     for axis in axes {
         let _ = writeln!(
             md,
@@ -123,16 +143,17 @@ pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
                 |c| format!("**{}**", c.name)
             )
         );
-        md.push_str("| rank | candidate | level | explained | p | significant | coefficient | absorbed by the model |\n|---:|---|---|---:|---:|:---:|---:|---:|\n");
+        md.push_str("| rank | candidate | level | explained | p | p whole | significant | coefficient | absorbed by the model |\n|---:|---|---|---:|---:|---:|:---:|---:|---:|\n");
         for (i, c) in axis.ranking.iter().take(top).enumerate() {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {:.3} | {:.1e} | {} | {:.3e} | {:.3} |",
+                "| {} | {} | {} | {:.3} | {:.1e} | {:.1e} | {} | {:.3e} | {:.3} |",
                 i + 1,
                 c.name,
                 c.level,
                 c.explained,
                 c.p_value,
+                c.whole_p_value,
                 if c.significant { "yes" } else { "" },
                 c.coefficient,
                 c.absorbed_by_model
@@ -231,6 +252,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             &options.calibration_set_points,
             &options.fit,
             args.extend,
+            true,
         )?;
         if !closed.series.is_empty() {
             units.insert(unit, (closed, fitted));
@@ -263,17 +285,29 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         // The held-out errors are needed by the crossings' table and the extended model's; a
         // unit with neither does not pay for correcting every held-out activation twice more.
-        let before_after = if fitted.crossings.is_empty() && closed.extended.is_none() {
-            Vec::new()
-        } else {
-            closed.before_after(fitted, &options.fit, true)
-        };
-        let stage3 = closed.choose_stage3(fitted, &options.fit, true);
+        let before_after =
+            if fitted.crossings.is_empty() && closed.extended.is_none() && !closed.keying.any() {
+                Vec::new()
+            } else {
+                closed.before_after(fitted, &options.fit)
+            };
+        let stage3 = closed.stage3.clone();
         md.push_str(&crossings_markdown(fitted, &stage3, &before_after));
         md.push_str(&markdown(axes, args.top));
         println!("{unit}:");
         for crossing in &fitted.crossings {
             println!("  tables: {}", crossing.note());
+        }
+        for c in &stage3 {
+            println!(
+                "  stage 3 on {}: drift on {} training activations {:.4} keyed by rise, {:.4} by history (p {:.1e}) → {}",
+                c.axis,
+                c.training_activations,
+                c.training_drift_by_rise_dps,
+                c.training_drift_by_history_dps,
+                c.p_value,
+                if c.keyed_by_history { "keyed by history" } else { "keyed by rise" }
+            );
         }
         for axis in axes.iter() {
             let chosen = axis
@@ -312,13 +346,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 );
             }
         }
-        let before_after = if closed.extended.is_some() {
-            before_after
-        } else {
-            Vec::new()
-        };
         if args.extend {
-            md.push_str(&super::extend::run(unit, closed, &before_after, &args.out)?);
+            md.push_str(&super::extend::run(
+                unit,
+                closed,
+                fitted,
+                &before_after,
+                &args.out,
+            )?);
         }
         json.push(serde_json::json!({
             "unit": unit,

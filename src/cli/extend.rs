@@ -8,6 +8,7 @@ use std::path::Path;
 
 use drift_core::blob;
 use drift_fit::closing::{BeforeAfter, Closed};
+use drift_fit::FittedUnit;
 
 use crate::output::write_atomic;
 
@@ -15,14 +16,58 @@ use crate::output::write_atomic;
 pub fn run(
     unit: &str,
     closed: &Closed<'_>,
+    fitted: &FittedUnit,
     before_after: &[BeforeAfter],
     out: &Path,
 ) -> anyhow::Result<String> {
-    let (calibration, training) = (&closed.roles.calibration, &closed.roles.training);
     let mut md = format!("## Extended model of unit {unit}\n\n");
-    if closed.proposed.terms.is_empty() {
-        md.push_str("Nothing significant maps to a term the firmware can compute: the paper's model is kept unchanged.\n\n");
+    md.push_str(&terms_markdown(closed));
+    let terms = closed
+        .extended
+        .as_ref()
+        .is_some_and(|e| !e.plan.terms.is_empty());
+    if !terms && !closed.keying.any() {
+        md.push_str("The paper's model is kept unchanged.\n\n");
         return Ok(md);
+    }
+    let tables = closed.model(fitted);
+    let keyed: Vec<&str> = closed
+        .stage3
+        .iter()
+        .filter(|c| c.keyed_by_history)
+        .map(|c| c.axis)
+        .collect();
+    if !keyed.is_empty() {
+        let _ = writeln!(
+            md,
+            "Stage 3 is keyed by heating history on {} (chosen on the training activations, above): firmware running this image starts with `power_on_after` and calls `keep` before power-off.\n",
+            keyed.join(", ")
+        );
+    }
+    md.push_str(&before_after_table(before_after));
+    let mut image = vec![0; blob::encoded_len(&*tables)?];
+    blob::encode(&*tables, &mut image)?;
+    write_atomic(&out.join(format!("extended-{unit}.bin")), &image)?;
+    write_atomic(
+        &out.join(format!("extended-{unit}.json")),
+        serde_json::to_string_pretty(&*tables)?.as_bytes(),
+    )?;
+    let _ = writeln!(
+        md,
+        "Firmware image of the loop's model: `extended-{unit}.bin` ({} bytes, format version {}); tables as JSON: `extended-{unit}.json`.\n",
+        image.len(),
+        blob::FORMAT_VERSION
+    );
+    Ok(md)
+}
+
+/// The guard's decisions and the admitted terms, as Markdown.
+fn terms_markdown(closed: &Closed<'_>) -> String {
+    let (calibration, training) = (&closed.roles.calibration, &closed.roles.training);
+    let mut md = String::new();
+    if closed.proposed.terms.is_empty() {
+        md.push_str("Nothing significant maps to a term the firmware can compute.\n\n");
+        return md;
     }
     let Some(extended) = &closed.extended else {
         let _ = writeln!(
@@ -30,7 +75,7 @@ pub fn run(
             "Proposed terms: {}. Their guard and coefficients need field-like activations at the calibration set points, inside the calibrated ambient range (other off-times, supply voltages, orientations: where the terms' inputs vary apart from the table's), and this campaign has none: record some (`gyrodrift simulate --field`) and run again.\n",
             closed.proposed.terms.iter().map(|t| t.candidate.as_str()).collect::<Vec<_>>().join(", ")
         );
-        return Ok(md);
+        return md;
     };
     let _ = writeln!(
         md,
@@ -53,8 +98,8 @@ pub fn run(
     }
     md.push('\n');
     if extended.plan.terms.is_empty() {
-        md.push_str("No term lowers the held-out error: the paper's model is kept unchanged.\n\n");
-        return Ok(md);
+        md.push_str("No term lowers the held-out error.\n\n");
+        return md;
     }
     let tables = &extended.tables;
     let _ = writeln!(
@@ -85,22 +130,7 @@ pub fn run(
             extended.plan.aux_inputs.join(", ")
         );
     }
-    md.push_str(&before_after_table(before_after));
-
-    let mut image = vec![0; blob::encoded_len(tables)?];
-    blob::encode(tables, &mut image)?;
-    write_atomic(&out.join(format!("extended-{unit}.bin")), &image)?;
-    write_atomic(
-        &out.join(format!("extended-{unit}.json")),
-        serde_json::to_string_pretty(tables)?.as_bytes(),
-    )?;
-    let _ = writeln!(
-        md,
-        "Firmware image: `extended-{unit}.bin` ({} bytes, format version {}); tables as JSON: `extended-{unit}.json`.\n",
-        image.len(),
-        blob::FORMAT_VERSION
-    );
-    Ok(md)
+    md
 }
 
 /// The held-out activations' results by set point and series kind (`+33.0 °C field`), in order.

@@ -17,14 +17,14 @@ use rayon::prelude::*;
 
 use crate::analyse::analyse;
 use crate::error::FitError;
-use crate::evaluate::correct_segment;
 use crate::fit::fit_unit;
+use crate::keying::Keying;
 use crate::settings::FitSettings;
 
-/// The paper's tables fitted to one quantity.
+/// The paper's tables fitted to one quantity, stage 3 keyed per axis as the loop's model is.
 #[derive(Debug, Clone)]
 pub struct Absorber {
-    tables: ModifiedTables,
+    tables: Box<ModifiedTables>,
 }
 
 /// `segment` with its rates replaced by `values`.
@@ -42,24 +42,30 @@ impl Absorber {
         calibration: &[&Segment],
         values: impl Fn(&Segment) -> Option<[Vec<f32>; 3]> + Sync,
         settings: &FitSettings,
+        keying: &Keying,
     ) -> Result<Self, FitError> {
         let analysed = calibration
             .par_iter()
             .filter_map(|segment| values(segment).map(|v| analyse(&carrying(segment, v), settings)))
             .collect::<Result<Vec<_>, _>>()?;
+        let fitted = fit_unit(&analysed, settings)?;
         Ok(Self {
-            tables: fit_unit(&analysed, settings)?.modified,
+            tables: keying.tables(&fitted.modified, &fitted.by_history),
         })
     }
 
     /// The part of `values` (the quantity on `segment`) that the tables do not predict, computed
-    /// by drift-core's corrector exactly as it corrects rates.
+    /// by drift-core's corrector exactly as it corrects rates, started as the loop's model is
+    /// (`keying`, the one the absorber was fitted with).
     pub fn left_over(
         &self,
         segment: &Segment,
         values: [Vec<f32>; 3],
         switch_on: [f32; 3],
+        keying: &Keying,
     ) -> [Vec<f32>; 3] {
-        correct_segment(&self.tables, &carrying(segment, values), switch_on).0
+        keying
+            .correct(&self.tables, &carrying(segment, values), switch_on)
+            .0
     }
 }

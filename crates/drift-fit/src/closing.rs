@@ -5,13 +5,15 @@
 
 use drift_core::Previous;
 use drift_recording::Segment;
+use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, Diagnoser};
+use crate::diagnose::{diagnose, one_sided_mean_test, ActivationSeries, AxisDiagnosis, Diagnoser};
 use crate::error::FitError;
 use crate::evaluate::{correct_segment_after, kept_before, metric, switch_on_raw};
 use crate::extend::{correct_with_terms, extend, Extended, TermPlan};
 use crate::fit::FittedUnit;
+use crate::keying::Keying;
 use crate::roles::Roles;
 use crate::settings::FitSettings;
 
@@ -19,6 +21,10 @@ use crate::settings::FitSettings;
 pub struct Closed<'a> {
     /// Which activations played which part.
     pub roles: Roles<'a>,
+    /// Stage 3's lookup per axis of the loop's model, chosen on the training activations.
+    pub stage3: [Stage3Choice; 3],
+    /// The same choice with what firmware kept before each of the unit's activations.
+    pub keying: Keying,
     /// The diagnosed activations on the diagnosis grid.
     pub series: Vec<ActivationSeries>,
     /// The ranking per axis.
@@ -51,39 +57,117 @@ pub struct BeforeAfter {
 }
 
 /// Whether stage 3 keyed by heating history ([`FittedUnit::by_history`]) replaces the paper's
-/// lookup by rise on one axis: only where the fit found the calibration curves crossing on that
-/// axis (the rise no longer names the history), and only if on the training activations (field-like
-/// use at the calibration set points; never the held-out ones) it leaves less drift than the
-/// paper's lookup — the guard's rule for a term, applied to a lookup.
+/// lookup by rise on one axis of the loop's model: where on the training activations (field-like
+/// use at the calibration set points; never the held-out ones) it leaves significantly less drift
+/// than the paper's lookup (paired by activation, one-sided, 5 %) — the guard's rule for a term,
+/// applied to a lookup. The diagnosis then looks behind the chosen model.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Stage3Choice {
     /// `X`, `Y` or `Z`.
     pub axis: &'static str,
-    /// Whether the fit found crossing curves on this axis ([`FittedUnit::crossings`]).
+    /// Whether the fit found crossing curves on this axis ([`FittedUnit::crossings`]): the rise
+    /// then names another history on every activation.
     pub curves_cross: bool,
-    /// Training activations compared (0 when the curves do not cross: nothing is tried).
+    /// Training activations compared.
     pub training_activations: usize,
     /// Their mean drift with the paper's lookup, °/s.
     pub training_drift_by_rise_dps: f64,
     /// Their mean drift keyed by history, °/s.
     pub training_drift_by_history_dps: f64,
+    /// One-sided p-value of "keyed by history leaves less drift" (paired by activation).
+    pub p_value: f64,
     /// The choice.
     pub keyed_by_history: bool,
 }
 
-/// Splits `segments` (one unit's) by role, diagnoses the paper model `fitted` on the training
-/// activations (or, without any, on every activation the fit did not see), and with `extend`
-/// fits the guarded extended model.
+/// Significance level of the stage-3 choice (the guard's).
+const CHOOSE_ALPHA: f64 = 0.05;
+
+/// Chooses stage 3's lookup per axis on the `training` activations, each started after what
+/// firmware kept before it (`kept`, in `training`'s order).
+fn choose_stage3(
+    fitted: &FittedUnit,
+    training: &[&Segment],
+    kept: &[[Previous; 3]],
+    settings: &FitSettings,
+) -> [Stage3Choice; 3] {
+    let window = settings.lowpass_window_samples;
+    let per_activation: Vec<([f64; 3], [f64; 3])> = training
+        .par_iter()
+        .zip(kept)
+        .map(|(segment, previous)| {
+            let on = switch_on_raw(segment, settings);
+            let (rise, _) = metric(
+                &correct_segment_after(&fitted.modified, segment, on, None).0,
+                window,
+            );
+            let (history, _) = metric(
+                &correct_segment_after(&fitted.by_history, segment, on, Some(previous)).0,
+                window,
+            );
+            (rise, history)
+        })
+        .collect();
+    std::array::from_fn(|a| {
+        let n = per_activation.len();
+        let mean = |pick: usize| {
+            if n == 0 {
+                f64::NAN
+            } else {
+                let sum: f64 = per_activation
+                    .iter()
+                    .map(|(rise, history)| [rise, history][pick][a])
+                    .sum();
+                sum / n as f64
+            }
+        };
+        let gains: Vec<f64> = per_activation.iter().map(|(r, h)| r[a] - h[a]).collect();
+        let (gain, p_value) = if n < 2 {
+            (0.0, 1.0)
+        } else {
+            one_sided_mean_test(&gains)
+        };
+        Stage3Choice {
+            axis: ["X", "Y", "Z"][a],
+            curves_cross: fitted.crossings.iter().any(|c| c.axis == a),
+            training_activations: n,
+            training_drift_by_rise_dps: mean(0),
+            training_drift_by_history_dps: mean(1),
+            p_value,
+            keyed_by_history: gain > 0.0 && p_value < CHOOSE_ALPHA,
+        }
+    })
+}
+
+/// Splits `segments` (one unit's) by role, chooses stage 3's lookup per axis on the training
+/// activations ([`Stage3Choice`]; `clock`: the firmware also knows when the unit cooled fully,
+/// [`crate::evaluate::kept_before`]), diagnoses the chosen model on the training activations (or,
+/// without any, on every activation the fit did not see), and with `extend` fits the guarded
+/// extended model.
 pub fn close<'a>(
     fitted: &FittedUnit,
     segments: impl IntoIterator<Item = &'a Segment>,
     calibration_set_points: &[f64],
     settings: &FitSettings,
     extend_model: bool,
+    clock: bool,
 ) -> Result<Closed<'a>, FitError> {
     let mut roles = Roles::split(segments, calibration_set_points);
     roles.hold_out_outside_range(fitted, settings);
-    let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings)?;
+    // The unit's whole life in order, as its firmware would have lived it: every activation
+    // passes what it kept on to the next.
+    let life: Vec<&Segment> = roles
+        .calibration
+        .iter()
+        .chain(&roles.training)
+        .chain(&roles.held_out)
+        .copied()
+        .collect();
+    let kept = kept_before(&life, settings, &fitted.by_history.settings, clock);
+    let kept_training = &kept[roles.calibration.len()..][..roles.training.len()];
+    let stage3 = choose_stage3(fitted, &roles.training, kept_training, settings);
+    let keying = Keying::new(stage3.clone().map(|c| c.keyed_by_history), &life, &kept);
+    let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings, keying.clone())?;
     let series: Vec<ActivationSeries> = roles
         .diagnosed()
         .iter()
@@ -94,6 +178,7 @@ pub fn close<'a>(
     let extended = if extend_model && !proposed.terms.is_empty() && !roles.training.is_empty() {
         Some(extend(
             fitted,
+            &keying,
             &proposed,
             &roles.calibration,
             &roles.training,
@@ -104,6 +189,8 @@ pub fn close<'a>(
     };
     Ok(Closed {
         roles,
+        stage3,
+        keying,
         series,
         axes,
         proposed,
@@ -112,72 +199,6 @@ pub fn close<'a>(
 }
 
 impl Closed<'_> {
-    /// The unit's activations in the order its firmware lived them, with what it kept before
-    /// each (`clock`: it also knows a full cool-down), as indices into calibration, training and
-    /// held-out activations in that order.
-    fn lived(
-        &self,
-        fitted: &FittedUnit,
-        settings: &FitSettings,
-        clock: bool,
-    ) -> Vec<[Previous; 3]> {
-        let roles = &self.roles;
-        let life: Vec<&Segment> = roles
-            .calibration
-            .iter()
-            .chain(&roles.training)
-            .chain(&roles.held_out)
-            .copied()
-            .collect();
-        kept_before(&life, settings, &fitted.by_history.settings, clock)
-    }
-
-    /// Per axis, whether stage 3 keyed by history replaces the paper's lookup ([`Stage3Choice`]),
-    /// decided on the training activations.
-    pub fn choose_stage3(
-        &self,
-        fitted: &FittedUnit,
-        settings: &FitSettings,
-        clock: bool,
-    ) -> [Stage3Choice; 3] {
-        let cross = |axis: usize| fitted.crossings.iter().any(|c| c.axis == axis);
-        let training = &self.roles.training;
-        let window = settings.lowpass_window_samples;
-        let mut sums = [(0.0, 0.0); 3];
-        if (0..3).any(cross) {
-            let kept = self.lived(fitted, settings, clock);
-            let kept_training = &kept[self.roles.calibration.len()..][..training.len()];
-            for (segment, previous) in training.iter().zip(kept_training) {
-                let on = switch_on_raw(segment, settings);
-                let (rise, _) = metric(
-                    &correct_segment_after(&fitted.modified, segment, on, None).0,
-                    window,
-                );
-                let (history, _) = metric(
-                    &correct_segment_after(&fitted.by_history, segment, on, Some(previous)).0,
-                    window,
-                );
-                for a in 0..3 {
-                    sums[a].0 += rise[a];
-                    sums[a].1 += history[a];
-                }
-            }
-        }
-        std::array::from_fn(|a| {
-            let n = if cross(a) { training.len() } else { 0 };
-            let mean = |sum: f64| if n == 0 { f64::NAN } else { sum / n as f64 };
-            let (by_rise, by_history) = (mean(sums[a].0), mean(sums[a].1));
-            Stage3Choice {
-                axis: ["X", "Y", "Z"][a],
-                curves_cross: cross(a),
-                training_activations: n,
-                training_drift_by_rise_dps: by_rise,
-                training_drift_by_history_dps: by_history,
-                keyed_by_history: n > 0 && by_history < by_rise,
-            }
-        })
-    }
-
     /// The terms the guard admitted (empty without an extended model).
     pub fn admitted(&self) -> TermPlan {
         self.extended
@@ -185,45 +206,44 @@ impl Closed<'_> {
             .map_or_else(TermPlan::default, |e| e.plan.clone())
     }
 
-    /// The error before (paper's model `fitted`) and after (the extended model; the paper's model
-    /// when nothing was admitted) on every held-out activation.
+    /// The loop's model of `fitted` (the unit it was closed with): stage 3 keyed per axis as
+    /// chosen, with the admitted terms (the extended model's tables when one was fitted).
+    pub fn model(&self, fitted: &FittedUnit) -> Box<drift_core::ModifiedTables> {
+        self.extended.as_ref().map_or_else(
+            || self.keying.tables(&fitted.modified, &fitted.by_history),
+            |e| Box::new(e.tables.clone()),
+        )
+    }
+
+    /// The error before (the paper's model `fitted`) and after (the loop's model,
+    /// [`Closed::model`]: the paper's when nothing was chosen or admitted) on every held-out
+    /// activation.
     ///
-    /// The history-keyed model runs through the unit's whole life in order, as its firmware would
-    /// have lived it; `clock`: the firmware also knows when the unit cooled fully
-    /// ([`crate::evaluate::kept_before`]).
-    pub fn before_after(
-        &self,
-        fitted: &FittedUnit,
-        settings: &FitSettings,
-        clock: bool,
-    ) -> Vec<BeforeAfter> {
+    /// The history-keyed model (every axis) runs through the unit's whole life in order, as its
+    /// firmware would have lived it ([`Closed::keying`]).
+    pub fn before_after(&self, fitted: &FittedUnit, settings: &FitSettings) -> Vec<BeforeAfter> {
         let plan = self.admitted();
         let window = settings.lowpass_window_samples;
-        // The unit's whole life in order, as its firmware would have lived it: every activation
-        // passes what it kept on to the next.
-        let roles = &self.roles;
-        let kept = self.lived(fitted, settings, clock);
-        let kept_held_out = &kept[roles.calibration.len() + roles.training.len()..];
-        roles
+        let every_axis = self.keying.with_by_history([true; 3]);
+        let model = self.model(fitted);
+        self.roles
             .held_out
             .iter()
-            .zip(kept_held_out)
-            .map(|(segment, previous)| {
+            .map(|segment| {
                 let on = switch_on_raw(segment, settings);
                 let (history_drift, history_rms) = metric(
-                    &correct_segment_after(&fitted.by_history, segment, on, Some(previous)).0,
+                    &every_axis.correct(&fitted.by_history, segment, on).0,
                     window,
                 );
                 let (drift_before, rms_before) = metric(
-                    &correct_with_terms(&fitted.modified, &plan, segment, on),
+                    &correct_with_terms(&fitted.modified, &plan, segment, on, None),
                     window,
                 );
-                let (drift_after, rms_after) = match &self.extended {
-                    Some(e) if !e.plan.terms.is_empty() => {
-                        metric(&correct_with_terms(&e.tables, &plan, segment, on), window)
-                    }
-                    _ => (drift_before, rms_before),
-                };
+                let previous = self.keying.previous(segment);
+                let (drift_after, rms_after) = metric(
+                    &correct_with_terms(&*model, &plan, segment, on, previous),
+                    window,
+                );
                 BeforeAfter {
                     set_point_celsius: segment.labels.nominal_set_point_celsius(),
                     series_kind: segment.labels.series_kind.as_str(),

@@ -15,7 +15,12 @@
 //! (K folds of whole activations, never samples), for a one-coefficient linear term. Significance:
 //! per-activation reductions of squared error on held-out activations, one-sided t-test of their
 //! mean against zero, Bonferroni-corrected over every candidate of the axis. Activations are the
-//! independent samples; the noise inside one is strongly autocorrelated.
+//! independent samples; the noise inside one is strongly autocorrelated. A candidate is significant
+//! only if it also lowers the *whole* held-out residual (offsets and shape, no activation means
+//! taken out) at the same level: a firmware term changes both, and a candidate left over from
+//! what the tables almost wholly absorb (rise², the rises) can match the tables' own lookup error
+//! in shape while a term in it makes the whole error no smaller (measured in
+//! `docs/closed-loop.md`, *the null case*).
 
 use std::collections::BTreeMap;
 
@@ -26,8 +31,9 @@ use serde::Serialize;
 use crate::absorb::Absorber;
 use crate::candidates::{Kind, SET_POINT_CHANNEL};
 use crate::error::FitError;
-use crate::evaluate::{correct_segment, switch_on_raw};
+use crate::evaluate::switch_on_raw;
 use crate::fit::FittedUnit;
+use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
 
@@ -58,22 +64,29 @@ fn on_grid<T: Copy + Into<f64>>(values: &[T], window: usize, step: usize) -> Vec
 
 /// Puts activations of one unit on the diagnosis grid, with the paper's model fitted on its
 /// calibration activations and, for every candidate, what those tables absorb of it.
-pub struct Diagnoser<'a> {
-    fitted: &'a FittedUnit,
+pub struct Diagnoser {
     settings: FitSettings,
+    /// How stage 3 reads each axis of the model diagnosed, and what firmware kept before each
+    /// activation.
+    keying: Keying,
+    /// The diagnosed model's tables (the paper's, with the history-keyed axes `keying` chose).
+    tables: Box<drift_core::ModifiedTables>,
     /// Each candidate kind with the tables fitted to it; a kind the calibration activations cannot
     /// carry (an auxiliary channel they lack) is not offered.
     kinds: Vec<(Kind, Absorber)>,
 }
 
-impl<'a> Diagnoser<'a> {
+impl Diagnoser {
     /// Learns what the paper's tables absorb of every candidate, on the activations `fitted` was
     /// fitted on. Candidates are the auxiliary channels every calibration activation has and the
     /// derived quantities.
+    ///
+    /// The model diagnosed is the paper's with stage 3 keyed as `keying` says per axis.
     pub fn new(
-        fitted: &'a FittedUnit,
+        fitted: &FittedUnit,
         calibration: &[&Segment],
         settings: &FitSettings,
+        keying: Keying,
     ) -> Result<Self, FitError> {
         let mut channels: Vec<String> = calibration
             .first()
@@ -88,13 +101,15 @@ impl<'a> Diagnoser<'a> {
                     calibration,
                     |s| kind.values(s, switch_on_raw(s, settings)),
                     settings,
+                    &keying,
                 )?;
                 Ok((kind, absorber))
             })
             .collect::<Result<Vec<_>, FitError>>()?;
         Ok(Self {
-            fitted,
             settings: settings.clone(),
+            tables: keying.tables(&fitted.modified, &fitted.by_history),
+            keying,
             kinds,
         })
     }
@@ -104,7 +119,7 @@ impl<'a> Diagnoser<'a> {
         let window = self.settings.lowpass_window_samples;
         let step = (segment.sample_rate_hz as usize * GRID_MS as usize / 1000).max(1);
         let switch_on = switch_on_raw(segment, &self.settings);
-        let (corrected, _) = correct_segment(&self.fitted.modified, segment, switch_on);
+        let (corrected, _) = self.keying.correct(&self.tables, segment, switch_on);
         let residual: [Vec<f64>; 3] = [0, 1, 2].map(|a| on_grid(&corrected[a], window, step));
         let mut candidates: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
         let mut left_over: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
@@ -113,7 +128,7 @@ impl<'a> Diagnoser<'a> {
             .par_iter()
             .filter_map(|(kind, absorber)| {
                 let values = kind.values(segment, switch_on)?;
-                let left = absorber.left_over(segment, values.clone(), switch_on);
+                let left = absorber.left_over(segment, values.clone(), switch_on, &self.keying);
                 Some((kind, values, left))
             })
             .collect();
@@ -142,7 +157,11 @@ pub struct CandidateScore {
     pub explained: f64,
     /// One-sided p-value of the mean held-out improvement (before multiple-comparison correction).
     pub p_value: f64,
-    /// Whether it passes the Bonferroni-corrected test at `alpha`.
+    /// One-sided p-value of the mean held-out improvement of the whole residual (offsets and
+    /// shape together, no per-activation means taken out): what a firmware term changes.
+    pub whole_p_value: f64,
+    /// Whether it passes the Bonferroni-corrected test at `alpha`, at its level and on the whole
+    /// residual.
     pub significant: bool,
     /// Fitted coefficient on all data ((°/s) per candidate unit, on what the tables leave of it).
     pub coefficient: f64,
@@ -381,6 +400,7 @@ pub fn diagnose_axis(
                 name: name.clone(),
                 explained: 0.0,
                 p_value: 1.0,
+                whole_p_value: 1.0,
                 significant: false,
                 coefficient: 0.0,
                 absorbed_by_model: absorbed,
@@ -408,8 +428,16 @@ pub fn diagnose_axis(
                     )]
                 })
                 .collect();
+            let whole: Vec<Vec<Point>> = activations
+                .iter()
+                .map(|a| {
+                    let (y, c) = (&a.residual_dps[axis], &a.left_over[axis][name]);
+                    y.iter().copied().zip(c.iter().copied()).collect()
+                })
+                .collect();
             let (we, wp, wc) = score(&within, folds);
             let (be, bp, bc) = score(&between, folds);
+            (_, candidate.whole_p_value, _) = score(&whole, folds);
             (
                 candidate.explained,
                 candidate.p_value,
@@ -425,7 +453,7 @@ pub fn diagnose_axis(
         .collect();
     let bonferroni = alpha / (2 * ranking.len()).max(1) as f64;
     for c in &mut ranking {
-        c.significant = c.p_value < bonferroni && c.explained > 0.0;
+        c.significant = c.p_value < bonferroni && c.whole_p_value < bonferroni && c.explained > 0.0;
     }
     // Significant first, then by explained share.
     ranking.sort_by(|a, b| {

@@ -14,8 +14,8 @@
 //! ambients.
 
 use drift_core::{
-    Corrector, Extension, ExtensionState, ExtraTerm, Model, ModifiedTables, Settings, Term,
-    TermInputs, AUX_INPUTS, MAX_TERMS,
+    Corrector, Extension, ExtensionState, ExtraTerm, Model, ModifiedTables, Previous, Settings,
+    Term, TermInputs, AUX_INPUTS, MAX_TERMS,
 };
 use drift_recording::Segment;
 use rayon::prelude::*;
@@ -28,6 +28,7 @@ use crate::diagnose::AxisDiagnosis;
 use crate::error::FitError;
 use crate::evaluate::{metric, sample_at, switch_on_raw};
 use crate::fit::{fit_unit, FittedUnit};
+use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
 
@@ -231,18 +232,24 @@ fn describe(term: Term, candidate: &str) -> String {
 }
 
 /// Corrects a whole activation with `tables` (extended or not), passing the plan's auxiliary
-/// inputs: the firmware's path, sample by sample.
+/// inputs: the firmware's path, sample by sample; started after `previous` (what firmware kept of
+/// the activation before) when given, as stage 3 keyed by history needs.
 pub fn correct_with_terms<M: Model>(
     tables: &M,
     plan: &TermPlan,
     segment: &Segment,
     switch_on: [f32; 3],
+    previous: Option<[Previous; 3]>,
 ) -> [Vec<f32>; 3] {
     let mut corrected: [Vec<f32>; 3] = Default::default();
     let Ok(mut corrector) = Corrector::new(tables) else {
         return segment.rate_dps.clone();
     };
-    if corrector.power_on(switch_on).is_err() {
+    let started = match previous {
+        Some(mut previous) => corrector.power_on_after(switch_on, &mut previous),
+        None => corrector.power_on(switch_on),
+    };
+    if started.is_err() {
         return segment.rate_dps.clone();
     }
     for i in 0..segment.len() {
@@ -327,6 +334,7 @@ struct TrainingSeries {
 
 fn training_series(
     base: &ModifiedTables,
+    keying: &Keying,
     plan: &TermPlan,
     absorbers: &[Absorber],
     segment: &Segment,
@@ -341,7 +349,7 @@ fn training_series(
             .collect()
     };
     let switch_on = switch_on_raw(segment, settings);
-    let residual = correct_with_terms(base, plan, segment, switch_on);
+    let residual = correct_with_terms(base, plan, segment, switch_on, keying.previous(segment));
     let values = term_values(plan, base.settings(), segment, switch_on);
     let raw_sum = values
         .iter()
@@ -356,7 +364,11 @@ fn training_series(
     let terms = values
         .into_iter()
         .zip(absorbers)
-        .map(|(v, absorber)| absorber.left_over(segment, v, switch_on).map(|l| grid(&l)))
+        .map(|(v, absorber)| {
+            absorber
+                .left_over(segment, v, switch_on, keying)
+                .map(|l| grid(&l))
+        })
         .collect();
     TrainingSeries {
         residual: residual.map(|r| grid(&r)),
@@ -387,6 +399,7 @@ fn joint_fit(series: &[&TrainingSeries], axis: usize, chosen: &[usize]) -> Vec<f
 /// the extension: the model firmware would run.
 fn refit(
     base: &FittedUnit,
+    keying: &Keying,
     plan: &TermPlan,
     extension: &Extension,
     calibration: &[&Segment],
@@ -411,9 +424,8 @@ fn refit(
             .collect::<Result<Vec<_>, _>>()?;
         fit_unit(&analysed, settings)?
     };
-    let tables = refitted
-        .modified
-        .clone()
+    let tables = keying
+        .tables(&refitted.modified, &refitted.by_history)
         .with_extension(extension.clone())
         .map_err(|source| FitError::Table {
             unit: base.unit_id.clone(),
@@ -427,11 +439,13 @@ fn refit(
 /// paper's drift metric of it (max − min).
 fn errors(
     tables: &ModifiedTables,
+    keying: &Keying,
     plan: &TermPlan,
     segment: &Segment,
     settings: &FitSettings,
 ) -> [(f64, f64); 3] {
-    let corrected = correct_with_terms(tables, plan, segment, switch_on_raw(segment, settings));
+    let on = switch_on_raw(segment, settings);
+    let corrected = correct_with_terms(tables, plan, segment, on, keying.previous(segment));
     let (drift, rms) = metric(&corrected, settings.lowpass_window_samples);
     std::array::from_fn(|a| (rms[a] * rms[a], drift[a]))
 }
@@ -472,6 +486,7 @@ struct HeldOutGain {
 #[allow(clippy::too_many_arguments)]
 fn held_out_gains(
     base: &FittedUnit,
+    keying: &Keying,
     plan: &TermPlan,
     centre: &[[f32; 3]],
     calibration: &[&Segment],
@@ -501,10 +516,10 @@ fn held_out_gains(
             .collect();
         let held_out_errors = |chosen: &[Vec<usize>; 3]| -> Result<Vec<[(f64, f64); 3]>, FitError> {
             let extension = plan.extension(centre, &coefficients(&train, chosen, plan.terms.len()));
-            let (_, tables) = refit(base, plan, &extension, calibration, settings)?;
+            let (_, tables) = refit(base, keying, plan, &extension, calibration, settings)?;
             Ok(held_out
                 .par_iter()
-                .map(|s| errors(&tables, plan, s, settings))
+                .map(|s| errors(&tables, keying, plan, s, settings))
                 .collect())
         };
         let (without, with) = (held_out_errors(admitted)?, held_out_errors(&with)?);
@@ -524,7 +539,9 @@ fn held_out_gains(
 /// The extended model of one unit and how it was reached.
 #[derive(Debug, Clone)]
 pub struct Extended {
-    /// Tables refitted with the terms' contribution removed, carrying the admitted terms.
+    /// Tables refitted with the terms' contribution removed, carrying the admitted terms, stage 3
+    /// keyed per axis as the loop chose ([`Keying`]: the history-keyed axes need firmware that
+    /// starts with `power_on_after`).
     pub tables: ModifiedTables,
     /// The terms that were admitted on at least one axis (which auxiliary channel is which input).
     pub plan: TermPlan,
@@ -540,9 +557,11 @@ pub struct Extended {
 /// every term and axis); the admitted
 /// terms' coefficients are fitted on all `training` activations against what the tables leave of
 /// each term ([`Absorber`]), and the tables are refitted once on `calibration` with the terms'
-/// contribution removed. With nothing admitted the paper's tables come back unchanged.
+/// contribution removed. With nothing admitted the paper's tables come back unchanged. Stage 3 is
+/// keyed per axis as `keying` says, throughout: the base model, the absorbers and the refits.
 pub fn extend(
     base: &FittedUnit,
+    keying: &Keying,
     plan: &TermPlan,
     calibration: &[&Segment],
     training: &[&Segment],
@@ -559,12 +578,14 @@ pub fn extend(
                         .nth(t)
                 },
                 settings,
+                keying,
             )
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let base_tables = keying.tables(&base.modified, &base.by_history);
     let series: Vec<TrainingSeries> = training
         .par_iter()
-        .map(|s| training_series(&base.modified, plan, &absorbers, s, settings))
+        .map(|s| training_series(&base_tables, keying, plan, &absorbers, s, settings))
         .collect();
 
     let centre: Vec<[f32; 3]> = (0..plan.terms.len())
@@ -585,6 +606,7 @@ pub fn extend(
     for (t, chosen) in plan.terms.iter().enumerate() {
         let gains = held_out_gains(
             base,
+            keying,
             plan,
             &centre,
             calibration,
@@ -634,7 +656,7 @@ pub fn extend(
         &keep.iter().map(|&t| centre[t]).collect::<Vec<_>>(),
         &keep.iter().map(|&t| coefficient[t]).collect::<Vec<_>>(),
     );
-    let (refitted, tables) = refit(base, &kept, &extension, calibration, settings)?;
+    let (refitted, tables) = refit(base, keying, &kept, &extension, calibration, settings)?;
     Ok(Extended {
         tables,
         plan: kept,
@@ -691,6 +713,7 @@ mod tests {
                     name: (*candidate).to_owned(),
                     explained: 0.5,
                     p_value: 0.001,
+                    whole_p_value: 0.001,
                     significant: *significant,
                     coefficient: 0.01,
                     absorbed_by_model: 0.0,

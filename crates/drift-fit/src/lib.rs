@@ -20,6 +20,7 @@ pub mod evaluate;
 pub mod extend;
 pub mod fit;
 pub mod history_order;
+pub mod keying;
 pub mod knots;
 pub mod lowpass;
 pub mod measured;

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use drift_fit::closing::close;
-use drift_fit::closing::BeforeAfter;
+use drift_fit::closing::{BeforeAfter, Stage3Choice};
 use drift_fit::diagnose::AxisDiagnosis;
 use drift_fit::extend::Admission;
 use drift_fit::{FitSettings, FittedUnit};
@@ -25,6 +25,7 @@ pub struct PyDiagnosis {
     axes: [AxisDiagnosis; 3],
     proposed: Vec<String>,
     admissions: Vec<Admission>,
+    stage3: [Stage3Choice; 3],
     extended: Option<PyModifiedTables>,
     aux_inputs: Vec<String>,
     before_after: Vec<BeforeAfter>,
@@ -47,6 +48,7 @@ struct RankRecord<'a> {
     level: &'static str,
     explained: f64,
     p_value: f64,
+    whole_p_value: f64,
     significant: bool,
     coefficient: f64,
     absorbed_by_model: f64,
@@ -98,19 +100,22 @@ pub fn diagnose_unit(
                 all.len()
             )));
         }
-        let closed = close(unit, own, &set_points, settings, extend)?;
+        let closed = close(unit, own, &set_points, settings, extend, true)?;
         if closed.series.is_empty() {
             return Err(Error::Input(format!(
                 "`segments` holds no activation of unit {} outside the calibration protocol at {set_points:?} °C to diagnose",
                 unit.unit_id
             )));
         }
-        let before_after = if closed.extended.is_some() {
-            closed.before_after(unit, settings, true)
+        let admitted = closed.extended.as_ref().filter(|e| !e.plan.terms.is_empty());
+        // The loop's model differs from the paper's when a term was admitted or stage 3 is keyed
+        // by history on an axis.
+        let changed = admitted.is_some() || closed.keying.any();
+        let before_after = if changed {
+            closed.before_after(unit, settings)
         } else {
             Vec::new()
         };
-        let admitted = closed.extended.as_ref().filter(|e| !e.plan.terms.is_empty());
         Ok(PyDiagnosis {
             unit_id: unit.unit_id.clone(),
             proposed: closed
@@ -124,7 +129,8 @@ pub fn diagnose_unit(
                 .as_ref()
                 .map(|e| e.admissions.clone())
                 .unwrap_or_default(),
-            extended: admitted.map(|e| PyModifiedTables(Arc::new(e.tables.clone()))),
+            extended: changed.then(|| PyModifiedTables(Arc::from(closed.model(unit)))),
+            stage3: closed.stage3.clone(),
             aux_inputs: admitted
                 .map(|e| e.plan.aux_inputs.clone())
                 .unwrap_or_default(),
@@ -151,7 +157,7 @@ impl PyDiagnosis {
     }
 
     /// The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
-    /// significant, coefficient, absorbed_by_model): a new list of dicts.
+    /// whole_p_value, significant, coefficient, absorbed_by_model): a new list of dicts.
     #[getter]
     fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.records())
@@ -190,8 +196,16 @@ impl PyDiagnosis {
         to_python(py, &self.admissions)
     }
 
-    /// The extended model (the refitted tables with the admitted terms), or None when none was
-    /// asked for or no term was admitted.
+    /// Per axis, stage 3's lookup as the loop chose it on the training activations (records:
+    /// axis, curves_cross, training_activations, training_drift_by_rise_dps,
+    /// training_drift_by_history_dps, p_value, keyed_by_history).
+    #[getter]
+    fn stage3<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.stage3)
+    }
+
+    /// The loop's model (stage 3 keyed as chosen, the refitted tables with the admitted terms),
+    /// or None when it is the paper's unchanged. History-keyed axes need `power_on_after`.
     #[getter]
     fn extended(&self) -> Option<PyModifiedTables> {
         self.extended.clone()
@@ -248,6 +262,7 @@ impl PyDiagnosis {
                     level: c.level,
                     explained: c.explained,
                     p_value: c.p_value,
+                    whole_p_value: c.whole_p_value,
                     significant: c.significant,
                     coefficient: c.coefficient,
                     absorbed_by_model: c.absorbed_by_model,

@@ -73,12 +73,30 @@ def test_the_ranking_is_records_with_every_axis(diagnosis: gyrodrift.Diagnosis) 
         "level",
         "explained",
         "p_value",
+        "whole_p_value",
         "significant",
         "absorbed_by_model",
     }
+    # A significant candidate is significant on the whole residual too.
+    assert all(r["whole_p_value"] < 0.05 for r in records if r["significant"])
     counts = dict(diagnosis.activations)
     assert counts["diagnosed"] == counts["training"] > 0
     assert "Diagnosis GIU-01" in repr(diagnosis)
+
+
+def test_stage_3_is_chosen_per_axis_on_the_training_activations(
+    diagnosis: gyrodrift.Diagnosis,
+) -> None:
+    stage3 = diagnosis.stage3
+    assert [c["axis"] for c in stage3] == ["X", "Y", "Z"]
+    counts = dict(diagnosis.activations)
+    for c in stage3:
+        assert c["training_activations"] == counts["training"]
+        # Keyed by history only where that leaves less drift, significantly.
+        if c["keyed_by_history"]:
+            assert c["training_drift_by_history_dps"] < c["training_drift_by_rise_dps"], c
+            assert c["p_value"] < 0.05, c
+            assert diagnosis.extended is not None
 
 
 def test_a_unit_without_activations_is_an_input_error(campaign: Path) -> None:

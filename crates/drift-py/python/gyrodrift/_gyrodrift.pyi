@@ -777,7 +777,7 @@ class Diagnosis:
     @property
     def ranking(self) -> list[dict[str, Any]]:
         """The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
-        significant, coefficient, absorbed_by_model): a new list of dicts."""
+        whole_p_value, significant, coefficient, absorbed_by_model): a new list of dicts."""
     def to_dataframe(self) -> Any:
         """The ranking as a pandas DataFrame (needs pandas; raises ImportError without it)."""
     @property
@@ -792,9 +792,14 @@ class Diagnosis:
         """The guard's decision for every proposed term and axis (records: candidate, axis,
         improvement, p_value, drift_gain_dps, admitted); empty unless `extend=True`."""
     @property
+    def stage3(self) -> list[dict[str, Any]]:
+        """Per axis, stage 3's lookup as the loop chose it on the training activations (records:
+        axis, curves_cross, training_activations, training_drift_by_rise_dps,
+        training_drift_by_history_dps, p_value, keyed_by_history)."""
+    @property
     def extended(self) -> ModifiedTables | None:
-        """The extended model (the refitted tables with the admitted terms), or None when none was
-        asked for or no term was admitted."""
+        """The loop's model (stage 3 keyed as chosen, the refitted tables with the admitted terms),
+        or None when it is the paper's unchanged. History-keyed axes need `power_on_after`."""
     @property
     def aux_inputs(self) -> list[str]:
         """The recorded channels the firmware passes as the extended model's auxiliary inputs 0..,
