@@ -54,3 +54,19 @@ fn without_a_hidden_effect_no_term_is_admitted_nor_anything_significant() {
         }
     }
 }
+
+#[test]
+fn crossing_curves_are_keyed_by_history_before_the_diagnosis_looks() {
+    // Heating power growing with temperature makes the calibration curves cross, and stage 3's
+    // lookup by rise reads another history's ratio: the loop keys those axes by history on the
+    // training activations, and what the +33 °C field activations show of it is measured.
+    let rows = rows("rise_nonlinearity", 3);
+    let keyed: Vec<&Row> = rows.iter().filter(|r| r.history_chosen).collect();
+    assert!(keyed.len() >= 2, "{rows:#?}");
+    for r in &keyed {
+        // The paper's drift metric over the +33 °C field activations, °/s.
+        assert!(r.after.0 < r.before.0, "{r:#?}");
+    }
+    // What the chosen model leaves is not a term's to explain.
+    assert!(rows.iter().all(|r| r.admitted.is_empty()), "{rows:#?}");
+}

@@ -360,6 +360,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "axes": axes,
             "proposed_terms": closed.proposed.terms.iter().map(|t| &t.candidate).collect::<Vec<_>>(),
             "admissions": closed.extended.as_ref().map(|e| &e.admissions),
+            "crossings": fitted.crossings,
             "stage3": stage3,
             "before_after": before_after,
         }));

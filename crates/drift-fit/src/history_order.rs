@@ -24,16 +24,23 @@ pub const WARMER_BY_CELSIUS: f64 = 0.2;
 /// curve averaged over repeats.
 pub const CROSSING_MARGIN_CELSIUS: f64 = 0.05;
 
+/// A curve by its name (`2min#4`) in serialised reports.
+fn curve_name<S: serde::Serializer>(key: &CurveKey, serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.serialize_str(&key.name())
+}
+
 /// The worst crossing of one set point and axis.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Crossing {
     /// Chamber set point, °C.
     pub set_point_celsius: f64,
     /// Axis (0 = X).
     pub axis: usize,
     /// The curve that switched on warmer and yet rose more.
+    #[serde(serialize_with = "curve_name")]
     pub warmer: CurveKey,
     /// The curve it rose above.
+    #[serde(serialize_with = "curve_name")]
     pub colder: CurveKey,
     /// How much warmer the first switched on, °C.
     pub switched_on_warmer_by_celsius: f64,
