@@ -131,12 +131,6 @@ fn is(set_point: f64, value: f64) -> bool {
     (set_point - value).abs() < 1e-6
 }
 
-/// (max − min, RMS) of the 1-s mean of each axis (the evaluation's own metric).
-fn metric(rates: &[Vec<f32>; 3], window: usize) -> [(f64, f64); 3] {
-    let (drift, rms) = evaluate::metric(rates, window);
-    std::array::from_fn(|a| (drift[a], rms[a]))
-}
-
 fn mean(values: &[f64]) -> f64 {
     values.iter().sum::<f64>() / values.len().max(1) as f64
 }
@@ -410,29 +404,7 @@ pub fn run(
                 && is(VALIDATION, s.labels.nominal_set_point_celsius())
         })
         .collect();
-    let offset: [f64; 3] = std::array::from_fn(|a| {
-        mean(
-            &twin_field
-                .iter()
-                .map(|s| {
-                    s.rate_dps[a].iter().map(|&v| f64::from(v)).sum::<f64>() / s.len().max(1) as f64
-                })
-                .collect::<Vec<_>>(),
-        )
-    });
-    let mut floor: [Vec<(f64, f64)>; 3] = Default::default();
-    for s in &twin_field {
-        let centred: [Vec<f32>; 3] = std::array::from_fn(|a| {
-            s.rate_dps[a]
-                .iter()
-                .map(|&v| (f64::from(v) - offset[a]) as f32)
-                .collect()
-        });
-        let m = metric(&centred, settings.lowpass_window_samples);
-        for a in 0..3 {
-            floor[a].push(m[a]);
-        }
-    }
+    let floor = evaluate::noise_floor(&twin_field, settings.lowpass_window_samples);
     // Per axis: the terms the guard admitted there, and those proposed but left out.
     let terms = |axis: &str, admitted: bool| -> Vec<String> {
         closed
@@ -469,7 +441,7 @@ pub fn run(
                 before: avg(&before[a]),
                 after: avg(&after[a]),
                 by_history: avg(&by_history[a]),
-                floor: avg(&floor[a]),
+                floor: floor[a],
                 field_activations: measured.len(),
                 training_activations: closed.roles.training.len(),
             }

@@ -70,13 +70,19 @@ fn simulate_fit_and_report_from_the_command_line() {
     let md = std::fs::read_to_string(diagnosis.join("diagnosis.md")).unwrap();
     assert!(md.contains("absorbed by the model"), "{md}");
     // No field sessions: nothing to choose stage 3 on, and the report says so.
-    assert!(md.contains("stage 3 keeps the paper's lookup by rise"), "{md}");
+    assert!(
+        md.contains("stage 3 keeps the paper's lookup by rise"),
+        "{md}"
+    );
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(diagnosis.join("diagnosis.json")).unwrap()).unwrap();
     let unit = &json[0];
     assert!(unit["crossings"].is_array(), "{unit}");
     assert_eq!(unit["stage3"].as_array().map(Vec::len), Some(3), "{unit}");
-    assert!(unit["axes"][0]["ranking"][0]["whole_p_value"].is_number(), "{unit}");
+    assert!(
+        unit["axes"][0]["ranking"][0]["whole_p_value"].is_number(),
+        "{unit}"
+    );
     // Closing the loop on a campaign without field sessions: the section says what it could do.
     let extended = dir.path().join("extended");
     run(&[

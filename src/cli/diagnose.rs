@@ -33,6 +33,11 @@ pub struct Args {
     /// after on the activations held out (other set points and sessions).
     #[arg(long)]
     pub extend: bool,
+    /// Campaign folder of units with zero systematic drift recorded like this one
+    /// (`gyrodrift simulate --zero-drift`): the noise floor, per set point, beside the error before
+    /// and after.
+    #[arg(long)]
+    pub noise_floor: Option<PathBuf>,
 }
 
 /// Where the tables' own history lookup fails, as Markdown: no per-sample candidate can carry it
@@ -258,12 +263,22 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             units.insert(unit, (closed, fitted));
         }
     }
-    steps.finish();
     anyhow::ensure!(
         !units.is_empty(),
         "no activations outside the calibration set points {:?} to diagnose",
         input.calibration
     );
+    let floor = match &args.noise_floor {
+        Some(dir) if args.extend => {
+            steps.update("measuring the noise floor", 0, 1);
+            Some(super::extend::noise_floor(
+                dir,
+                options.fit.lowpass_window_samples,
+            )?)
+        }
+        _ => None,
+    };
+    steps.finish();
     let mut md = String::from("# gyrodrift diagnosis\n\n");
     let mut json = Vec::new();
     for (unit, (closed, fitted)) in &units {
@@ -352,6 +367,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 closed,
                 fitted,
                 &before_after,
+                floor.as_ref(),
                 &args.out,
             )?);
         }

@@ -6,9 +6,13 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use anyhow::Context as _;
 use drift_core::blob;
 use drift_fit::closing::{BeforeAfter, Closed};
+use drift_fit::evaluate;
+use drift_fit::pipeline;
 use drift_fit::FittedUnit;
+use drift_recording::{read_recording, Segment};
 
 use crate::output::write_atomic;
 
@@ -18,6 +22,7 @@ pub fn run(
     closed: &Closed<'_>,
     fitted: &FittedUnit,
     before_after: &[BeforeAfter],
+    floor: Option<&Floor>,
     out: &Path,
 ) -> anyhow::Result<String> {
     let mut md = format!("## Extended model of unit {unit}\n\n");
@@ -44,7 +49,7 @@ pub fn run(
             keyed.join(", ")
         );
     }
-    md.push_str(&before_after_table(before_after));
+    md.push_str(&before_after_table(before_after, floor));
     let mut image = vec![0; blob::encoded_len(&*tables)?];
     blob::encode(&*tables, &mut image)?;
     write_atomic(&out.join(format!("extended-{unit}.bin")), &image)?;
@@ -133,37 +138,99 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
     md
 }
 
+/// The noise floor per held-out group (`+33.0 °C field`, as [`by_set_point_and_kind`] names it)
+/// and axis: (drift, RMS) of the 1-s mean, °/s.
+pub type Floor = BTreeMap<String, [(f64, f64); 3]>;
+
+/// The group an activation's result goes in.
+fn group(set_point_celsius: f64, series_kind: &str) -> String {
+    format!("{set_point_celsius:+.1} °C {series_kind}")
+}
+
+/// Measures the noise floor on the zero-drift campaign in `dir`, recorded like the diagnosed one:
+/// per unit, set point and series kind, its activations uncorrected, less the unit's constant bias
+/// ([`drift_fit::evaluate::noise_floor`], as the closed-loop experiment measures it); the mean
+/// over its units.
+pub fn noise_floor(dir: &Path, window: usize) -> anyhow::Result<Floor> {
+    let mut groups: BTreeMap<(String, String), Vec<Segment>> = BTreeMap::new();
+    for path in pipeline::recording_files(dir)? {
+        let recording = read_recording(&path)
+            .with_context(|| format!("noise floor: reading {}", path.display()))?;
+        for segment in recording.segments {
+            let key = group(
+                segment.labels.nominal_set_point_celsius(),
+                segment.labels.series_kind.as_str(),
+            );
+            groups
+                .entry((key, recording.unit_id.clone()))
+                .or_default()
+                .push(segment);
+        }
+    }
+    let mut sums: BTreeMap<String, ([(f64, f64); 3], usize)> = BTreeMap::new();
+    for ((key, _unit), segments) in &groups {
+        let refs: Vec<&Segment> = segments.iter().collect();
+        let floor = evaluate::noise_floor(&refs, window);
+        let entry = sums.entry(key.clone()).or_default();
+        for (sum, (drift, rms)) in entry.0.iter_mut().zip(floor) {
+            sum.0 += drift;
+            sum.1 += rms;
+        }
+        entry.1 += 1;
+    }
+    anyhow::ensure!(
+        !sums.is_empty(),
+        "noise floor: {} has no activations",
+        dir.display()
+    );
+    Ok(sums
+        .into_iter()
+        .map(|(key, (axes, n))| (key, axes.map(|(d, r)| (d / n as f64, r / n as f64))))
+        .collect())
+}
+
 /// The held-out activations' results by set point and series kind (`+33.0 °C field`), in order.
 pub fn by_set_point_and_kind(results: &[BeforeAfter]) -> BTreeMap<String, Vec<&BeforeAfter>> {
     let mut groups: BTreeMap<String, Vec<&BeforeAfter>> = BTreeMap::new();
     for r in results {
         groups
-            .entry(format!("{:+.1} °C {}", r.set_point_celsius, r.series_kind))
+            .entry(group(r.set_point_celsius, r.series_kind))
             .or_default()
             .push(r);
     }
     groups
 }
 
-/// Means per set point, series kind and axis of the held-out activations' errors.
-fn before_after_table(results: &[BeforeAfter]) -> String {
+/// Means per set point, series kind and axis of the held-out activations' errors, with the noise
+/// floor of their set point when measured.
+fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String {
     let groups = by_set_point_and_kind(results);
-    let mut md = String::from("\nError on the held-out activations (nothing was fitted or chosen on them):\n\n| set point | axis | activations | RMS before | RMS after | drift before | drift after |\n|---|---|---:|---:|---:|---:|---:|\n");
+    let mut md = String::from("\nError on the held-out activations (nothing was fitted or chosen on them):\n\n| set point | axis | activations | RMS before | RMS after | noise floor RMS | drift before | drift after | noise floor drift |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for (key, rows) in &groups {
         let n = rows.len() as f64;
+        let at = floor.and_then(|f| f.get(key));
         for (a, axis) in ["X", "Y", "Z"].iter().enumerate() {
             let mean = |f: &dyn Fn(&BeforeAfter) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+            let floor = |pick: fn(&(f64, f64)) -> f64| {
+                at.map_or_else(|| "–".to_owned(), |f| format!("{:.4}", pick(&f[a])))
+            };
             let _ = writeln!(
                 md,
-                "| {key} | {axis} | {} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                "| {key} | {axis} | {} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {} |",
                 rows.len(),
                 mean(&|r| r.rms_dps[a].0),
                 mean(&|r| r.rms_dps[a].1),
+                floor(|f| f.1),
                 mean(&|r| r.drift_dps[a].0),
                 mean(&|r| r.drift_dps[a].1),
+                floor(|f| f.0),
             );
         }
     }
-    md.push_str("\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). Compare with the noise floor of `gyrodrift report --noise-floor`.\n\n");
+    md.push_str(if floor.is_some() {
+        "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). Noise floor: the zero-drift units of `--noise-floor`, the same set point and series kind, uncorrected, less each unit's constant bias — the physical limit beside each figure; – where the twin has no such activations.\n\n"
+    } else {
+        "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). No noise floor given: record a zero-drift twin (`gyrodrift simulate --zero-drift`) and pass it as `--noise-floor`.\n\n"
+    });
     md
 }

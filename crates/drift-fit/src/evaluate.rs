@@ -91,6 +91,38 @@ pub fn metric(rates: &[Vec<f32>; 3], window: usize) -> ([f64; 3], [f64; 3]) {
     (drift, rms)
 }
 
+/// The noise floor of `activations` (one zero-drift unit's, recorded like the unit they stand
+/// beside): per axis, the mean over them of [`metric`]'s drift and RMS of the uncorrected rate
+/// less the unit's constant bias (its mean over every one of them). What a perfect model would
+/// leave: white noise and bias instability through the 1-s window.
+pub fn noise_floor(activations: &[&Segment], window: usize) -> [(f64, f64); 3] {
+    let n = activations.len().max(1) as f64;
+    let offset: [f64; 3] = std::array::from_fn(|a| {
+        activations
+            .iter()
+            .map(|s| {
+                s.rate_dps[a].iter().map(|&v| f64::from(v)).sum::<f64>() / s.len().max(1) as f64
+            })
+            .sum::<f64>()
+            / n
+    });
+    let mut sums = [(0.0, 0.0); 3];
+    for s in activations {
+        let centred: [Vec<f32>; 3] = std::array::from_fn(|a| {
+            s.rate_dps[a]
+                .iter()
+                .map(|&v| (f64::from(v) - offset[a]) as f32)
+                .collect()
+        });
+        let (drift, rms) = metric(&centred, window);
+        for a in 0..3 {
+            sums[a].0 += drift[a];
+            sums[a].1 += rms[a];
+        }
+    }
+    sums.map(|(drift, rms)| (drift / n, rms / n))
+}
+
 /// The switch-on reading firmware passes to `power_on`: the mean raw temperature over the first
 /// `switch_on_window_ms`.
 pub fn switch_on_raw(segment: &Segment, settings: &FitSettings) -> [f32; 3] {
@@ -330,6 +362,27 @@ mod tests {
             rate_dps: [vec![0.0; 3], vec![0.0; 3], vec![0.0; 3]],
             temperature_raw: [0, 1, 2].map(|_| temperatures.clone()),
             aux: BTreeMap::new(),
+        }
+    }
+
+    #[test]
+    fn the_noise_floor_takes_out_the_units_constant_bias_only() {
+        // Two activations of a zero-drift unit: a constant 0.5 °/s bias on every axis, and on X
+        // one activation 0.01 °/s above the other (what differs between activations stays).
+        let mut first = activation(0, 3600.0, 30.0, 30.0);
+        let mut second = activation(400, 3600.0, 30.0, 30.0);
+        for axis in 0..3 {
+            first.rate_dps[axis] = vec![0.5; 3];
+            second.rate_dps[axis] = vec![0.5; 3];
+        }
+        second.rate_dps[0] = vec![0.51; 3];
+        let floor = noise_floor(&[&first, &second], 1);
+        // X: each activation is 0.005 °/s off the unit's mean, flat within itself.
+        assert!((floor[0].1 - 0.005).abs() < 1e-6, "{floor:?}");
+        assert!(floor[0].0.abs() < 1e-9, "{floor:?}");
+        // Y and Z: nothing but the bias, so nothing is left.
+        for (drift, rms) in &floor[1..] {
+            assert!(drift.abs() < 1e-9 && rms.abs() < 1e-6, "{floor:?}");
         }
     }
 
