@@ -36,7 +36,7 @@ pub struct Args {
     /// Campaign folder of units with zero systematic drift recorded like this one
     /// (`gyrodrift simulate --zero-drift`): the noise floor, per set point, beside the error before
     /// and after.
-    #[arg(long)]
+    #[arg(long, requires = "extend")]
     pub noise_floor: Option<PathBuf>,
 }
 
@@ -269,14 +269,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         input.calibration
     );
     let floor = match &args.noise_floor {
-        Some(dir) if args.extend => {
+        Some(dir) => {
             steps.update("measuring the noise floor", 0, 1);
             Some(super::extend::noise_floor(
                 dir,
                 options.fit.lowpass_window_samples,
             )?)
         }
-        _ => None,
+        None => None,
     };
     steps.finish();
     let mut md = String::from("# gyrodrift diagnosis\n\n");

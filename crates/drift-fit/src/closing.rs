@@ -1,6 +1,7 @@
-//! Closing the loop for one unit, in the data's one direction: activations by role → the
-//! diagnosis of the paper model's residual → proposed terms → the guarded extended model → the
-//! error before and after on the held-out activations. The command line (`gyrodrift diagnose
+//! Closing the loop for one unit, in the data's one direction: activations by role → stage 3's
+//! lookup chosen per axis (by rise, the paper's, or by heating history) → the diagnosis of that
+//! model's residual → proposed terms → the guarded extended model → the error before and after on
+//! the held-out activations. The command line (`gyrodrift diagnose
 //! [--extend]`), the Python module and the closed-loop experiment all run this.
 
 use drift_core::Previous;

@@ -20,7 +20,10 @@
 //! taken out) at the same level: a firmware term changes both, and a candidate left over from
 //! what the tables almost wholly absorb (rise², the rises) can match the tables' own lookup error
 //! in shape while a term in it makes the whole error no smaller (measured in
-//! `docs/closed-loop.md`, *the null case*).
+//! `docs/closed-loop.md`, *Session 8*).
+//!
+//! The model whose residual is diagnosed is the loop's: the paper's tables with stage 3 keyed by
+//! rise or by heating history per axis, as [`crate::closing`] chose ([`Keying`]).
 
 use std::collections::BTreeMap;
 
@@ -62,8 +65,9 @@ fn on_grid<T: Copy + Into<f64>>(values: &[T], window: usize, step: usize) -> Vec
         .collect()
 }
 
-/// Puts activations of one unit on the diagnosis grid, with the paper's model fitted on its
-/// calibration activations and, for every candidate, what those tables absorb of it.
+/// Puts activations of one unit on the diagnosis grid, with the loop's model (the paper's tables
+/// fitted on its calibration activations, stage 3 keyed as chosen) and, for every candidate, what
+/// those tables absorb of it.
 pub struct Diagnoser {
     settings: FitSettings,
     /// How stage 3 reads each axis of the model diagnosed, and what firmware kept before each
