@@ -2,7 +2,7 @@
 //! before each of its activations: the model the diagnosis looks behind.
 //!
 //! The loop diagnoses the residual of the model it would ship. Where stage 3 keyed by heating
-//! history ([`FittedUnit::by_history`]) leaves less drift on the training activations, that is the
+//! history ([`crate::FittedUnit::by_history`]) leaves less drift on the training activations, that is the
 //! model, and a residual the paper's lookup by rise leaves but the history-keyed one does not is
 //! no longer the diagnosis's to explain.
 
