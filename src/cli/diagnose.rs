@@ -313,7 +313,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         for crossing in &fitted.crossings {
             println!("  tables: {}", crossing.note());
         }
-        for c in &stage3 {
+        if stage3.iter().all(|c| c.training_activations == 0) {
+            println!("  stage 3: no field-like activations at the calibration set points to choose on; keyed by rise");
+        }
+        for c in stage3.iter().filter(|c| c.training_activations > 0) {
             println!(
                 "  stage 3 on {}: drift on {} training activations {:.4} keyed by rise, {:.4} by history (p {:.1e}) → {}",
                 c.axis,
