@@ -335,8 +335,8 @@ pub fn run(
             if a.admitted { "admitted" } else { "left out" }
         );
     }
-    let stage3 = closed.stage3.clone();
-    for choice in &stage3 {
+    let stage3 = &closed.stage3;
+    for choice in stage3 {
         eprintln!(
             "  stage 3 on {}{}: {} training activations, drift keyed by rise {:.4}, by history {:.4} °/s (p {:.1e}) → {}",
             choice.axis,

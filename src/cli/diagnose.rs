@@ -306,8 +306,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             } else {
                 closed.before_after(fitted, &options.fit)
             };
-        let stage3 = closed.stage3.clone();
-        md.push_str(&crossings_markdown(fitted, &stage3, &before_after));
+        let stage3 = &closed.stage3;
+        md.push_str(&crossings_markdown(fitted, stage3, &before_after));
         md.push_str(&markdown(axes, args.top));
         println!("{unit}:");
         for crossing in &fitted.crossings {

@@ -167,7 +167,11 @@ pub fn close<'a>(
     let kept = kept_before(&life, settings, &fitted.by_history.settings, clock);
     let kept_training = &kept[roles.calibration.len()..][..roles.training.len()];
     let stage3 = choose_stage3(fitted, &roles.training, kept_training, settings);
-    let keying = Keying::new(stage3.clone().map(|c| c.keyed_by_history), &life, &kept);
+    let keying = Keying::new(
+        std::array::from_fn(|a| stage3[a].keyed_by_history),
+        &life,
+        &kept,
+    );
     let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings, keying.clone())?;
     let series: Vec<ActivationSeries> = roles
         .diagnosed()

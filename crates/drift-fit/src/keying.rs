@@ -25,11 +25,6 @@ pub struct Keying {
 }
 
 impl Keying {
-    /// Stage 3 by rise on every axis (the paper's lookup); nothing kept is needed.
-    pub fn by_rise() -> Self {
-        Self::default()
-    }
-
     /// `by_history` per axis, with `kept[i]` what firmware kept before `segments[i]`.
     pub fn new(by_history: [bool; 3], segments: &[&Segment], kept: &[[Previous; 3]]) -> Self {
         Self {
