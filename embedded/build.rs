@@ -44,6 +44,7 @@ fn main() {
             "third_order" => "ModelName::ThirdOrder",
             "extended" => "ModelName::Extended",
             "by_history" => "ModelName::ByHistory",
+            "warm_started" => "ModelName::WarmStarted",
             other => panic!("unknown model {other}"),
         };
         writeln!(

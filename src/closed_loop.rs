@@ -156,6 +156,9 @@ pub struct Row {
     /// Whether stage 3 keyed by history was chosen on the training activations
     /// (`drift_fit::closing::Stage3Choice`).
     pub history_chosen: bool,
+    /// Whether the warm starts' initial bias was chosen on the training activations
+    /// (`drift_fit::warm_start::WarmStartChoice`).
+    pub warm_start_chosen: bool,
     /// The paper's model.
     pub before: (f64, f64),
     /// The loop's model: stage 3 keyed as chosen, with the admitted terms (the paper's model when
@@ -178,6 +181,9 @@ impl Row {
         let mut admitted = self.admitted.clone();
         if self.history_chosen {
             admitted.push("stage 3 keyed by history".to_owned());
+        }
+        if self.warm_start_chosen {
+            admitted.push("warm starts' initial bias".to_owned());
         }
         let (admitted, left_out) = (admitted.join(", "), self.left_out.join(", "));
         match (admitted.is_empty(), left_out.is_empty()) {
@@ -348,6 +354,17 @@ pub fn run(
             if choice.keyed_by_history { "keyed by history" } else { "kept by rise" }
         );
     }
+    for choice in &closed.warm_start {
+        eprintln!(
+            "  initial bias on {}: {} training activations, RMS with the paper's {:.4}, with warm starts {:.4} °/s (p {:.1e}) → {}",
+            choice.axis,
+            choice.training_activations,
+            choice.training_rms_cold_dps,
+            choice.training_rms_warm_dps,
+            choice.p_value,
+            if choice.chosen { "warm starts" } else { "the paper's" }
+        );
+    }
     let held_out = closed.before_after(&base, settings);
     // The +33 °C protocol activations, on stderr only: the paper's own validation, where the
     // histories are the calibration's. An error that shows there too is the tables' interpolation
@@ -438,6 +455,7 @@ pub fn run(
                 admitted: terms(axes[a].axis, true),
                 left_out: terms(axes[a].axis, false),
                 history_chosen: stage3[a].keyed_by_history,
+                warm_start_chosen: closed.warm_start[a].chosen,
                 before: avg(&before[a]),
                 after: avg(&after[a]),
                 by_history: avg(&by_history[a]),

@@ -23,6 +23,8 @@ pub enum ModelName {
     Extended,
     /// The paper's tables with stage 3 keyed by heating history (residual heat at switch-on).
     ByHistory,
+    /// The paper's tables with warm starts' initial bias.
+    WarmStarted,
 }
 
 /// One test-vector case (see `testdata/vectors.json`).

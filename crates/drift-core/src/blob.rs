@@ -33,10 +33,12 @@ pub const MAGIC: [u8; 4] = *b"GYDT";
 /// The image format version this build writes. Version 2 added the extended model's extra terms
 /// to [`ModifiedTables`]; version 3 gave the auxiliary-input term a low-pass time constant
 /// ([`Term::Aux`]); version 4 lets stage 3 be keyed by heating history
-/// ([`AmbientCurves::residual_heat_celsius`]). This build still reads version-1 images (they load
-/// with no extra terms), version-2 images (their auxiliary terms load unfiltered, time constant 0,
-/// as they were meant) and version-3 images (stage 3 keyed by rise, as the paper's).
-pub const FORMAT_VERSION: u16 = 4;
+/// ([`AmbientCurves::residual_heat_celsius`]); version 5 gives warm starts their own initial bias
+/// ([`AmbientCurves::warm_starts`]). This build still reads version-1 images (they load with no
+/// extra terms), version-2 images (their auxiliary terms load unfiltered, time constant 0, as they
+/// were meant), version-3 images (stage 3 keyed by rise, as the paper's) and version-4 images (the
+/// paper's initial bias, a function of the switch-on temperature alone).
+pub const FORMAT_VERSION: u16 = 5;
 /// The oldest image format version this build reads.
 pub const OLDEST_READABLE_VERSION: u16 = 1;
 /// Bytes before the payload.
@@ -97,6 +99,7 @@ impl<const R: usize, const A: usize, const C: usize> From<AxisTableV3<R, A, C>>
                 initial_bias_dps: ambient.initial_bias_dps,
                 curves: ambient.curves,
                 residual_heat_celsius: heapless::Vec::new(),
+                warm_starts: heapless::Vec::new(),
             });
         }
         Self {
@@ -104,6 +107,52 @@ impl<const R: usize, const A: usize, const C: usize> From<AxisTableV3<R, A, C>>
             ambients,
         }
     }
+}
+
+/// A version-4 ambient: no warm starts.
+#[derive(serde::Deserialize)]
+struct AmbientCurvesV4<const R: usize, const C: usize> {
+    ambient_celsius: f32,
+    initial_bias_dps: f32,
+    curves: heapless::Vec<Curve<R>, C>,
+    residual_heat_celsius: heapless::Vec<f32, C>,
+}
+
+/// A version-4 axis table.
+#[derive(serde::Deserialize)]
+struct AxisTableV4<const R: usize, const A: usize, const C: usize> {
+    reference_ms: heapless::Vec<u32, R>,
+    ambients: heapless::Vec<AmbientCurvesV4<R, C>, A>,
+}
+
+impl<const R: usize, const A: usize, const C: usize> From<AxisTableV4<R, A, C>>
+    for AxisTable<R, A, C>
+{
+    fn from(v4: AxisTableV4<R, A, C>) -> Self {
+        let mut ambients = heapless::Vec::new();
+        for ambient in v4.ambients {
+            // The same capacity on both sides: never full.
+            let _ = ambients.push(AmbientCurves {
+                ambient_celsius: ambient.ambient_celsius,
+                initial_bias_dps: ambient.initial_bias_dps,
+                curves: ambient.curves,
+                residual_heat_celsius: ambient.residual_heat_celsius,
+                warm_starts: heapless::Vec::new(),
+            });
+        }
+        Self {
+            reference_ms: v4.reference_ms,
+            ambients,
+        }
+    }
+}
+
+/// A version-4 modified-model payload.
+#[derive(serde::Deserialize)]
+struct ModifiedTablesV4<const R: usize, const A: usize, const C: usize> {
+    settings: Settings,
+    axes: [AxisTableV4<R, A, C>; AXES],
+    extension: Extension,
 }
 
 /// A version-1 modified-model payload: the tables before the extended model existed.
@@ -178,6 +227,7 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
             1 => from_v1(payload),
             2 => from_v2(payload),
             3 => from_v3(payload),
+            4 => from_v4(payload),
             _ => from_current(payload),
         }
     }
@@ -205,6 +255,19 @@ fn from_v3<const R: usize, const A: usize, const C: usize>(
         settings: v3.settings,
         axes: v3.axes.map(AxisTable::from),
         extension: v3.extension,
+    };
+    Ok((tables, rest))
+}
+
+#[inline(never)]
+fn from_v4<const R: usize, const A: usize, const C: usize>(
+    payload: &[u8],
+) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
+    let (v4, rest) = postcard::take_from_bytes::<ModifiedTablesV4<R, A, C>>(payload)?;
+    let tables = ModifiedTables {
+        settings: v4.settings,
+        axes: v4.axes.map(AxisTable::from),
+        extension: v4.extension,
     };
     Ok((tables, rest))
 }

@@ -30,6 +30,7 @@ mod polynomial;
 mod settings;
 mod stage;
 mod table;
+mod warm_start;
 
 pub use corrector::{
     AxisState, Corrector, CorrectorState, Output, Sample, MAX_PLAUSIBLE_DRIFT_DPS,
@@ -48,6 +49,7 @@ pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};
 pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedAxisState, ModifiedTables};
+pub use warm_start::WarmStart;
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.
 pub const AXES: usize = 3;

@@ -11,6 +11,7 @@ use crate::settings::Settings;
 use crate::stage::ambient::AmbientPosition;
 use crate::stage::heating::{by_history, cached_k, search, BlendedCurves, Knots};
 use crate::stage::since_power_on::{Moment, Segment, SegmentKind};
+use crate::warm_start::{self, WarmStart};
 use crate::AXES;
 
 /// One point of a heating-dynamics curve: where the curve stood at one reference time.
@@ -57,6 +58,17 @@ pub struct AmbientCurves<const R: usize, const C: usize> {
     /// ambient across power-off ([`crate::CorrectorState::power_on_after`]).
     #[cfg_attr(feature = "serde", serde(default))]
     pub residual_heat_celsius: Vec<f32, C>,
+    /// The initial bias of warm starts (optional), in increasing residual heat: a start at this
+    /// ambient with that much residual heat begins at `initial_bias_dps` plus the offset, found by
+    /// the ambient and residual heat firmware estimates
+    /// ([`crate::CorrectorState::power_on_after`]). Empty: the paper's initial bias, a function of
+    /// the switch-on temperature alone. Independent of how stage 3 is keyed; the same for every
+    /// ambient of an axis: all empty or none.
+    ///
+    /// Why: after a short off-time the sensing element is not at the sensor's temperature and is
+    /// still cooling when the unit switches on, so its bias starts elsewhere (docs/closed-loop.md).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub warm_starts: Vec<WarmStart, C>,
 }
 
 /// The correlation table of one axis.
@@ -120,6 +132,34 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             .is_some_and(|a| !a.residual_heat_celsius.is_empty())
     }
 
+    /// Whether the initial bias depends on the residual heat at switch-on
+    /// ([`AmbientCurves::warm_starts`]).
+    pub fn warm_started(&self) -> bool {
+        self.ambients.iter().any(|a| !a.warm_starts.is_empty())
+    }
+
+    /// The initial bias at stage 2's `position` after a start with `residual_heat_celsius` (0: a
+    /// cold start, the paper's): the ambients' cold-start bias plus their warm starts' offset.
+    fn initial_bias(&self, position: &AmbientPosition, residual_heat_celsius: f32) -> f32 {
+        let at = |i: u8| {
+            self.ambients.get(usize::from(i)).map_or(f32::NAN, |a| {
+                a.initial_bias_dps + warm_start::offset_dps(&a.warm_starts, residual_heat_celsius)
+            })
+        };
+        position.blend(at(position.lo), at(position.hi))
+    }
+
+    /// The warmest start stored at stage 2's `position` (blended), °C.
+    fn warmest_start(&self, position: &AmbientPosition) -> f32 {
+        let at = |i: u8| {
+            self.ambients
+                .get(usize::from(i))
+                .and_then(|a| a.warm_starts.last())
+                .map_or(0.0, |w| w.residual_heat_celsius)
+        };
+        position.blend(at(position.lo), at(position.hi))
+    }
+
     /// Checks this axis's table; `at` names the axis in errors.
     pub fn validate(&self, at: Location) -> Result<(), Error> {
         let references = self.reference_ms.len();
@@ -157,6 +197,10 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             let at = at.ambient(a);
             if !ambient.initial_bias_dps.is_finite() {
                 return Err(Error::new("initial_bias_dps", at, Problem::NonFinite));
+            }
+            warm_start::validate(&ambient.warm_starts, at)?;
+            if ambient.warm_starts.is_empty() && self.warm_started() {
+                return Err(Error::new("warm_starts", at, Problem::Empty));
             }
             if ambient.curves.is_empty() {
                 return Err(Error::new("curves", at, Problem::Empty));
@@ -335,7 +379,8 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         };
         // The paper indexes ambient by the switch-on temperature, residual heat included, as its
         // calibration saw it; a table keyed by history was built against the ambient itself.
-        let (ambient, history) = if by_history {
+        let heat = switch_on.residual_heat_celsius;
+        let (ambient, history, heat) = if by_history {
             let ambient = locate(switch_on.ambient_celsius);
             let rise_margin = settings.rise_margin_celsius;
             let history =
@@ -352,45 +397,56 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
                         out_of_range: true,
                         ..cold
                     },
+                    0.0,
                 )
             } else {
-                (ambient, history)
+                (ambient, history, heat)
             }
         } else {
             (
                 locate(switch_on.switch_on_celsius),
                 AmbientPosition::default(),
+                heat,
             )
         };
         *state = ModifiedAxisState::new(&ambient);
-        // The initial bias is the bias at the switch-on temperature, whatever the history (the
-        // paper's tables located the ambient there already: one search per switch-on, not two).
-        let at_switch_on = if by_history {
-            locate(switch_on.switch_on_celsius)
-        } else {
-            ambient
-        };
-        let bias_at = |i: u8| {
-            self.ambients
-                .get(usize::from(i))
-                .map_or(f32::NAN, |a| a.initial_bias_dps)
-        };
-        let initial_bias = at_switch_on.blend(bias_at(at_switch_on.lo), bias_at(at_switch_on.hi));
         let mut flags = if ambient.out_of_range {
             Flags::AMBIENT_OUT_OF_RANGE
         } else {
             Flags::NONE
         };
+        let warm_started = self.warm_started();
+        if (by_history || warm_started) && !switch_on.known {
+            flags |= Flags::HISTORY_UNKNOWN;
+        }
         if by_history {
             state.set_history(history.lo, history.weight);
-            if !switch_on.known {
-                flags |= Flags::HISTORY_UNKNOWN;
-            }
             if history.out_of_range {
                 flags |= Flags::HISTORY_OUT_OF_SPAN;
             }
         }
-        (initial_bias, flags)
+        // A warm start's initial bias is the calibration's at its ambient and residual heat, as the
+        // calibration's series measured it. More residual heat than the warmest of them left: the
+        // ambient rose during the off-time (as for stage 3): the paper's cold start, flagged.
+        if warm_started && heat > 0.0 {
+            let at_ambient = if by_history {
+                ambient
+            } else {
+                locate(switch_on.ambient_celsius)
+            };
+            if heat <= self.warmest_start(&at_ambient) + settings.rise_margin_celsius {
+                return (self.initial_bias(&at_ambient, heat), flags);
+            }
+            flags |= Flags::HISTORY_OUT_OF_SPAN;
+        }
+        // The paper's: the cold start's bias at the switch-on temperature (a table keyed by rise
+        // located the ambient there already: one search per switch-on, not two).
+        let at_switch_on = if by_history {
+            locate(switch_on.switch_on_celsius)
+        } else {
+            ambient
+        };
+        (self.initial_bias(&at_switch_on, 0.0), flags)
     }
 
     #[inline(always)]

@@ -315,6 +315,63 @@ fn version_3_images_still_load_keyed_by_rise() {
     assert_eq!(back, by_history);
 }
 
+/// The history-keyed fixture as the version-4 build wrote it (`testdata/image-v4-by_history.bin`,
+/// the `by_history` image of `testdata/vectors.json` before version 5), committed as it was: it
+/// still loads, keyed by history, with the paper's initial bias (no warm starts); the fixture with
+/// warm starts round-trips through the current version.
+#[test]
+fn version_4_images_still_load_without_warm_starts() {
+    let v4 = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../testdata/image-v4-by_history.bin"
+    ))
+    .unwrap();
+    assert_eq!(u16::from_le_bytes([v4[4], v4[5]]), 4);
+    let tables: FixtureTables = decode(&v4).unwrap();
+    assert!(tables
+        .axes
+        .iter()
+        .all(|axis| axis.keyed_by_history() && !axis.warm_started()));
+    let mut without = fixture::by_history();
+    for ambient in without.axes.iter_mut().flat_map(|axis| &mut axis.ambients) {
+        ambient.warm_starts.clear();
+    }
+    assert_eq!(tables, without);
+    let warm_started = fixture::warm_started();
+    let mut buffer = vec![0; 64 * 1024];
+    let len = encode(&warm_started, &mut buffer).unwrap();
+    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
+    let back: FixtureTables = decode(&buffer[..len]).unwrap();
+    assert!(back.axes.iter().all(|axis| axis.warm_started()));
+    assert_eq!(back, warm_started);
+}
+
+/// Warm starts that are not in increasing residual heat, or start at none, are refused, named.
+#[test]
+fn bad_warm_starts_are_named() {
+    let mut tables = fixture::warm_started();
+    tables.axes[1].ambients[2].warm_starts.swap(1, 2);
+    let error = tables.validate().unwrap_err();
+    assert_eq!(
+        (error.field, error.at.axis, error.at.ambient, error.at.index, error.problem),
+        ("warm_starts", Some(1), Some(2), Some(2), Problem::NotIncreasing)
+    );
+    let mut tables = fixture::warm_started();
+    tables.axes[0].ambients[0].warm_starts[0].residual_heat_celsius = 0.0;
+    assert_eq!(tables.validate().unwrap_err().problem, Problem::NotPositive);
+    let mut tables = fixture::warm_started();
+    tables.axes[2].ambients[1].warm_starts[3].bias_offset_dps = f32::NAN;
+    let error = tables.validate().unwrap_err();
+    assert_eq!(
+        (error.field, error.at.index, error.problem),
+        ("warm_starts", Some(3), Problem::NonFinite)
+    );
+    assert_eq!(
+        error.to_string(),
+        "axes[2].ambients[1].warm_starts[3]: value is NaN or infinite"
+    );
+}
+
 /// A history-keyed table whose residual heats do not fit its curves is refused, named.
 #[test]
 fn bad_residual_heats_are_named() {

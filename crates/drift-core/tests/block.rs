@@ -115,6 +115,7 @@ fn the_shared_vectors_give_the_same_bits_in_blocks() {
     let modified: ModifiedTables = decode(&image("modified")).unwrap();
     let extended: ModifiedTables = decode(&image("extended")).unwrap();
     let by_history: ModifiedTables = decode(&image("by_history")).unwrap();
+    let warm_started: ModifiedTables = decode(&image("warm_started")).unwrap();
     let standard: PolynomialTables = decode(&image("standard")).unwrap();
     let third_order: PolynomialTables = decode(&image("third_order")).unwrap();
     for case in &file.cases {
@@ -150,6 +151,7 @@ fn the_shared_vectors_give_the_same_bits_in_blocks() {
             "modified" => run!(&modified),
             "extended" => run!(&extended),
             "by_history" => run!(&by_history),
+            "warm_started" => run!(&warm_started),
             "standard" => run!(&standard),
             "third_order" => run!(&third_order),
             other => panic!("unknown model {other}"),

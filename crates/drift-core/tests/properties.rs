@@ -53,6 +53,7 @@ fn table() -> impl Strategy<Value = Table> {
                         initial_bias_dps: bias,
                         curves: heapless::Vec::new(),
                         residual_heat_celsius: heapless::Vec::new(),
+                        warm_starts: heapless::Vec::new(),
                     };
                     // Ordered by rise at every reference time: curve c sits at least RISE_GAP above c − 1.
                     let mut rise: Vec<f32> = (0..refs).map(|j| j as f32 * 0.5).collect();
@@ -284,5 +285,64 @@ proptest! {
         let (state, _) = start(wild);
         let got = table.correlation(&settings(), &mut state.clone(), ms, rises.0).0;
         prop_assert!(got.is_finite());
+    }
+
+    /// Warm starts: at a calibration ambient, a stored warm start's residual heat gives that
+    /// ambient's cold initial bias plus the warm start's offset; between two stored warm starts the offset lies
+    /// between theirs; a cold start has none; any residual heat, finite or not, gives a finite
+    /// initial bias and no panic — whether stage 3 is keyed by rise or by history.
+    #[test]
+    fn warm_starts_offset_the_initial_bias_by_residual_heat(
+        table in table(),
+        a in 0usize..3,
+        offsets in prop::collection::vec(-0.02f32..0.02, 1..5),
+        w in 0usize..5,
+        between_u in 0.0f32..1.0,
+        by_history in any::<bool>(),
+        wild in prop_oneof![Just(f32::NAN), Just(f32::INFINITY), Just(f32::NEG_INFINITY), -5.0f32..50.0],
+    ) {
+        let mut table = table;
+        for ambient in &mut table.ambients {
+            ambient.warm_starts = offsets
+                .iter()
+                .enumerate()
+                .map(|(i, &offset)| drift_core::WarmStart {
+                    residual_heat_celsius: 0.5 * (i + 1) as f32,
+                    bias_offset_dps: offset,
+                })
+                .collect();
+            if by_history {
+                let count = ambient.curves.len();
+                ambient.residual_heat_celsius = (0..count).map(|c| 0.4 * c as f32).collect();
+            }
+        }
+        prop_assert!(table.validate(drift_core::Location::axis(0)).is_ok());
+        let a = a % table.ambients.len();
+        let ambient = &table.ambients[a];
+        let bias = |heat: f32| {
+            let mut state = ModifiedAxisState::default();
+            let switch_on = SwitchOn {
+                switch_on_celsius: ambient.ambient_celsius + heat,
+                ambient_celsius: ambient.ambient_celsius,
+                residual_heat_celsius: heat,
+                known: true,
+            };
+            table.power_on_after(&settings(), &switch_on, &mut state).0
+        };
+        let cold = ambient.initial_bias_dps;
+        prop_assert_eq!(bias(0.0), cold);
+        let w = w % offsets.len();
+        let stored = ambient.warm_starts[w];
+        // Keyed by history, a residual heat beyond every stored history is read as a cold start.
+        let within_histories = !by_history || stored.residual_heat_celsius <= 0.4 * (ambient.curves.len() - 1) as f32;
+        if within_histories {
+            prop_assert_eq!(bias(stored.residual_heat_celsius), cold + stored.bias_offset_dps);
+            if w + 1 < offsets.len() && (!by_history || stored.residual_heat_celsius + 0.5 <= 0.4 * (ambient.curves.len() - 1) as f32) {
+                let got = bias(stored.residual_heat_celsius + 0.5 * between_u) - cold;
+                let (lo, hi) = (stored.bias_offset_dps, offsets[w + 1]);
+                prop_assert!(got >= lo.min(hi) - 1e-6 && got <= lo.max(hi) + 1e-6, "{got} not in {lo}..{hi}");
+            }
+        }
+        prop_assert!(bias(wild).is_finite());
     }
 }

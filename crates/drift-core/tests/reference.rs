@@ -171,8 +171,16 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -
             let temps: Vec<f64> = ambients.iter().map(|a| f(&a["ambient_celsius"])).collect();
             let labels = |a: usize| list(&ambients[a]["residual_heat_celsius"]);
             let keyed_by_history = !labels(0).is_empty();
+            let warm_starts = |a: usize| -> Vec<(f64, f64)> {
+                ambients[a]["warm_starts"].as_array().map_or(Vec::new(), |w| {
+                    w.iter()
+                        .map(|p| (f(&p["residual_heat_celsius"]), f(&p["bias_offset_dps"])))
+                        .collect()
+                })
+            };
+            let warm_started = (0..ambients.len()).any(|a| !warm_starts(a).is_empty());
             let (mut at, mut heat) = (celsius, 0.0);
-            if keyed_by_history {
+            if keyed_by_history || warm_started {
                 let (ambient, residual, known) = estimate(celsius, previous);
                 if !known {
                     state.activation |= HISTORY_UNKNOWN;
@@ -200,18 +208,46 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -
                 }
                 state.history = Some((lo, hi, w));
             }
-            let (lo, hi, w, outside) = locate(&temps, at, s.ambient_margin);
+            // A table keyed by history was built against the ambient; the paper's stage 2 looks at
+            // the switch-on temperature.
+            let stage2_at = if keyed_by_history { at } else { celsius };
+            let (lo, hi, w, outside) = locate(&temps, stage2_at, s.ambient_margin);
             if outside {
                 state.activation |= AMBIENT_OUT_OF_RANGE;
             }
             state.ambient = (lo, hi, w);
-            // The initial bias at the switch-on temperature, whatever the history.
-            let (lo, hi, w, _) = locate(&temps, celsius, s.ambient_margin);
-            state.initial = lerp(
-                f(&ambients[lo]["initial_bias_dps"]),
-                f(&ambients[hi]["initial_bias_dps"]),
-                w,
-            );
+            // A warm start's initial bias: the ambient's cold start plus an offset that is zero
+            // cold, linear from there through the stored warm starts, held beyond the warmest;
+            // beyond the warmest by more than the rise margin, the paper's cold start, flagged.
+            // Otherwise the paper's: the cold start's at the switch-on temperature.
+            let offset = |a: usize| {
+                let points = warm_starts(a);
+                if heat <= 0.0 || points.is_empty() {
+                    return 0.0;
+                }
+                let mut previous = (0.0, 0.0);
+                for &(h, offset) in &points {
+                    if heat <= h {
+                        return lerp(previous.1, offset, (heat - previous.0) / (h - previous.0));
+                    }
+                    previous = (h, offset);
+                }
+                previous.1
+            };
+            let warmest = |a: usize| warm_starts(a).last().map_or(0.0, |w| w.0);
+            let (mut lo, mut hi, mut w, _) = locate(&temps, at, s.ambient_margin);
+            let mut warm = warm_started && heat > 0.0;
+            if warm && heat > lerp(warmest(lo), warmest(hi), w) + s.rise_margin {
+                state.activation |= HISTORY_OUT_OF_SPAN;
+                warm = false;
+            }
+            if !warm {
+                (lo, hi, w, _) = locate(&temps, celsius, s.ambient_margin);
+            }
+            let total = |a: usize| {
+                f(&ambients[a]["initial_bias_dps"]) + if warm { offset(a) } else { 0.0 }
+            };
+            state.initial = lerp(total(lo), total(hi), w);
         }
         Axis::Polynomial(p) => {
             let (value, outside) = poly(p, celsius, s.ambient_margin);

@@ -119,6 +119,8 @@ fn corrector_reproduces_vectors_bit_for_bit() {
     let extended: ModifiedTables = model(&file, "extended");
     let by_history: ModifiedTables = model(&file, "by_history");
     assert!(by_history.axes.iter().all(|axis| axis.keyed_by_history()));
+    let warm_started: ModifiedTables = model(&file, "warm_started");
+    assert!(warm_started.axes.iter().all(|axis| axis.warm_started() && !axis.keyed_by_history()));
     let mut total = 0;
     let mut samples = 0;
     for case in &file.cases {
@@ -129,6 +131,7 @@ fn corrector_reproduces_vectors_bit_for_bit() {
             "third_order" => check_case(&third_order, case),
             "extended" => check_case(&extended, case),
             "by_history" => check_case(&by_history, case),
+            "warm_started" => check_case(&warm_started, case),
             other => panic!("unknown model {other}"),
         };
     }

@@ -1,6 +1,6 @@
 //! Closing the loop for one unit, in the data's one direction: activations by role → stage 3's
-//! lookup chosen per axis (by rise, the paper's, or by heating history) → the diagnosis of that
-//! model's residual → proposed terms → the guarded extended model → the error before and after on
+//! lookup chosen per axis (by rise, the paper's, or by heating history) → the initial bias chosen
+//! per axis (the paper's, or with the warm starts') → the diagnosis of that model's residual → proposed terms → the guarded extended model → the error before and after on
 //! the held-out activations. The command line (`gyrodrift diagnose
 //! [--extend]`), the Python module and the closed-loop experiment all run this.
 
@@ -17,6 +17,7 @@ use crate::fit::FittedUnit;
 use crate::keying::Keying;
 use crate::roles::Roles;
 use crate::settings::FitSettings;
+use crate::warm_start::{self, WarmStartChoice};
 
 /// One unit's loop, closed as far as its data allow.
 pub struct Closed<'a> {
@@ -24,7 +25,10 @@ pub struct Closed<'a> {
     pub roles: Roles<'a>,
     /// Stage 3's lookup per axis of the loop's model, chosen on the training activations.
     pub stage3: [Stage3Choice; 3],
-    /// The same choice with what firmware kept before each of the unit's activations.
+    /// Whether the initial bias of warm starts is taken per axis, chosen on the training
+    /// activations after stage 3.
+    pub warm_start: [WarmStartChoice; 3],
+    /// Both choices with what firmware kept before each of the unit's activations.
     pub keying: Keying,
     /// The diagnosed activations on the diagnosis grid.
     pub series: Vec<ActivationSeries>,
@@ -172,6 +176,8 @@ pub fn close<'a>(
         &life,
         &kept,
     );
+    let warm_start = warm_start::choose(fitted, &keying, &roles.training, settings);
+    let keying = keying.with_warm_start(std::array::from_fn(|a| warm_start[a].chosen));
     let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings, keying.clone())?;
     let series: Vec<ActivationSeries> = roles
         .diagnosed()
@@ -195,6 +201,7 @@ pub fn close<'a>(
     Ok(Closed {
         roles,
         stage3,
+        warm_start,
         keying,
         series,
         axes,

@@ -72,6 +72,8 @@ pub struct AveragedCurve {
     pub rise_celsius: [Vec<f64>; 3],
     /// Mean sensor temperature at switch-on, per axis, °C: how warm the history left the unit.
     pub switch_on_celsius: [f64; 3],
+    /// Mean initial bias, per axis, °/s: where this history's bias starts.
+    pub initial_bias_dps: [f64; 3],
 }
 
 impl AveragedCurve {
@@ -140,6 +142,7 @@ fn average(key: CurveKey, members: &[&Analysed]) -> AveragedCurve {
         drift_dps: [0, 1, 2].map(|axis| mean(members, len, |m| &m.drift_dps[axis])),
         rise_celsius: [0, 1, 2].map(|axis| mean(members, len, |m| &m.rise_celsius[axis])),
         switch_on_celsius: mean_of(members, |a| a.switch_on_celsius),
+        initial_bias_dps: mean_of(members, |a| a.initial_bias_dps),
     }
 }
 

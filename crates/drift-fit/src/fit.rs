@@ -4,6 +4,7 @@ use std::collections::BTreeSet;
 
 use drift_core::{
     AmbientCurves, AxisTable, Curve, CurvePoint, Model, ModifiedTables, PolynomialTables, Settings,
+    WarmStart,
 };
 
 use crate::analyse::Analysed;
@@ -31,7 +32,8 @@ pub struct FittedUnit {
     /// The paper's ("modified") tables.
     pub modified: ModifiedTables,
     /// The same curves with stage 3 keyed by heating history (each curve labelled by the residual
-    /// heat it switched on with) instead of by rise: for firmware that keeps what it knew of the
+    /// heat it switched on with) instead of by rise, and the initial bias of warm starts
+    /// (`drift_core::AmbientCurves::warm_starts`): for firmware that keeps what it knew of the
     /// previous activation across power-off (`drift_core::CorrectorState::power_on_after`).
     pub by_history: ModifiedTables,
     /// The paper's standard calibration (Lagrange through the set points).
@@ -163,6 +165,7 @@ fn axis_table(
             initial_bias_dps: sp.initial_bias_dps[axis] as f32,
             curves: heapless::Vec::new(),
             residual_heat_celsius: heapless::Vec::new(),
+            warm_starts: heapless::Vec::new(),
         };
         if ambient.ambient_celsius <= last_ambient {
             return Err(format!(
@@ -238,7 +241,28 @@ fn axis_table(
         }
         let _ = table.ambients.push(ambient);
     }
+    if stage3 == Stage3::ByHistory {
+        add_warm_starts(&mut table, set_points, &order, axis);
+    }
     Ok((table, notes))
+}
+
+/// Gives a table keyed by history the initial bias of its warm starts: each history that switched
+/// on with residual heat, at the residual heat stage 3 labels it with, offset by how far its mean
+/// initial bias stood from the cold starts' at the same set point.
+fn add_warm_starts(table: &mut Table, set_points: &[SetPointCurves], order: &[usize], axis: usize) {
+    for (ambient, sp) in table.ambients.iter_mut().zip(set_points) {
+        ambient.warm_starts = order
+            .iter()
+            .zip(&ambient.residual_heat_celsius)
+            .filter(|(_, &heat)| heat > 0.0)
+            .map(|(&c, &heat)| WarmStart {
+                residual_heat_celsius: heat,
+                bias_offset_dps: (sp.curves[c].initial_bias_dps[axis] - sp.initial_bias_dps[axis])
+                    as f32,
+            })
+            .collect();
+    }
 }
 
 /// Fits one unit from its analysed activations (calibration set points only: the caller keeps the

@@ -149,6 +149,7 @@ mod tests {
             drift_dps: [vec![0.0; 120], vec![0.0; 120], vec![0.0; 120]],
             rise_celsius: [r.clone(), r.clone(), r],
             switch_on_celsius: [on; 3],
+            initial_bias_dps: [0.0; 3],
         }
     }
 

@@ -240,6 +240,7 @@ mod tests {
                     drift_dps: [drift.clone(), drift.clone(), drift],
                     rise_celsius: [rise.clone(), rise.clone(), rise],
                     switch_on_celsius: [30.0; 3],
+                    initial_bias_dps: [0.0; 3],
                 })
                 .collect(),
         }

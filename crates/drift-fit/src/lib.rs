@@ -30,6 +30,7 @@ pub mod roles;
 pub mod settings;
 pub mod summary;
 pub mod windows;
+pub mod warm_start;
 
 pub use error::FitError;
 pub use fit::{fit_unit, FittedUnit};

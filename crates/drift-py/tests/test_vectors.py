@@ -30,6 +30,7 @@ def test_vectors_cover_every_model_and_enough_samples(cases: list[Case], models:
             "third_order",
             "extended",
             "by_history",
+            "warm_started",
         }
     )
     assert sum(len(c.times) for c in cases) > 1000

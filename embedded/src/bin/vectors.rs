@@ -15,6 +15,7 @@ use drift_core::{
 };
 use gyrodrift_embedded::{
     stack, Case, FirmwareTables, ModelName, BY_HISTORY, CASES, EXTENDED, MODIFIED, STANDARD,
+    WARM_STARTED,
     THIRD_ORDER,
 };
 use panic_semihosting as _;
@@ -119,6 +120,9 @@ fn main() -> ! {
         Err(_) => fail("by_history image did not decode"),
     };
     let decode_history_stack = painted.used();
+    let Ok(warm_started) = decode::<FirmwareTables>(WARM_STARTED) else {
+        fail("warm_started image")
+    };
 
     let mut samples = 0;
     let mut mismatches = 0;
@@ -130,6 +134,7 @@ fn main() -> ! {
             ModelName::ThirdOrder => run(&third_order, case),
             ModelName::Extended => run(&extended, case),
             ModelName::ByHistory => run(&by_history, case),
+            ModelName::WarmStarted => run(&warm_started, case),
         };
     }
 

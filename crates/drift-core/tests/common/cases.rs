@@ -317,6 +317,28 @@ fn scenarios() -> Vec<Scenario> {
             previous: Some([[30.0, 34.0], [f32::NAN, 34.0], [30.0, 34.0]]),
         },
         Scenario {
+            name: "warm-start-initial-bias",
+            description: "the paper's tables (keyed by rise) with warm starts' initial bias, power_on_after: switched on at 33 °C after a short off-time, 2.0 °C of residual heat on X (on a stored warm start), 0.2 °C on Y (between a cold start and the first), 5.0 °C on Z (more than the warmest stored start left: the ambient rose, the paper's cold start at the switch-on temperature, flagged HISTORY_OUT_OF_SPAN); the warm starts' initial bias is read at the kept ambient, stage 2 at the switch-on temperature as the paper's",
+            model: "warm_started",
+            switch_on_celsius: Some([33.0, 33.2, 33.0]),
+            final_rise: [3.0, 2.5, 3.5],
+            times: every(2000, 120_000),
+            tamper: untouched,
+            aux: None,
+            previous: Some([[31.0, 36.0], [33.0, 35.5], [28.0, 35.0]]),
+        },
+        Scenario {
+            name: "warm-start-unknown",
+            description: "tables with warm starts powered on with plain power_on (nothing kept): the cold start's initial bias, flagged HISTORY_UNKNOWN",
+            model: "warm_started",
+            switch_on_celsius: Some([31.0, 31.0, 31.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(5000, 60_000),
+            tamper: untouched,
+            aux: None,
+            previous: None,
+        },
+        Scenario {
             name: "modified-ignores-history",
             description: "the paper's tables (keyed by rise) powered on with power_on_after: what was kept is ignored, the outputs are power_on's",
             model: "modified",
@@ -430,6 +452,7 @@ pub fn build() -> VectorFile {
     let third_order = fixture::third_order();
     let extended = fixture::extended();
     let by_history = fixture::by_history();
+    let warm_started = fixture::warm_started();
     let cases = scenarios()
         .iter()
         .enumerate()
@@ -438,6 +461,7 @@ pub fn build() -> VectorFile {
             "standard" => run(&standard, scenario, i as u64 + 1),
             "extended" => run(&extended, scenario, i as u64 + 1),
             "by_history" => run(&by_history, scenario, i as u64 + 1),
+            "warm_started" => run(&warm_started, scenario, i as u64 + 1),
             _ => run(&third_order, scenario, i as u64 + 1),
         })
         .collect();
@@ -458,6 +482,7 @@ pub fn build() -> VectorFile {
             named("third_order", "polynomial", &third_order),
             named("extended", "modified", &extended),
             named("by_history", "modified", &by_history),
+            named("warm_started", "modified", &warm_started),
         ],
         cases,
     }
