@@ -135,10 +135,11 @@ fn main() -> anyhow::Result<()> {
             )
         };
         println!(
-            "{effect}: diagnosis significant on {}; a term admitted on {}; stage 3 keyed by history chosen on {}; scale {}, calibration at {:?} °C, {} field activations measured and {} trained on per run",
+            "{effect}: diagnosis significant on {}; a term admitted on {}; stage 3 keyed by history chosen on {}; warm starts' initial bias chosen on {}; scale {}, calibration at {:?} °C, {} field activations measured and {} trained on per run",
             share(&|r| r.significant),
             share(&|r| !r.admitted.is_empty()),
             share(&|r| r.history_chosen),
+            share(&|r| r.warm_start_chosen),
             plan.scale,
             plan.calibration,
             of.first().map_or(0, |r| r.field_activations),

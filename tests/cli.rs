@@ -79,6 +79,15 @@ fn simulate_fit_and_report_from_the_command_line() {
     let unit = &json[0];
     assert!(unit["crossings"].is_array(), "{unit}");
     assert_eq!(unit["stage3"].as_array().map(Vec::len), Some(3), "{unit}");
+    // Nor the initial bias: the paper's on every axis.
+    let warm_start = unit["warm_start"].as_array().unwrap();
+    assert_eq!(warm_start.len(), 3, "{unit}");
+    assert!(
+        warm_start
+            .iter()
+            .all(|c| c["training_activations"] == 0 && c["chosen"] == false),
+        "{unit}"
+    );
     assert!(
         unit["axes"][0]["ranking"][0]["whole_p_value"].is_number(),
         "{unit}"

@@ -49,6 +49,19 @@ pub fn run(
             keyed.join(", ")
         );
     }
+    let warm: Vec<&str> = closed
+        .warm_start
+        .iter()
+        .filter(|c| c.chosen)
+        .map(|c| c.axis)
+        .collect();
+    if !warm.is_empty() {
+        let _ = writeln!(
+            md,
+            "The initial bias of warm starts is taken from the calibration's series on {} (chosen on the training activations, above): firmware running this image starts with `power_on_after` and calls `keep` before power-off.\n",
+            warm.join(", ")
+        );
+    }
     md.push_str(&before_after_table(before_after, floor));
     let mut image = vec![0; blob::encoded_len(&*tables)?];
     blob::encode(&*tables, &mut image)?;

@@ -63,13 +63,29 @@ pub trait Image: Model + Serialize + DeserializeOwned {
     /// The kind byte written in the header.
     const KIND: Kind;
 
-    /// Decodes a payload written by format `version` (already checked to be readable); returns
-    /// the model and the bytes left over. Models whose payload changed between versions override
-    /// this to read the older form.
-    fn from_payload(version: u16, payload: &[u8]) -> postcard::Result<(Self, &[u8])> {
+    /// Decodes a payload written by format `version` (already checked to be readable) that holds
+    /// exactly one model, and validates it. Models whose payload changed between versions
+    /// override this to read the older form.
+    fn from_payload(version: u16, payload: &[u8]) -> Result<Self, BlobError> {
         let _ = version;
-        postcard::take_from_bytes(payload)
+        whole(postcard::take_from_bytes(payload))
     }
+}
+
+/// The model of a decoded payload, which must have held nothing else, validated. Inlined into
+/// each decoder: the model is then built and validated in one frame and written once into the
+/// caller's result, not copied through a frame per step (firmware decodes ~12-KB tables on a stack
+/// it must budget, docs/embedded.md).
+#[inline(always)]
+fn whole<M: Model>(decoded: postcard::Result<(M, &[u8])>) -> Result<M, BlobError> {
+    let (model, rest) = decoded.map_err(BlobError::Malformed)?;
+    if !rest.is_empty() {
+        return Err(BlobError::Malformed(
+            postcard::Error::DeserializeBadEncoding,
+        ));
+    }
+    model.validate().map_err(BlobError::Invalid)?;
+    Ok(model)
 }
 
 /// A version-1 to -3 ambient: stage 3 keyed by rise only.
@@ -220,7 +236,7 @@ impl From<ExtraTermV2> for ExtraTerm {
 impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R, A, C> {
     const KIND: Kind = Kind::Modified;
 
-    fn from_payload(version: u16, payload: &[u8]) -> postcard::Result<(Self, &[u8])> {
+    fn from_payload(version: u16, payload: &[u8]) -> Result<Self, BlobError> {
         // One function per version, never inlined: each needs stack for its own copy of the
         // tables, and in one frame they would add up.
         match version {
@@ -236,47 +252,51 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
 #[inline(never)]
 fn from_v1<const R: usize, const A: usize, const C: usize>(
     payload: &[u8],
-) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
-    let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)?;
+) -> Result<ModifiedTables<R, A, C>, BlobError> {
+    let (v1, rest) = postcard::take_from_bytes::<ModifiedTablesV1<R, A, C>>(payload)
+        .map_err(BlobError::Malformed)?;
     let tables = ModifiedTables {
         settings: v1.settings,
         axes: v1.axes.map(AxisTable::from),
         extension: Extension::NONE,
     };
-    Ok((tables, rest))
+    whole(Ok((tables, rest)))
 }
 
 #[inline(never)]
 fn from_v3<const R: usize, const A: usize, const C: usize>(
     payload: &[u8],
-) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
-    let (v3, rest) = postcard::take_from_bytes::<ModifiedTablesV3<R, A, C>>(payload)?;
+) -> Result<ModifiedTables<R, A, C>, BlobError> {
+    let (v3, rest) = postcard::take_from_bytes::<ModifiedTablesV3<R, A, C>>(payload)
+        .map_err(BlobError::Malformed)?;
     let tables = ModifiedTables {
         settings: v3.settings,
         axes: v3.axes.map(AxisTable::from),
         extension: v3.extension,
     };
-    Ok((tables, rest))
+    whole(Ok((tables, rest)))
 }
 
 #[inline(never)]
 fn from_v4<const R: usize, const A: usize, const C: usize>(
     payload: &[u8],
-) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
-    let (v4, rest) = postcard::take_from_bytes::<ModifiedTablesV4<R, A, C>>(payload)?;
+) -> Result<ModifiedTables<R, A, C>, BlobError> {
+    let (v4, rest) = postcard::take_from_bytes::<ModifiedTablesV4<R, A, C>>(payload)
+        .map_err(BlobError::Malformed)?;
     let tables = ModifiedTables {
         settings: v4.settings,
         axes: v4.axes.map(AxisTable::from),
         extension: v4.extension,
     };
-    Ok((tables, rest))
+    whole(Ok((tables, rest)))
 }
 
 #[inline(never)]
 fn from_v2<const R: usize, const A: usize, const C: usize>(
     payload: &[u8],
-) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
-    let (v2, rest) = postcard::take_from_bytes::<ModifiedTablesV2<R, A, C>>(payload)?;
+) -> Result<ModifiedTables<R, A, C>, BlobError> {
+    let (v2, rest) = postcard::take_from_bytes::<ModifiedTablesV2<R, A, C>>(payload)
+        .map_err(BlobError::Malformed)?;
     let mut extension = Extension::NONE;
     for term in v2.terms {
         // The same capacity on both sides: never full.
@@ -287,14 +307,14 @@ fn from_v2<const R: usize, const A: usize, const C: usize>(
         axes: v2.axes.map(AxisTable::from),
         extension,
     };
-    Ok((tables, rest))
+    whole(Ok((tables, rest)))
 }
 
 #[inline(never)]
 fn from_current<const R: usize, const A: usize, const C: usize>(
     payload: &[u8],
-) -> postcard::Result<(ModifiedTables<R, A, C>, &[u8])> {
-    postcard::take_from_bytes(payload)
+) -> Result<ModifiedTables<R, A, C>, BlobError> {
+    whole(postcard::take_from_bytes(payload))
 }
 
 impl Image for PolynomialTables {
@@ -504,12 +524,5 @@ pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
         return Err(BlobError::CrcMismatch { stored, computed });
     }
     let payload = body.get(HEADER_LEN..).unwrap_or_default();
-    let (model, rest) = M::from_payload(version, payload).map_err(BlobError::Malformed)?;
-    if !rest.is_empty() {
-        return Err(BlobError::Malformed(
-            postcard::Error::DeserializeBadEncoding,
-        ));
-    }
-    model.validate().map_err(BlobError::Invalid)?;
-    Ok(model)
+    M::from_payload(version, payload)
 }

@@ -30,7 +30,8 @@ pub struct WarmStart {
 /// the rise margin beyond).
 #[inline]
 pub(crate) fn offset_dps(warm_starts: &[WarmStart], residual_heat_celsius: f32) -> f32 {
-    if !(residual_heat_celsius > 0.0) {
+    // NaN included: no usable residual heat is a cold start.
+    if residual_heat_celsius.is_nan() || residual_heat_celsius <= 0.0 {
         return 0.0;
     }
     let heat = |w: &WarmStart| w.residual_heat_celsius;
@@ -60,11 +61,15 @@ pub(crate) fn offset_dps(warm_starts: &[WarmStart], residual_heat_celsius: f32) 
 pub(crate) fn validate(warm_starts: &[WarmStart], at: Location) -> Result<(), Error> {
     let field = "warm_starts";
     if let Some(first) = warm_starts.first() {
-        if !(first.residual_heat_celsius > 0.0) && first.residual_heat_celsius.is_finite() {
+        if first.residual_heat_celsius <= 0.0 {
             return Err(Error::new(field, at.index(0), Problem::NotPositive));
         }
     }
-    check_increasing(field, at, warm_starts.iter().map(|w| w.residual_heat_celsius))?;
+    check_increasing(
+        field,
+        at,
+        warm_starts.iter().map(|w| w.residual_heat_celsius),
+    )?;
     check_finite(field, at, warm_starts.iter().map(|w| w.bias_offset_dps))
 }
 

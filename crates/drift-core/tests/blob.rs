@@ -353,8 +353,20 @@ fn bad_warm_starts_are_named() {
     tables.axes[1].ambients[2].warm_starts.swap(1, 2);
     let error = tables.validate().unwrap_err();
     assert_eq!(
-        (error.field, error.at.axis, error.at.ambient, error.at.index, error.problem),
-        ("warm_starts", Some(1), Some(2), Some(2), Problem::NotIncreasing)
+        (
+            error.field,
+            error.at.axis,
+            error.at.ambient,
+            error.at.index,
+            error.problem
+        ),
+        (
+            "warm_starts",
+            Some(1),
+            Some(2),
+            Some(2),
+            Problem::NotIncreasing
+        )
     );
     let mut tables = fixture::warm_started();
     tables.axes[0].ambients[0].warm_starts[0].residual_heat_celsius = 0.0;

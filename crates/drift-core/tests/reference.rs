@@ -172,11 +172,13 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -
             let labels = |a: usize| list(&ambients[a]["residual_heat_celsius"]);
             let keyed_by_history = !labels(0).is_empty();
             let warm_starts = |a: usize| -> Vec<(f64, f64)> {
-                ambients[a]["warm_starts"].as_array().map_or(Vec::new(), |w| {
-                    w.iter()
-                        .map(|p| (f(&p["residual_heat_celsius"]), f(&p["bias_offset_dps"])))
-                        .collect()
-                })
+                ambients[a]["warm_starts"]
+                    .as_array()
+                    .map_or(Vec::new(), |w| {
+                        w.iter()
+                            .map(|p| (f(&p["residual_heat_celsius"]), f(&p["bias_offset_dps"])))
+                            .collect()
+                    })
             };
             let warm_started = (0..ambients.len()).any(|a| !warm_starts(a).is_empty());
             let (mut at, mut heat) = (celsius, 0.0);
@@ -244,9 +246,8 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -
             if !warm {
                 (lo, hi, w, _) = locate(&temps, celsius, s.ambient_margin);
             }
-            let total = |a: usize| {
-                f(&ambients[a]["initial_bias_dps"]) + if warm { offset(a) } else { 0.0 }
-            };
+            let total =
+                |a: usize| f(&ambients[a]["initial_bias_dps"]) + if warm { offset(a) } else { 0.0 };
             state.initial = lerp(total(lo), total(hi), w);
         }
         Axis::Polynomial(p) => {

@@ -120,7 +120,10 @@ fn corrector_reproduces_vectors_bit_for_bit() {
     let by_history: ModifiedTables = model(&file, "by_history");
     assert!(by_history.axes.iter().all(|axis| axis.keyed_by_history()));
     let warm_started: ModifiedTables = model(&file, "warm_started");
-    assert!(warm_started.axes.iter().all(|axis| axis.warm_started() && !axis.keyed_by_history()));
+    assert!(warm_started
+        .axes
+        .iter()
+        .all(|axis| axis.warm_started() && !axis.keyed_by_history()));
     let mut total = 0;
     let mut samples = 0;
     for case in &file.cases {

@@ -6,6 +6,7 @@ use drift_core::{
     AmbientCurves, AxisTable, Curve, CurvePoint, Model, ModifiedTables, PolynomialTables, Settings,
     WarmStart,
 };
+use nalgebra::{Matrix2, Vector2};
 
 use crate::analyse::Analysed;
 use crate::baselines;
@@ -242,27 +243,75 @@ fn axis_table(
         let _ = table.ambients.push(ambient);
     }
     if stage3 == Stage3::ByHistory {
-        add_warm_starts(&mut table, set_points, &order, axis);
+        add_warm_starts(&mut table, set_points, axis);
     }
     Ok((table, notes))
 }
 
-/// Gives a table keyed by history the initial bias of its warm starts: each history that switched
-/// on with residual heat, at the residual heat stage 3 labels it with, offset by how far its mean
-/// initial bias stood from the cold starts' at the same set point.
-fn add_warm_starts(table: &mut Table, set_points: &[SetPointCurves], order: &[usize], axis: usize) {
+/// Warm starts stored per ambient: the smoothed offset at this many residual heats, evenly spaced
+/// up to the warmest calibration start.
+const WARM_START_POINTS: usize = 4;
+
+/// Gives a table keyed by history the initial bias of its warm starts, per set point: how far each
+/// history that switched on with residual heat started from the cold starts' initial bias,
+/// smoothed over the histories ([`smooth_warm_starts`]).
+fn add_warm_starts(table: &mut Table, set_points: &[SetPointCurves], axis: usize) {
     for (ambient, sp) in table.ambients.iter_mut().zip(set_points) {
-        ambient.warm_starts = order
+        let starts: Vec<(f64, f64, f64)> = sp
+            .curves
             .iter()
-            .zip(&ambient.residual_heat_celsius)
-            .filter(|(_, &heat)| heat > 0.0)
-            .map(|(&c, &heat)| WarmStart {
-                residual_heat_celsius: heat,
-                bias_offset_dps: (sp.curves[c].initial_bias_dps[axis] - sp.initial_bias_dps[axis])
-                    as f32,
+            .enumerate()
+            .map(|(c, curve)| {
+                (
+                    residual_heat(sp, c, axis),
+                    curve.initial_bias_dps[axis] - sp.initial_bias_dps[axis],
+                    curve.members as f64,
+                )
             })
+            .filter(|(heat, offset, _)| *heat > 0.0 && offset.is_finite())
             .collect();
+        ambient.warm_starts = smooth_warm_starts(&starts);
     }
+}
+
+/// The warm starts of one ambient from its histories' `(residual heat, offset, activations)`: the
+/// weighted least-squares `offset = a·h + b·h²` (`a·h` alone with fewer than three histories),
+/// sampled at [`WARM_START_POINTS`] residual heats up to the warmest.
+///
+/// Why smoothed: each history's initial bias is the mean of a few activations, each with its own
+/// turn-on jitter, and histories of nearly equal residual heat (a long interval's later
+/// activations) would make a table that zig-zags through that noise. The offset itself is smooth
+/// in the residual heat: the sensor's temperature above the ambient (through the cold starts'
+/// slope) and the element's lag behind it, both of which fade together as the unit cools. Through
+/// the origin: a cold start is the cold starts' own initial bias.
+fn smooth_warm_starts(starts: &[(f64, f64, f64)]) -> heapless::Vec<WarmStart, MAX_CURVES> {
+    let warmest = starts.iter().map(|s| s.0).fold(0.0, f64::max);
+    let sum = |f: &dyn Fn(f64, f64) -> f64| starts.iter().map(|&(h, o, w)| w * f(h, o)).sum();
+    let (hh, hh2, h2h2) = (
+        sum(&|h, _| h * h),
+        sum(&|h, _| h * h * h),
+        sum(&|h, _| h * h * h * h),
+    );
+    let (ho, h2o) = (sum(&|h, o| h * o), sum(&|h, o| h * h * o));
+    let quadratic = (starts.len() >= 3)
+        .then(|| Matrix2::new(hh, hh2, hh2, h2h2).try_inverse())
+        .flatten()
+        .map(|inverse| inverse * Vector2::new(ho, h2o));
+    let (a, b) = match quadratic {
+        Some(ab) => (ab[0], ab[1]),
+        None if hh > 0.0 => (ho / hh, 0.0),
+        None => return heapless::Vec::new(),
+    };
+    (1..=WARM_START_POINTS)
+        .map(|i| {
+            let h = warmest * i as f64 / WARM_START_POINTS as f64;
+            WarmStart {
+                residual_heat_celsius: h as f32,
+                bias_offset_dps: (a * h + b * h * h) as f32,
+            }
+        })
+        .filter(|w| w.residual_heat_celsius > 0.0)
+        .collect()
 }
 
 /// Fits one unit from its analysed activations (calibration set points only: the caller keeps the

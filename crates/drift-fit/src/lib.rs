@@ -29,8 +29,8 @@ pub mod pipeline;
 pub mod roles;
 pub mod settings;
 pub mod summary;
-pub mod windows;
 pub mod warm_start;
+pub mod windows;
 
 pub use error::FitError;
 pub use fit::{fit_unit, FittedUnit};

@@ -67,11 +67,15 @@ pub fn choose(
         .collect();
     let n = squares.len();
     std::array::from_fn(|a| {
-        let root_mean = |pick: fn(&([f64; 3], [f64; 3])) -> &[f64; 3]| {
+        let root_mean = |warm: bool| {
             if n == 0 {
                 f64::NAN
             } else {
-                (squares.iter().map(|s| pick(s)[a]).sum::<f64>() / n as f64).sqrt()
+                let sum: f64 = squares
+                    .iter()
+                    .map(|(cold, hot)| if warm { hot[a] } else { cold[a] })
+                    .sum();
+                (sum / n as f64).sqrt()
             }
         };
         let gains: Vec<f64> = squares.iter().map(|(c, w)| c[a] - w[a]).collect();
@@ -83,8 +87,8 @@ pub fn choose(
         WarmStartChoice {
             axis: ["X", "Y", "Z"][a],
             training_activations: n,
-            training_rms_cold_dps: root_mean(|s| &s.0),
-            training_rms_warm_dps: root_mean(|s| &s.1),
+            training_rms_cold_dps: root_mean(false),
+            training_rms_warm_dps: root_mean(true),
             p_value,
             chosen: gain > 0.0 && p_value < CHOOSE_ALPHA,
         }

@@ -44,7 +44,8 @@ fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8], ambients: fn(&M)
     // A version-1 image of the paper's tables is re-encoded as the current version, which adds
     // the (empty) extension: postcard writes its length, one byte. A version-2 image gains each
     // auxiliary term's time constant (0: one byte each). Versions 1 to 3 gain, per ambient, the
-    // (empty) residual-heat labels of version 4: their length, one byte each.
+    // (empty) residual-heat labels of version 4, and versions 1 to 4 the (empty) warm starts of
+    // version 5: their length, one byte each.
     let version = u16::from_le_bytes([bytes[4], bytes[5]]);
     let aux_terms = model
         .extension()
@@ -53,9 +54,10 @@ fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8], ambients: fn(&M)
         .filter(|t| matches!(t.term, drift_core::Term::Aux { .. }))
         .count();
     let upgrade = match (version, M::KIND) {
-        (1, Kind::Modified) => 1 + ambients(&model),
-        (2, Kind::Modified) => aux_terms + ambients(&model),
-        (3, Kind::Modified) => ambients(&model),
+        (1, Kind::Modified) => 1 + 2 * ambients(&model),
+        (2, Kind::Modified) => aux_terms + 2 * ambients(&model),
+        (3, Kind::Modified) => 2 * ambients(&model),
+        (4, Kind::Modified) => ambients(&model),
         _ => 0,
     };
     assert!(

@@ -117,7 +117,7 @@ struct Run<'m, M: Model> {
     previous: [Previous; AXES],
     /// The flags of the current activation, as `power_on`/`power_on_after` returned them.
     activation: [Flags; AXES],
-    /// Whether the model keys stage 3 by heating history.
+    /// Whether the model reads the heating history (stage 3 or the initial bias).
     by_history: bool,
 }
 
@@ -339,6 +339,11 @@ pub fn run(data: &[u8]) {
         return;
     };
     let m = models();
+    // Tables that read the heating history (stage 3 or the initial bias) flag what they know of
+    // it; the others never do.
+    if which % 8 == 7 {
+        return drive(&m.warm_started, ops, true);
+    }
     if which % 4 == 3 {
         return drive(&m.by_history, ops, true);
     }

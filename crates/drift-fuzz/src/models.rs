@@ -8,8 +8,9 @@ use drift_core::{ModifiedTables, PolynomialTables};
 
 const VECTORS: &str = include_str!("../../../testdata/vectors.json");
 
-/// The shared vectors' models: the paper's tables, the two polynomial baselines and the paper's
-/// tables with stage 3 keyed by heating history.
+/// The shared vectors' models: the paper's tables, the two polynomial baselines, the paper's
+/// tables with stage 3 keyed by heating history, and the paper's tables with warm starts' initial
+/// bias.
 pub struct Models {
     /// The modified (paper's) tables.
     pub modified: ModifiedTables,
@@ -19,6 +20,8 @@ pub struct Models {
     pub third_order: PolynomialTables,
     /// The paper's tables with stage 3 keyed by heating history (`power_on_after`, `keep`).
     pub by_history: ModifiedTables,
+    /// The paper's tables with the initial bias of warm starts (`power_on_after`, `keep`).
+    pub warm_started: ModifiedTables,
 }
 
 fn unhex(hex: &str) -> Vec<u8> {
@@ -71,6 +74,7 @@ pub fn models() -> &'static Models {
             standard: decode(&image("standard")).unwrap_or_else(|e| bad("standard", e)),
             third_order: decode(&image("third_order")).unwrap_or_else(|e| bad("third_order", e)),
             by_history: decode(&image("by_history")).unwrap_or_else(|e| bad("by_history", e)),
+            warm_started: decode(&image("warm_started")).unwrap_or_else(|e| bad("warm_started", e)),
         }
     })
 }

@@ -8,6 +8,7 @@ use drift_fit::closing::close;
 use drift_fit::closing::{BeforeAfter, Stage3Choice};
 use drift_fit::diagnose::AxisDiagnosis;
 use drift_fit::extend::Admission;
+use drift_fit::warm_start::WarmStartChoice;
 use drift_fit::{FitSettings, FittedUnit};
 use drift_recording::{read_recording, Segment};
 use pyo3::prelude::*;
@@ -26,6 +27,7 @@ pub struct PyDiagnosis {
     proposed: Vec<String>,
     admissions: Vec<Admission>,
     stage3: [Stage3Choice; 3],
+    warm_start: [WarmStartChoice; 3],
     extended: Option<PyModifiedTables>,
     aux_inputs: Vec<String>,
     before_after: Vec<BeforeAfter>,
@@ -108,8 +110,8 @@ pub fn diagnose_unit(
             )));
         }
         let admitted = closed.extended.as_ref().filter(|e| !e.plan.terms.is_empty());
-        // The loop's model differs from the paper's when a term was admitted or stage 3 is keyed
-        // by history on an axis.
+        // The loop's model differs from the paper's when a term was admitted, or stage 3 or the
+        // initial bias reads the heating history on an axis.
         let changed = admitted.is_some() || closed.keying.any();
         let before_after = if changed {
             closed.before_after(unit, settings)
@@ -131,6 +133,7 @@ pub fn diagnose_unit(
                 .unwrap_or_default(),
             extended: changed.then(|| PyModifiedTables(Arc::from(closed.model(unit)))),
             stage3: closed.stage3.clone(),
+            warm_start: closed.warm_start.clone(),
             aux_inputs: admitted
                 .map(|e| e.plan.aux_inputs.clone())
                 .unwrap_or_default(),
@@ -204,8 +207,17 @@ impl PyDiagnosis {
         to_python(py, &self.stage3)
     }
 
-    /// The loop's model (stage 3 keyed as chosen, the refitted tables with the admitted terms),
-    /// or None when it is the paper's unchanged. History-keyed axes need `power_on_after`.
+    /// Per axis, whether the loop took the initial bias of warm starts from the calibration's
+    /// series, chosen on the training activations after stage 3 (records: axis,
+    /// training_activations, training_rms_cold_dps, training_rms_warm_dps, p_value, chosen).
+    #[getter]
+    fn warm_start<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.warm_start)
+    }
+
+    /// The loop's model (stage 3 keyed and the initial bias taken as chosen, the refitted tables
+    /// with the admitted terms), or None when it is the paper's unchanged. Axes that read the
+    /// heating history need `power_on_after`.
     #[getter]
     fn extended(&self) -> Option<PyModifiedTables> {
         self.extended.clone()

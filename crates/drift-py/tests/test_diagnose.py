@@ -3,6 +3,7 @@ with a supply-voltage sensitivity the fitter is never told about."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -97,6 +98,25 @@ def test_stage_3_is_chosen_per_axis_on_the_training_activations(
             assert c["training_drift_by_history_dps"] < c["training_drift_by_rise_dps"], c
             assert c["p_value"] < 0.05, c
             assert diagnosis.extended is not None
+
+
+def test_the_initial_bias_is_chosen_per_axis_after_stage_3(
+    diagnosis: gyrodrift.Diagnosis,
+) -> None:
+    warm_start = diagnosis.warm_start
+    assert [c["axis"] for c in warm_start] == ["X", "Y", "Z"]
+    counts = dict(diagnosis.activations)
+    for c in warm_start:
+        assert c["training_activations"] == counts["training"]
+        assert c["training_rms_cold_dps"] > 0.0 and c["training_rms_warm_dps"] > 0.0, c
+        # The warm starts' initial bias only where it leaves less error, significantly.
+        if c["chosen"]:
+            assert c["training_rms_warm_dps"] < c["training_rms_cold_dps"], c
+            assert c["p_value"] < 0.05, c
+            assert diagnosis.extended is not None
+            axis = "XYZ".index(c["axis"])
+            tables = json.loads(diagnosis.extended.to_json())
+            assert tables["axes"][axis]["ambients"][0]["warm_starts"], c
 
 
 def test_a_unit_without_activations_is_an_input_error(campaign: Path) -> None:

@@ -797,6 +797,11 @@ class Diagnosis:
         axis, curves_cross, training_activations, training_drift_by_rise_dps,
         training_drift_by_history_dps, p_value, keyed_by_history)."""
     @property
+    def warm_start(self) -> list[dict[str, Any]]:
+        """Per axis, whether the loop took the initial bias of warm starts from the calibration's
+        series, chosen on the training activations after stage 3 (records: axis,
+        training_activations, training_rms_cold_dps, training_rms_warm_dps, p_value, chosen)."""
+    @property
     def extended(self) -> ModifiedTables | None:
         """The loop's model (stage 3 keyed as chosen, the refitted tables with the admitted terms),
         or None when it is the paper's unchanged. History-keyed axes need `power_on_after`."""
