@@ -7,16 +7,37 @@ use clap::Parser;
 /// thread stack (8 MiB on Linux, 1 MiB on Windows).
 const STACK_BYTES: usize = 64 << 20;
 
+/// Whether a panic is `println!` finding stdout closed (`gyrodrift … | head`): std's message for
+/// EPIPE. Not a bug to report, and the default hook's backtrace advice would say it is one.
+fn broken_pipe(message: Option<&str>) -> bool {
+    message.is_some_and(|m| m.contains("Broken pipe"))
+}
+
 fn main() -> std::process::ExitCode {
     let cli = gyrodrift::cli::Cli::parse();
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !broken_pipe(info.payload_as_str()) {
+            report(info);
+        }
+    }));
     let worker = std::thread::Builder::new()
         .name("gyrodrift".into())
         .stack_size(STACK_BYTES)
         .spawn(move || gyrodrift::cli::run(cli));
     let outcome = match worker {
-        Ok(handle) => handle
-            .join()
-            .unwrap_or_else(|_| Err(anyhow::anyhow!("internal error: the command panicked"))),
+        Ok(handle) => handle.join().unwrap_or_else(|panic| {
+            let message = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied());
+            Err(if broken_pipe(message) {
+                // Files are written whole or not at all; what was not yet written is not.
+                anyhow::anyhow!("standard output was closed (broken pipe); the command stopped")
+            } else {
+                anyhow::anyhow!("internal error: the command panicked")
+            })
+        }),
         Err(error) => Err(anyhow::anyhow!(
             "cannot start the command's thread: {error}"
         )),

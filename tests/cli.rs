@@ -1,6 +1,6 @@
 //! End-to-end runs of the `gyrodrift` binary.
 
-use std::process::Command;
+use std::process::{Command, Stdio};
 
 use drift_core::blob::decode;
 use drift_core::{ModifiedTables, PolynomialTables};
@@ -43,6 +43,22 @@ fn simulate_fit_and_report_from_the_command_line() {
     let tables = dir.path().join("tables");
     let text = run(&["fit", c, "-q", "-o", tables.to_str().unwrap()]);
     assert!(text.contains("GIU-01: 5 curves"), "{text}");
+    // Standard output closed before the command prints (`gyrodrift … | head`): one line that says
+    // so, not a panic report.
+    let mut child = gyrodrift()
+        .args(["fit", c, "-q", "-o", dir.path().join("again").to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("broken pipe") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
     let modified = std::fs::read(tables.join("GIU-01/modified.bin")).unwrap();
     let decoded: ModifiedTables = decode(&modified).unwrap();
     let json: ModifiedTables = serde_json::from_str(

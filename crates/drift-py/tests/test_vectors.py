@@ -55,17 +55,19 @@ def test_history_cases_start_with_what_was_kept(cases: list[Case], models: dict[
     exist (history-keyed and not), `powered_corrector` starts them with `power_on_after`, and they
     exercise both history flags."""
     with_previous = [c for c in cases if c.previous is not None]
-    assert {c.model for c in with_previous} == {"by_history", "modified"}
+    assert {c.model for c in with_previous} == {"by_history", "modified", "warm_started"}
     assert all(c.previous is not None and c.previous.shape == (3, 2) for c in with_previous)
     flags = np.concatenate([c.flags for c in cases if c.model == "by_history"])
     for flag in (gyrodrift.Flags.HISTORY_UNKNOWN, gyrodrift.Flags.HISTORY_OUT_OF_SPAN):
         assert (flags & flag).any(), flag
-    # The same samples started with `power_on` instead differ: the kept values are read.
-    case = next(c for c in with_previous if c.model == "by_history" and c.switch_on_raw is not None)
-    cold = gyrodrift.Corrector(models[case.model])
-    cold.power_on(case.switch_on_raw)
-    corrected, _, _ = cold.correct_batch(case.times, case.rate, case.temperature)
-    assert not same_bits(case.corrected, corrected).all()
+    # The same samples started with `power_on` instead differ: the kept values are read (stage 3
+    # keyed by history; the warm starts' initial bias).
+    for model in ("by_history", "warm_started"):
+        case = next(c for c in with_previous if c.model == model and c.switch_on_raw is not None)
+        cold = gyrodrift.Corrector(models[case.model])
+        cold.power_on(case.switch_on_raw)
+        corrected, _, _ = cold.correct_batch(case.times, case.rate, case.temperature)
+        assert not same_bits(case.corrected, corrected).all(), model
 
 
 def test_power_on_after_returns_what_to_keep(cases: list[Case], models: dict[str, Model]) -> None:
