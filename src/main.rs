@@ -9,7 +9,11 @@ const STACK_BYTES: usize = 64 << 20;
 
 /// Whether a panic is `println!` finding stdout closed (`gyrodrift … | head`): std's message for
 /// EPIPE. Not a bug to report, and the default hook's backtrace advice would say it is one.
-fn broken_pipe(message: Option<&str>) -> bool {
+fn broken_pipe(payload: &(dyn std::any::Any + Send)) -> bool {
+    let message = payload
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| payload.downcast_ref::<&str>().copied());
     message.is_some_and(|m| m.contains("Broken pipe"))
 }
 
@@ -17,7 +21,7 @@ fn main() -> std::process::ExitCode {
     let cli = gyrodrift::cli::Cli::parse();
     let report = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        if !broken_pipe(info.payload_as_str()) {
+        if !broken_pipe(info.payload()) {
             report(info);
         }
     }));
@@ -27,11 +31,7 @@ fn main() -> std::process::ExitCode {
         .spawn(move || gyrodrift::cli::run(cli));
     let outcome = match worker {
         Ok(handle) => handle.join().unwrap_or_else(|panic| {
-            let message = panic
-                .downcast_ref::<String>()
-                .map(String::as_str)
-                .or_else(|| panic.downcast_ref::<&str>().copied());
-            Err(if broken_pipe(message) {
+            Err(if broken_pipe(&*panic) {
                 // Files are written whole or not at all; what was not yet written is not.
                 anyhow::anyhow!("standard output was closed (broken pipe); the command stopped")
             } else {

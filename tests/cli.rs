@@ -46,7 +46,13 @@ fn simulate_fit_and_report_from_the_command_line() {
     // Standard output closed before the command prints (`gyrodrift … | head`): one line that says
     // so, not a panic report.
     let mut child = gyrodrift()
-        .args(["fit", c, "-q", "-o", dir.path().join("again").to_str().unwrap()])
+        .args([
+            "fit",
+            c,
+            "-q",
+            "-o",
+            dir.path().join("again").to_str().unwrap(),
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()

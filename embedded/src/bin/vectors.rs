@@ -15,8 +15,7 @@ use drift_core::{
 };
 use gyrodrift_embedded::{
     stack, Case, FirmwareTables, ModelName, BY_HISTORY, CASES, EXTENDED, MODIFIED, STANDARD,
-    WARM_STARTED,
-    THIRD_ORDER,
+    THIRD_ORDER, WARM_STARTED,
 };
 use panic_semihosting as _;
 
