@@ -85,6 +85,16 @@ fn settings() -> Settings {
     Settings::default()
 }
 
+/// A start at a calibration ambient with `heat` °C of residual heat, the history known.
+fn warm_start(ambient_celsius: f32, heat: f32) -> SwitchOn {
+    SwitchOn {
+        switch_on_celsius: ambient_celsius + heat,
+        ambient_celsius,
+        residual_heat_celsius: heat,
+        known: true,
+    }
+}
+
 fn position(table: &Table, celsius: f32) -> AmbientPosition {
     AmbientPosition::locate(&table.ambients, celsius, 0.5, |a| a.ambient_celsius)
 }
@@ -257,12 +267,7 @@ proptest! {
         let c = c % ambient.curves.len();
         let start = |heat: f32| {
             let mut state = ModifiedAxisState::default();
-            let switch_on = SwitchOn {
-                switch_on_celsius: ambient.ambient_celsius + heat,
-                ambient_celsius: ambient.ambient_celsius,
-                residual_heat_celsius: heat,
-                known: true,
-            };
+            let switch_on = warm_start(ambient.ambient_celsius, heat);
             let (_, flags) = table.power_on_after(&settings(), &switch_on, &mut state);
             (state, flags)
         };
@@ -321,12 +326,7 @@ proptest! {
         let ambient = &table.ambients[a];
         let bias = |heat: f32| {
             let mut state = ModifiedAxisState::default();
-            let switch_on = SwitchOn {
-                switch_on_celsius: ambient.ambient_celsius + heat,
-                ambient_celsius: ambient.ambient_celsius,
-                residual_heat_celsius: heat,
-                known: true,
-            };
+            let switch_on = warm_start(ambient.ambient_celsius, heat);
             table.power_on_after(&settings(), &switch_on, &mut state).0
         };
         let cold = ambient.initial_bias_dps;

@@ -1,15 +1,16 @@
 //! Closing the loop for one unit, in the data's one direction: activations by role → stage 3's
 //! lookup chosen per axis (by rise, the paper's, or by heating history) → the initial bias chosen
-//! per axis (the paper's, or with the warm starts') → the diagnosis of that model's residual → proposed terms → the guarded extended model → the error before and after on
-//! the held-out activations. The command line (`gyrodrift diagnose
-//! [--extend]`), the Python module and the closed-loop experiment all run this.
+//! per axis (the paper's, or with the warm starts') → the diagnosis of that model's residual →
+//! proposed terms → the guarded extended model → the error before and after on the held-out
+//! activations. The command line (`gyrodrift diagnose [--extend]`), the Python module and the
+//! closed-loop experiment all run this.
 
 use drift_core::Previous;
 use drift_recording::Segment;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::diagnose::{diagnose, one_sided_mean_test, ActivationSeries, AxisDiagnosis, Diagnoser};
+use crate::diagnose::{diagnose, paired_choice, ActivationSeries, AxisDiagnosis, Diagnoser};
 use crate::error::FitError;
 use crate::evaluate::{correct_segment_after, kept_before, metric, switch_on_raw};
 use crate::extend::{correct_with_terms, extend, Extended, TermPlan};
@@ -85,9 +86,6 @@ pub struct Stage3Choice {
     pub keyed_by_history: bool,
 }
 
-/// Significance level of the stage-3 choice (the guard's).
-const CHOOSE_ALPHA: f64 = 0.05;
-
 /// Chooses stage 3's lookup per axis on the `training` activations, each started after what
 /// firmware kept before it (`kept`, in `training`'s order).
 fn choose_stage3(
@@ -127,11 +125,7 @@ fn choose_stage3(
             }
         };
         let gains: Vec<f64> = per_activation.iter().map(|(r, h)| r[a] - h[a]).collect();
-        let (gain, p_value) = if n < 2 {
-            (0.0, 1.0)
-        } else {
-            one_sided_mean_test(&gains)
-        };
+        let (p_value, keyed_by_history) = paired_choice(&gains);
         Stage3Choice {
             axis: ["X", "Y", "Z"][a],
             curves_cross: fitted.crossings.iter().any(|c| c.axis == a),
@@ -139,7 +133,7 @@ fn choose_stage3(
             training_drift_by_rise_dps: mean(0),
             training_drift_by_history_dps: mean(1),
             p_value,
-            keyed_by_history: gain > 0.0 && p_value < CHOOSE_ALPHA,
+            keyed_by_history,
         }
     })
 }

@@ -279,6 +279,21 @@ pub(crate) fn one_sided_mean_test(gains: &[f64]) -> (f64, f64) {
     (mean, standard_normal_tail(z))
 }
 
+/// Significance level of the loop's model choices (stage 3's lookup, the initial bias): the
+/// guard's.
+const CHOOSE_ALPHA: f64 = 0.05;
+
+/// A model choice from per-activation `gains` of the alternative (paired by activation): its
+/// one-sided p-value, and whether it is taken (a positive mean gain, significant at 5 %). Fewer
+/// than two activations choose nothing.
+pub(crate) fn paired_choice(gains: &[f64]) -> (f64, bool) {
+    if gains.len() < 2 {
+        return (1.0, false);
+    }
+    let (gain, p_value) = one_sided_mean_test(gains);
+    (p_value, gain > 0.0 && p_value < CHOOSE_ALPHA)
+}
+
 /// One point of the scoring data: residual and candidate (left over after the tables).
 type Point = (f64, f64);
 

@@ -478,3 +478,37 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
         crossings,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn warm_starts_are_the_histories_offsets_smoothed_through_a_cold_start() {
+        // Offsets on 0.004·h − 0.0005·h², with ±0.001 of turn-on jitter that averages out.
+        let truth = |h: f64| 0.004 * h - 0.0005 * h * h;
+        let starts: Vec<(f64, f64, f64)> = [0.1, 0.1, 0.4, 0.45, 1.0, 1.3, 1.6, 2.2, 2.5]
+            .iter()
+            .enumerate()
+            .map(|(i, &h)| (h, truth(h) + if i % 2 == 0 { 0.001 } else { -0.001 }, 2.0))
+            .collect();
+        let warm = smooth_warm_starts(&starts);
+        assert_eq!(warm.len(), WARM_START_POINTS);
+        assert_eq!(warm.last().unwrap().residual_heat_celsius, 2.5);
+        for w in &warm {
+            let h = f64::from(w.residual_heat_celsius);
+            assert!(
+                (f64::from(w.bias_offset_dps) - truth(h)).abs() < 6e-4,
+                "{w:?}"
+            );
+        }
+        assert!(warm
+            .windows(2)
+            .all(|p| p[0].residual_heat_celsius < p[1].residual_heat_celsius));
+        // Two histories: a line through the origin; none (or no heat): nothing to store.
+        let line = smooth_warm_starts(&[(1.0, 0.002, 1.0), (2.0, 0.004, 1.0)]);
+        assert!((line[3].bias_offset_dps - 0.004).abs() < 1e-9);
+        assert!((line[0].bias_offset_dps - 0.001).abs() < 1e-9);
+        assert!(smooth_warm_starts(&[]).is_empty());
+    }
+}

@@ -15,9 +15,9 @@ use drift_recording::Segment;
 use crate::evaluate::correct_segment_after;
 
 /// Per axis, stage 3 keyed by history or by rise and the initial bias with or without warm starts,
-/// and per activation what firmware kept of the one before. Activations are known by their switch-on time: one unit's are distinct (the order
-/// `kept_before` lives them in), and a copy carrying another quantity in its rates (an absorber's)
-/// keeps it.
+/// and per activation what firmware kept of the one before. Activations are known by their
+/// switch-on time: one unit's are distinct (the order `kept_before` lives them in), and a copy
+/// carrying another quantity in its rates (an absorber's) keeps it.
 #[derive(Debug, Clone, Default)]
 pub struct Keying {
     /// Per axis: stage 3 keyed by heating history.

@@ -12,14 +12,11 @@ use drift_recording::Segment;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::diagnose::one_sided_mean_test;
+use crate::diagnose::paired_choice;
 use crate::evaluate::{metric, switch_on_raw};
 use crate::fit::FittedUnit;
 use crate::keying::Keying;
 use crate::settings::FitSettings;
-
-/// Significance level of the choice (the guard's and stage 3's).
-const CHOOSE_ALPHA: f64 = 0.05;
 
 /// The choice on one axis: the warm starts' initial bias where, on the training activations, it
 /// leaves a significantly smaller mean square error than the paper's initial bias (paired by
@@ -79,18 +76,14 @@ pub fn choose(
             }
         };
         let gains: Vec<f64> = squares.iter().map(|(c, w)| c[a] - w[a]).collect();
-        let (gain, p_value) = if n < 2 {
-            (0.0, 1.0)
-        } else {
-            one_sided_mean_test(&gains)
-        };
+        let (p_value, chosen) = paired_choice(&gains);
         WarmStartChoice {
             axis: ["X", "Y", "Z"][a],
             training_activations: n,
             training_rms_cold_dps: root_mean(false),
             training_rms_warm_dps: root_mean(true),
             p_value,
-            chosen: gain > 0.0 && p_value < CHOOSE_ALPHA,
+            chosen,
         }
     })
 }
