@@ -36,31 +36,26 @@ pub fn run(
         return Ok(md);
     }
     let tables = closed.model(fitted);
-    let keyed: Vec<&str> = closed
-        .stage3
-        .iter()
-        .filter(|c| c.keyed_by_history)
-        .map(|c| c.axis)
-        .collect();
-    if !keyed.is_empty() {
-        let _ = writeln!(
-            md,
-            "Stage 3 is keyed by heating history on {} (chosen on the training activations, above): firmware running this image starts with `power_on_after` and calls `keep` before power-off.\n",
-            keyed.join(", ")
-        );
-    }
-    let warm: Vec<&str> = closed
-        .warm_start
-        .iter()
-        .filter(|c| c.chosen)
-        .map(|c| c.axis)
-        .collect();
-    if !warm.is_empty() {
-        let _ = writeln!(
-            md,
-            "The initial bias of warm starts is taken from the calibration's series on {} (chosen on the training activations, above): firmware running this image starts with `power_on_after` and calls `keep` before power-off.\n",
-            warm.join(", ")
-        );
+    let keying = &closed.keying;
+    for (what, axes) in [
+        ("Stage 3 is keyed by heating history", keying.by_history),
+        (
+            "The initial bias of warm starts is taken from the calibration's series",
+            keying.warm_start,
+        ),
+    ] {
+        let axes: Vec<&str> = ["X", "Y", "Z"]
+            .into_iter()
+            .zip(axes)
+            .filter_map(|(axis, chosen)| chosen.then_some(axis))
+            .collect();
+        if !axes.is_empty() {
+            let _ = writeln!(
+                md,
+                "{what} on {} (chosen on the training activations, above): firmware running this image starts with `power_on_after` and calls `keep` before power-off.\n",
+                axes.join(", ")
+            );
+        }
     }
     md.push_str(&before_after_table(before_after, floor));
     let mut image = vec![0; blob::encoded_len(&*tables)?];
