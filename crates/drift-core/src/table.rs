@@ -193,13 +193,14 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             self.ambients.iter().map(|a| a.ambient_celsius),
         )?;
         let by_history = self.keyed_by_history();
+        let warm_started = self.warm_started();
         for (a, ambient) in self.ambients.iter().enumerate() {
             let at = at.ambient(a);
             if !ambient.initial_bias_dps.is_finite() {
                 return Err(Error::new("initial_bias_dps", at, Problem::NonFinite));
             }
             warm_start::validate(&ambient.warm_starts, at)?;
-            if ambient.warm_starts.is_empty() && self.warm_started() {
+            if ambient.warm_starts.is_empty() && warm_started {
                 return Err(Error::new("warm_starts", at, Problem::Empty));
             }
             if ambient.curves.is_empty() {

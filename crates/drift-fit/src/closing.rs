@@ -112,28 +112,15 @@ fn choose_stage3(
         })
         .collect();
     std::array::from_fn(|a| {
-        let n = per_activation.len();
-        let mean = |pick: usize| {
-            if n == 0 {
-                f64::NAN
-            } else {
-                let sum: f64 = per_activation
-                    .iter()
-                    .map(|(rise, history)| [rise, history][pick][a])
-                    .sum();
-                sum / n as f64
-            }
-        };
-        let gains: Vec<f64> = per_activation.iter().map(|(r, h)| r[a] - h[a]).collect();
-        let (p_value, keyed_by_history) = paired_choice(&gains);
+        let choice = paired_choice(&per_activation, a);
         Stage3Choice {
             axis: ["X", "Y", "Z"][a],
             curves_cross: fitted.crossings.iter().any(|c| c.axis == a),
-            training_activations: n,
-            training_drift_by_rise_dps: mean(0),
-            training_drift_by_history_dps: mean(1),
-            p_value,
-            keyed_by_history,
+            training_activations: per_activation.len(),
+            training_drift_by_rise_dps: choice.current,
+            training_drift_by_history_dps: choice.alternative,
+            p_value: choice.p_value,
+            keyed_by_history: choice.chosen,
         }
     })
 }

@@ -283,15 +283,47 @@ pub(crate) fn one_sided_mean_test(gains: &[f64]) -> (f64, f64) {
 /// guard's.
 const CHOOSE_ALPHA: f64 = 0.05;
 
-/// A model choice from per-activation `gains` of the alternative (paired by activation): its
-/// one-sided p-value, and whether it is taken (a positive mean gain, significant at 5 %). Fewer
-/// than two activations choose nothing.
-pub(crate) fn paired_choice(gains: &[f64]) -> (f64, bool) {
-    if gains.len() < 2 {
-        return (1.0, false);
+/// A model choice on one axis, paired by activation.
+pub(crate) struct PairedChoice {
+    /// Mean of the current model's per-activation error (NaN without activations).
+    pub current: f64,
+    /// Mean of the alternative's.
+    pub alternative: f64,
+    /// One-sided p-value of "the alternative leaves less error".
+    pub p_value: f64,
+    /// Whether the alternative is taken: a smaller mean error, significant at 5 %. Fewer than two
+    /// activations choose nothing.
+    pub chosen: bool,
+}
+
+/// The choice on `axis` from per-activation errors `(current, alternative)` per axis.
+pub(crate) fn paired_choice(errors: &[([f64; 3], [f64; 3])], axis: usize) -> PairedChoice {
+    let n = errors.len();
+    let mean = |alternative: bool| {
+        if n == 0 {
+            f64::NAN
+        } else {
+            let sum: f64 = errors
+                .iter()
+                .map(|(c, a)| if alternative { a[axis] } else { c[axis] })
+                .sum();
+            sum / n as f64
+        }
+    };
+    let (current, alternative) = (mean(false), mean(true));
+    let gains: Vec<f64> = errors.iter().map(|(c, a)| c[axis] - a[axis]).collect();
+    let (p_value, chosen) = if n < 2 {
+        (1.0, false)
+    } else {
+        let (gain, p_value) = one_sided_mean_test(&gains);
+        (p_value, gain > 0.0 && p_value < CHOOSE_ALPHA)
+    };
+    PairedChoice {
+        current,
+        alternative,
+        p_value,
+        chosen,
     }
-    let (gain, p_value) = one_sided_mean_test(gains);
-    (p_value, gain > 0.0 && p_value < CHOOSE_ALPHA)
 }
 
 /// One point of the scoring data: residual and candidate (left over after the tables).

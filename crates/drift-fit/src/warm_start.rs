@@ -62,28 +62,15 @@ pub fn choose(
             (rms_cold.map(|r| r * r), rms_warm.map(|r| r * r))
         })
         .collect();
-    let n = squares.len();
     std::array::from_fn(|a| {
-        let root_mean = |warm: bool| {
-            if n == 0 {
-                f64::NAN
-            } else {
-                let sum: f64 = squares
-                    .iter()
-                    .map(|(cold, hot)| if warm { hot[a] } else { cold[a] })
-                    .sum();
-                (sum / n as f64).sqrt()
-            }
-        };
-        let gains: Vec<f64> = squares.iter().map(|(c, w)| c[a] - w[a]).collect();
-        let (p_value, chosen) = paired_choice(&gains);
+        let choice = paired_choice(&squares, a);
         WarmStartChoice {
             axis: ["X", "Y", "Z"][a],
-            training_activations: n,
-            training_rms_cold_dps: root_mean(false),
-            training_rms_warm_dps: root_mean(true),
-            p_value,
-            chosen,
+            training_activations: squares.len(),
+            training_rms_cold_dps: choice.current.sqrt(),
+            training_rms_warm_dps: choice.alternative.sqrt(),
+            p_value: choice.p_value,
+            chosen: choice.chosen,
         }
     })
 }
