@@ -25,31 +25,36 @@ const EFFECTS: [&str; 8] = [
 
 fn print(r: &Row) {
     println!(
-        "| {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} |",
+        "| {} | {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} |",
         r.effect,
         r.seed,
         r.axis,
+        r.paper_top,
         r.top,
         if r.significant { "yes" } else { "no" },
         r.terms(),
         r.before.1,
         r.after.1,
         r.floor.1,
-        if r.before.1 > r.floor.1 {
-            format!("{:.1}×", r.excess_cut())
-        } else {
-            "– (floor above)".to_owned()
-        },
+        cut(r.before.1, r.after.1, r.floor.1, r.excess_cut()),
         r.before.0,
         r.after.0,
         r.floor.0,
         r.by_history.0,
-        if r.before.0 > r.floor.0 {
-            format!("{:.1}×", r.history_drift_cut())
-        } else {
-            "– (floor above)".to_owned()
-        },
+        cut(r.before.0, r.by_history.0, r.floor.0, r.history_drift_cut()),
     );
+}
+
+/// An excess cut for the table: a model that ends within the table's last digit (0.00005 °/s) of
+/// the floor has nothing left to cut, and the ratio would only measure that digit.
+fn cut(before: f64, after: f64, floor: f64, ratio: f64) -> String {
+    if before <= floor {
+        "– (floor above)".to_owned()
+    } else if after - floor < 0.00005 {
+        "at the floor".to_owned()
+    } else {
+        format!("{ratio:.1}×")
+    }
 }
 
 const USAGE: &str = "closed_loop [--seeds 1] [--first-seed 1] [--sessions 6] [--scale 1] \
@@ -111,8 +116,8 @@ fn main() -> anyhow::Result<()> {
     let work = tempfile::tempdir()?;
     let settings = drift_fit::FitSettings::default();
     let mut rows: Vec<Row> = Vec::new();
-    println!("| effect | seed | axis | top candidate | significant | terms admitted | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift | drift keyed by history | drift excess cut by history |");
-    println!("|---|---:|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| effect | seed | axis | top candidate behind the paper's model | top candidate left behind the loop's model | significant | terms admitted | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift | drift keyed by history | drift excess cut by history |");
+    println!("|---|---:|---|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for effect in &effects {
         for seed in first_seed..first_seed + seeds {
             eprintln!("{effect}, seed {seed} …");

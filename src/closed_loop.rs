@@ -145,7 +145,9 @@ pub struct Row {
     pub seed: u64,
     /// `X`, `Y` or `Z`.
     pub axis: &'static str,
-    /// The diagnosis's top candidate.
+    /// The top candidate behind the paper's model: what it lacked (with ", significant" when so).
+    pub paper_top: String,
+    /// The diagnosis's top candidate behind the loop's model: what is left.
     pub top: String,
     /// Whether it is significant.
     pub significant: bool,
@@ -316,18 +318,24 @@ pub fn run(
         closed.roles.training.len(),
         closed.roles.outside_range
     );
-    for axis in &closed.axes {
-        for c in axis.ranking.iter().take(6) {
-            eprintln!(
-                "  ranking {}: {} explained {:.3}, p {:.1e}{}, absorbed by the tables {:.3}, {}",
+    for (model, axes) in [
+        ("paper's model", &closed.paper_axes),
+        ("loop's model", &closed.axes),
+    ] {
+        for axis in axes {
+            for c in axis.ranking.iter().take(6) {
+                eprintln!(
+                "  ranking behind the {model}, {}: {} explained {:.3}, p {:.1e} (whole residual {:.1e}){}, absorbed by the tables {:.3}, {}",
                 axis.axis,
                 c.name,
                 c.explained,
                 c.p_value,
+                c.whole_p_value,
                 if c.significant { " (significant)" } else { "" },
                 c.absorbed_by_model,
                 c.level
             );
+            }
         }
     }
     for a in closed.extended.iter().flat_map(|e| &e.admissions) {
@@ -446,7 +454,15 @@ pub fn run(
         .map(|a| {
             let axes = &closed.axes;
             let top = axes[a].ranking.first();
+            let paper_top = closed.paper_axes[a].ranking.first();
             Row {
+                paper_top: paper_top.map_or("–".into(), |c| {
+                    if c.significant {
+                        format!("{}, significant", c.name)
+                    } else {
+                        c.name.clone()
+                    }
+                }),
                 effect: effect.to_owned(),
                 seed,
                 axis: axes[a].axis,

@@ -165,7 +165,7 @@ fn history_table(held_out: &[BeforeAfter]) -> String {
 
 /// The ranking as Markdown.
 pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
-    let mut md = String::from("## Diagnosis of the residual after the paper's model (stage 3 keyed as chosen above)\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: one-sided test of the held-out improvement per activation at the candidate's level (p) and of the whole residual, offsets and shape together (p whole: what a firmware term changes), both under Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
+    let mut md = String::from("## Diagnosis of the residual after the loop's model (stage 3 and the initial bias as chosen above)\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: one-sided test of the held-out improvement per activation at the candidate's level (p) and of the whole residual, offsets and shape together (p whole: what a firmware term changes), both under Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
     for axis in axes {
         let _ = writeln!(
             md,
@@ -196,6 +196,40 @@ pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
         }
         md.push('\n');
     }
+    md
+}
+
+/// The ranking behind the paper's own model, when the loop changed it: what the paper's model
+/// lacked, which the choices above answer; the section before it says what is left.
+fn paper_markdown(axes: &[AxisDiagnosis], top: usize) -> String {
+    let mut md = String::from("## What the paper's model lacked\n\nThe same diagnosis, on the same activations, behind the paper's model (stage 3 keyed by rise, the paper's initial bias): what the choices above answer.\n\n| axis | residual RMS | top candidates (explained, level) | significant |\n|---|---:|---|---|\n");
+    for axis in axes {
+        let ranked: Vec<String> = axis
+            .ranking
+            .iter()
+            .take(top)
+            .map(|c| format!("{} ({:.3}, {})", c.name, c.explained, c.level))
+            .collect();
+        let significant: Vec<&str> = axis
+            .ranking
+            .iter()
+            .filter(|c| c.significant)
+            .map(|c| c.name.as_str())
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {} | {:.4} | {} | {} |",
+            axis.axis,
+            axis.residual_rms_dps,
+            ranked.join("; "),
+            if significant.is_empty() {
+                "–".to_owned()
+            } else {
+                significant.join(", ")
+            }
+        );
+    }
+    md.push('\n');
     md
 }
 
@@ -345,6 +379,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             &before_after,
         ));
         md.push_str(&markdown(axes, args.top));
+        if closed.keying.any() {
+            md.push_str(&paper_markdown(&closed.paper_axes, args.top));
+        }
         println!("{unit}:");
         for crossing in &fitted.crossings {
             println!("  tables: {}", crossing.note());
@@ -373,6 +410,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 c.p_value,
                 if c.chosen { "warm starts'" } else { "the paper's" }
             );
+        }
+        if closed.keying.any() {
+            for axis in &closed.paper_axes {
+                println!(
+                    "  behind the paper's model, {}: {}",
+                    axis.axis,
+                    axis.ranking.first().map_or("–".to_owned(), |c| format!(
+                        "{} explained {:.3}{}",
+                        c.name,
+                        c.explained,
+                        if c.significant { ", significant" } else { "" }
+                    ))
+                );
+            }
         }
         for axis in axes.iter() {
             let chosen = axis
@@ -424,6 +475,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         json.push(serde_json::json!({
             "unit": unit,
             "axes": axes,
+            "paper_axes": &closed.paper_axes,
             "proposed_terms": closed.proposed.terms.iter().map(|t| &t.candidate).collect::<Vec<_>>(),
             "admissions": closed.extended.as_ref().map(|e| &e.admissions),
             "crossings": fitted.crossings,

@@ -49,9 +49,10 @@ impl Flags {
     /// activation ([`crate::CorrectorState::power_on`] rather than `power_on_after`, or nothing
     /// finite kept): the start is taken as fully cooled. Set on every sample of the activation.
     pub const HISTORY_UNKNOWN: Self = Self(1 << 10);
-    /// A table keyed by heating history: the residual heat at switch-on lies outside the span of
-    /// the stored histories by more than [`Settings::rise_margin_celsius`](crate::Settings): the
-    /// nearest history's curve is used (clamp). Set on every sample of the activation.
+    /// A table keyed by heating history or with warm starts: the residual heat at switch-on lies
+    /// outside the span of the stored histories (or beyond the warmest stored warm start) by more
+    /// than [`Settings::rise_margin_celsius`](crate::Settings): the nearest history's curve and
+    /// the warmest start's initial bias are used (clamp). Set on every sample of the activation.
     pub const HISTORY_OUT_OF_SPAN: Self = Self(1 << 11);
 
     /// Every flag with its name, in bit order (for bindings, logs and reports: a flag added here is

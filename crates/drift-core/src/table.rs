@@ -381,33 +381,20 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         // The paper indexes ambient by the switch-on temperature, residual heat included, as its
         // calibration saw it; a table keyed by history was built against the ambient itself.
         let heat = switch_on.residual_heat_celsius;
-        let (ambient, history, heat) = if by_history {
+        let (ambient, history) = if by_history {
             let ambient = locate(switch_on.ambient_celsius);
-            let rise_margin = settings.rise_margin_celsius;
-            let history =
-                self.locate_history(&ambient, switch_on.residual_heat_celsius, rise_margin);
-            if history.out_of_range && switch_on.residual_heat_celsius > 0.0 {
-                // More residual heat than the calibration's shortest off-time left: the ambient
-                // rose during the off-time rather than the unit kept that much heat (the first
-                // start of a carried unit): a cold start at the switch-on temperature, flagged.
-                let ambient = locate(switch_on.switch_on_celsius);
-                let cold = self.locate_history(&ambient, 0.0, rise_margin);
-                (
-                    ambient,
-                    AmbientPosition {
-                        out_of_range: true,
-                        ..cold
-                    },
-                    0.0,
-                )
-            } else {
-                (ambient, history, heat)
-            }
+            // More residual heat than the calibration's shortest off-time left: the warmest
+            // history's curve (clamp), flagged, like every other stage beyond its span. Why not a
+            // cold start there: in use, off-times shorter than the calibration's are common and
+            // such a start is nearer the warmest history than a cold one (measured:
+            // docs/closed-loop.md, session 10). An ambient that rose during the off-time by more
+            // than the unit cooled is told apart already (`SwitchOn::estimate`: a cold start).
+            let history = self.locate_history(&ambient, heat, settings.rise_margin_celsius);
+            (ambient, history)
         } else {
             (
                 locate(switch_on.switch_on_celsius),
                 AmbientPosition::default(),
-                heat,
             )
         };
         *state = ModifiedAxisState::new(&ambient);
@@ -427,18 +414,22 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
             }
         }
         // A warm start's initial bias is the calibration's at its ambient and residual heat, as the
-        // calibration's series measured it. More residual heat than the warmest of them left: the
-        // ambient rose during the off-time (as for stage 3): the paper's cold start, flagged.
+        // calibration's series measured it. More residual heat than the warmest of them left: held
+        // at the warmest, flagged. Why not the paper's cold start there: in use, off-times shorter
+        // than the calibration's shortest interval are common and leave more heat than any
+        // calibration start, and their offset is nearer the warmest start's than a cold start's
+        // (measured: docs/closed-loop.md, session 10). An ambient that rose during the off-time by
+        // more than the unit cooled is told apart already (`SwitchOn::estimate`: a cold start).
         if warm_started && heat > 0.0 {
             let at_ambient = if by_history {
                 ambient
             } else {
                 locate(switch_on.ambient_celsius)
             };
-            if heat <= self.warmest_start(&at_ambient) + settings.rise_margin_celsius {
-                return (self.initial_bias(&at_ambient, heat), flags);
+            if heat > self.warmest_start(&at_ambient) + settings.rise_margin_celsius {
+                flags |= Flags::HISTORY_OUT_OF_SPAN;
             }
-            flags |= Flags::HISTORY_OUT_OF_SPAN;
+            return (self.initial_bias(&at_ambient, heat), flags);
         }
         // The paper's: the cold start's bias at the switch-on temperature (a table keyed by rise
         // located the ambient there already: one search per switch-on, not two).

@@ -26,8 +26,8 @@ pub struct WarmStart {
 
 /// The initial-bias offset at `residual_heat_celsius` from the warm starts of one ambient (in
 /// increasing residual heat): zero for a cold start, linear between the calibrated warm starts
-/// (from a cold start's zero up to the first), and held at the warmest beyond it (the table allows
-/// the rise margin beyond).
+/// (from a cold start's zero up to the first), and held at the warmest beyond it (where the table
+/// flags the start `HISTORY_OUT_OF_SPAN`).
 #[inline]
 pub(crate) fn offset_dps(warm_starts: &[WarmStart], residual_heat_celsius: f32) -> f32 {
     // NaN included: no usable residual heat is a cold start.

@@ -294,8 +294,9 @@ proptest! {
 
     /// Warm starts: at a calibration ambient, a stored warm start's residual heat gives that
     /// ambient's cold initial bias plus the warm start's offset; between two stored warm starts the offset lies
-    /// between theirs; a cold start has none; any residual heat, finite or not, gives a finite
-    /// initial bias and no panic — whether stage 3 is keyed by rise or by history.
+    /// between theirs; beyond the warmest, the warmest's, flagged; a cold start has none; any
+    /// residual heat, finite or not, gives a finite initial bias and no panic — whether stage 3 is
+    /// keyed by rise or by history (beyond every stored history too).
     #[test]
     fn warm_starts_offset_the_initial_bias_by_residual_heat(
         table in table(),
@@ -324,25 +325,28 @@ proptest! {
         prop_assert!(table.validate(drift_core::Location::axis(0)).is_ok());
         let a = a % table.ambients.len();
         let ambient = &table.ambients[a];
-        let bias = |heat: f32| {
+        let started = |heat: f32| {
             let mut state = ModifiedAxisState::default();
             let switch_on = warm_start(ambient.ambient_celsius, heat);
-            table.power_on_after(&settings(), &switch_on, &mut state).0
+            table.power_on_after(&settings(), &switch_on, &mut state)
         };
+        let bias = |heat: f32| started(heat).0;
         let cold = ambient.initial_bias_dps;
         prop_assert_eq!(bias(0.0), cold);
         let w = w % offsets.len();
         let stored = ambient.warm_starts[w];
-        // Keyed by history, a residual heat beyond every stored history is read as a cold start.
-        let within_histories = !by_history || stored.residual_heat_celsius <= 0.4 * (ambient.curves.len() - 1) as f32;
-        if within_histories {
-            prop_assert_eq!(bias(stored.residual_heat_celsius), cold + stored.bias_offset_dps);
-            if w + 1 < offsets.len() && (!by_history || stored.residual_heat_celsius + 0.5 <= 0.4 * (ambient.curves.len() - 1) as f32) {
-                let got = bias(stored.residual_heat_celsius + 0.5 * between_u) - cold;
-                let (lo, hi) = (stored.bias_offset_dps, offsets[w + 1]);
-                prop_assert!(got >= lo.min(hi) - 1e-6 && got <= lo.max(hi) + 1e-6, "{got} not in {lo}..{hi}");
-            }
+        prop_assert_eq!(bias(stored.residual_heat_celsius), cold + stored.bias_offset_dps);
+        if w + 1 < offsets.len() {
+            let got = bias(stored.residual_heat_celsius + 0.5 * between_u) - cold;
+            let (lo, hi) = (stored.bias_offset_dps, offsets[w + 1]);
+            prop_assert!(got >= lo.min(hi) - 1e-6 && got <= lo.max(hi) + 1e-6, "{got} not in {lo}..{hi}");
         }
+        // More heat than the warmest stored start left (an off-time shorter than the
+        // calibration's): held at the warmest, flagged.
+        let warmest = ambient.warm_starts[offsets.len() - 1];
+        let (beyond, flags) = started(warmest.residual_heat_celsius + 1.0);
+        prop_assert_eq!(beyond, cold + warmest.bias_offset_dps);
+        prop_assert!(flags.contains(Flags::HISTORY_OUT_OF_SPAN));
         prop_assert!(bias(wild).is_finite());
     }
 }

@@ -199,14 +199,10 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -
                 locate(&blended, heat, s.rise_margin)
             };
             if keyed_by_history {
-                let (mut lo, mut hi, mut w, outside) = history_at(at, heat);
+                // Beyond the stored histories: the nearest (clamp), flagged.
+                let (lo, hi, w, outside) = history_at(at, heat);
                 if outside {
                     state.activation |= HISTORY_OUT_OF_SPAN;
-                    if heat > 0.0 {
-                        // More residual heat than any stored history: the ambient changed.
-                        (at, heat) = (celsius, 0.0);
-                        (lo, hi, w, _) = history_at(at, heat);
-                    }
                 }
                 state.history = Some((lo, hi, w));
             }
@@ -219,8 +215,8 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -
             }
             state.ambient = (lo, hi, w);
             // A warm start's initial bias: the ambient's cold start plus an offset that is zero
-            // cold, linear from there through the stored warm starts, held beyond the warmest;
-            // beyond the warmest by more than the rise margin, the paper's cold start, flagged.
+            // cold, linear from there through the stored warm starts, held beyond the warmest
+            // (flagged beyond it by more than the rise margin).
             // Otherwise the paper's: the cold start's at the switch-on temperature.
             let offset = |a: usize| {
                 let points = warm_starts(a);
@@ -238,10 +234,10 @@ fn power_on(axis: &Axis, s: &Settings, raw: f64, previous: Option<(f64, f64)>) -
             };
             let warmest = |a: usize| warm_starts(a).last().map_or(0.0, |w| w.0);
             let (mut lo, mut hi, mut w, _) = locate(&temps, at, s.ambient_margin);
-            let mut warm = warm_started && heat > 0.0;
+            let warm = warm_started && heat > 0.0;
+            // Beyond the warmest stored start: held there (`offset`), flagged.
             if warm && heat > lerp(warmest(lo), warmest(hi), w) + s.rise_margin {
                 state.activation |= HISTORY_OUT_OF_SPAN;
-                warm = false;
             }
             if !warm {
                 (lo, hi, w, _) = locate(&temps, celsius, s.ambient_margin);

@@ -12,6 +12,11 @@ use crate::lowpass::centred_moving_average;
 
 const AXES: [&str; 3] = ["X", "Y", "Z"];
 
+/// The temperature-rate filters' time constants the diagnosis offers, s: from the sensor's own
+/// rate (2 s, about a ±1 s difference) to a lag of minutes, a factor of ~4 apart, so whatever the
+/// element's lag one of them is within a factor of 2 of it.
+pub const RATE_TIME_CONSTANTS_S: [u32; 4] = [2, 8, 30, 120];
+
 /// The auxiliary channel holding the chamber's set point (the ambient the unit is kept at).
 pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
 
@@ -20,9 +25,17 @@ pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
 pub enum Kind {
     /// A recorded auxiliary channel, the same for every axis.
     Aux(String),
-    /// The axis's own temperature rate, °C/s: central difference over ±1 s of the 1-s low-passed
-    /// temperature.
-    TemperatureRate,
+    /// The axis's own temperature rate, °C/s, through a first-order low-pass of time constant
+    /// `time_constant_s`: the rise since switch-on (1-s low-passed) less its low-passed self, over
+    /// τ — what drift-core's rate term computes (`Term::TemperatureRate`). Several τ, because the
+    /// sensing element sits in its capsule behind the temperature sensor and follows it through a
+    /// lag of its own, seconds to minutes, which nobody tells the fitter: the rate a bias follows
+    /// is the element's, the sensor's rate low-passed by that lag. The data chooses among
+    /// [`RATE_TIME_CONSTANTS_S`].
+    TemperatureRate {
+        /// The low-pass's time constant, s.
+        time_constant_s: u32,
+    },
     /// The axis's own temperature rise since switch-on, squared, °C².
     RiseSquared,
     /// Another axis's rise since switch-on, °C: the axis `offset` (1 or 2) places further on.
@@ -42,8 +55,10 @@ impl Kind {
     /// Every kind a segment with these auxiliary channels offers.
     pub fn all(aux_channels: impl IntoIterator<Item = String>, has_set_point: bool) -> Vec<Self> {
         let mut kinds: Vec<Self> = aux_channels.into_iter().map(Self::Aux).collect();
+        kinds.extend(
+            RATE_TIME_CONSTANTS_S.map(|time_constant_s| Self::TemperatureRate { time_constant_s }),
+        );
         kinds.extend([
-            Self::TemperatureRate,
             Self::RiseSquared,
             Self::OtherAxisRise(1),
             Self::OtherAxisRise(2),
@@ -62,7 +77,9 @@ impl Kind {
         let own = AXES.get(axis).copied().unwrap_or("?");
         match self {
             Self::Aux(channel) => format!("aux:{channel}"),
-            Self::TemperatureRate => format!("temperature rate {own}"),
+            Self::TemperatureRate { time_constant_s } => {
+                format!("temperature rate {own} (τ {time_constant_s} s)")
+            }
             Self::RiseSquared => format!("rise² {own}"),
             Self::OtherAxisRise(offset) => format!("rise {}", AXES[(axis + offset) % 3]),
             Self::SinceSwitchOn => "time since switch-on".into(),
@@ -106,19 +123,8 @@ impl Kind {
                         .collect(),
                 )
             }
-            Self::TemperatureRate => per_axis(&|axis| {
-                let rise = rise(axis);
-                let half = (rate_hz as usize).max(1);
-                (0..n)
-                    .map(|i| {
-                        let (lo, hi) = (i.saturating_sub(half), (i + half).min(n - 1));
-                        if hi > lo {
-                            ((rise[hi] - rise[lo]) * rate_hz / (hi - lo) as f64) as f32
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect()
+            Self::TemperatureRate { time_constant_s } => per_axis(&|axis| {
+                filtered_rate(&rise(axis), f64::from(*time_constant_s), 1.0 / rate_hz)
             }),
             Self::RiseSquared => {
                 per_axis(&|axis| rise(axis).into_iter().map(|r| (r * r) as f32).collect())
@@ -144,5 +150,67 @@ impl Kind {
                 )
             }
         }
+    }
+}
+
+/// The rate of `rise` (°C, one value per `step_s`) through a first-order low-pass of time constant
+/// `tau_s`, as drift-core's rate term steps it (backward Euler on the lag `rise − filtered`, the
+/// filter starting at the first rise): 0 at switch-on, the rate of a steady ramp after a few τ.
+pub fn filtered_rate(rise: &[f64], tau_s: f64, step_s: f64) -> Vec<f32> {
+    let keep = tau_s / (tau_s + step_s);
+    let mut filtered = rise.first().copied().unwrap_or(0.0);
+    rise.iter()
+        .map(|&r| {
+            let lag = (r - filtered) * keep;
+            filtered = r - lag;
+            (lag / tau_s) as f32
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use drift_core::{Extension, ExtensionState, ExtraTerm, Term, TermInputs};
+
+    /// The diagnosis scores the rate the firmware's term computes: drift-core's filter, fed the
+    /// same rise, gives the same values.
+    #[test]
+    fn the_filtered_rate_is_drift_cores_rate_term() {
+        let (tau_s, step_ms) = (8_u32, 10_u32);
+        let rise: Vec<f64> = (0..6000)
+            .map(|i| 5.0 * (1.0 - (-f64::from(i * step_ms) / 60_000.0).exp()))
+            .collect();
+        let ours = filtered_rate(&rise, f64::from(tau_s), f64::from(step_ms) / 1000.0);
+
+        let mut extension = Extension::NONE;
+        let term = ExtraTerm {
+            term: Term::TemperatureRate {
+                time_constant_ms: tau_s * 1000,
+            },
+            centre: [0.0; 3],
+            coefficient: [1.0; 3],
+        };
+        extension.terms.push(term).unwrap();
+        let mut state = ExtensionState::power_on();
+        for (i, (&r, &mine)) in rise.iter().zip(&ours).enumerate() {
+            let inputs = TermInputs {
+                since_power_on_ms: u32::try_from(i).unwrap() * step_ms,
+                rise_celsius: [r as f32; 3],
+                ..TermInputs::default()
+            };
+            let firmware = state.values(&extension, &inputs)[0][0];
+            assert!(
+                (firmware - mine).abs() < 2e-5,
+                "sample {i}: {firmware} vs {mine}"
+            );
+        }
+        // A lag of τ behind the true rate: at 60 s (one time constant of the rise) the true rate
+        // is 5/60·e⁻¹ °C/s, and the filter reads the rate of τ earlier, less the filter's own gain.
+        let true_rate = |t: f64| 5.0 / 60.0 * (-t / 60.0).exp();
+        let at = ours[6000 - 1];
+        assert!(at > 0.0 && f64::from(at) < true_rate(59.99 - 8.0) * 1.01);
+        assert!(f64::from(at) > true_rate(59.99) * 0.95, "{at}");
+        assert_eq!(ours[0], 0.0);
     }
 }

@@ -33,8 +33,12 @@ pub struct Closed<'a> {
     pub keying: Keying,
     /// The diagnosed activations on the diagnosis grid.
     pub series: Vec<ActivationSeries>,
-    /// The ranking per axis.
+    /// The ranking per axis: what is left behind the loop's model.
     pub axes: [AxisDiagnosis; 3],
+    /// The ranking per axis behind the paper's model (stage 3 by rise, the paper's initial bias),
+    /// on the same activations: what the paper's model lacked, which the loop's choices and terms
+    /// then answer. The same as `axes` when the loop kept the paper's model.
+    pub paper_axes: [AxisDiagnosis; 3],
     /// The terms the diagnosis proposes (significant winners the firmware can compute).
     pub proposed: TermPlan,
     /// The extended model, when asked for, when something was proposed and there are training
@@ -159,13 +163,25 @@ pub fn close<'a>(
     );
     let warm_start = warm_start::choose(fitted, &keying, &roles.training, settings);
     let keying = keying.with_warm_start(std::array::from_fn(|a| warm_start[a].chosen));
-    let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings, keying.clone())?;
-    let series: Vec<ActivationSeries> = roles
-        .diagnosed()
-        .iter()
-        .map(|s| diagnoser.series(s))
-        .collect();
+    let diagnosed = |keying: &Keying| -> Result<Vec<ActivationSeries>, FitError> {
+        let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings, keying.clone())?;
+        Ok(roles
+            .diagnosed()
+            .iter()
+            .map(|s| diagnoser.series(s))
+            .collect())
+    };
+    let series = diagnosed(&keying)?;
     let axes = diagnose(&series);
+    let paper_axes = if keying.any() {
+        diagnose(&diagnosed(
+            &keying
+                .with_by_history([false; 3])
+                .with_warm_start([false; 3]),
+        )?)
+    } else {
+        axes.clone()
+    };
     let proposed = TermPlan::choose(&axes);
     let extended = if extend_model && !proposed.terms.is_empty() && !roles.training.is_empty() {
         Some(extend(
@@ -186,6 +202,7 @@ pub fn close<'a>(
         keying,
         series,
         axes,
+        paper_axes,
         proposed,
         extended,
     })

@@ -32,8 +32,8 @@ use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
 
-/// Time constant of the temperature-rate filter, ms: about the 1-s low-pass and ±1 s difference
-/// the diagnosis scores the rate with.
+/// Time constant of the temperature-rate filter, ms, for a candidate that does not name one: the
+/// diagnosis's shortest (`candidates::RATE_TIME_CONSTANTS_S`), about a ±1 s difference.
 pub const RATE_TIME_CONSTANT_MS: u32 = 2000;
 
 /// Time constant of an auxiliary term's low-pass, ms: the diagnosis scores a channel through the
@@ -70,10 +70,24 @@ impl TermPlan {
     /// Time since switch-on, switch-on temperature and the off-time estimate are the table's own
     /// inputs; campaign time is ageing, which no thermal term should model.
     fn term_for(&mut self, candidate: &str) -> Option<Term> {
-        if candidate.starts_with("temperature rate ") {
-            return Some(Term::TemperatureRate {
-                time_constant_ms: RATE_TIME_CONSTANT_MS,
-            });
+        if let Some(rest) = candidate.strip_prefix("temperature rate ") {
+            // "X (τ 30 s)": the filter the diagnosis scored the rate through.
+            let time_constant_ms = match rest.split_once("(τ ") {
+                Some((_, tau)) => tau
+                    .strip_suffix(" s)")?
+                    .parse::<u32>()
+                    .ok()?
+                    .checked_mul(1000)?,
+                None => RATE_TIME_CONSTANT_MS,
+            };
+            // drift-core keeps one rate filter per axis, so every rate term shares its τ: the
+            // best-ranked rate candidate sets it.
+            if self.terms.iter().any(|t| {
+                matches!(t.term, Term::TemperatureRate { time_constant_ms: other } if other != time_constant_ms)
+            }) {
+                return None;
+            }
+            return Some(Term::TemperatureRate { time_constant_ms });
         }
         if candidate.starts_with("rise² ") {
             return Some(Term::RiseSquared);
@@ -225,7 +239,10 @@ impl TermPlan {
 /// on one axis, the term applies its kind on every axis).
 fn describe(term: Term, candidate: &str) -> String {
     match term {
-        Term::TemperatureRate { .. } => "temperature rate (own axis)".into(),
+        Term::TemperatureRate { time_constant_ms } => format!(
+            "temperature rate (own axis, τ {} s)",
+            f64::from(time_constant_ms) / 1000.0
+        ),
         Term::RiseSquared => "rise² (own axis)".into(),
         _ => candidate.to_owned(),
     }
@@ -728,12 +745,16 @@ mod tests {
         let axes = [
             axis(
                 "X",
-                &[("temperature rate X", true), ("aux:supply_voltage", true)],
+                &[
+                    ("temperature rate X (τ 30 s)", true),
+                    ("aux:supply_voltage", true),
+                ],
             ),
             axis(
                 "Y",
                 &[
-                    ("temperature rate Y", true),
+                    // drift-core keeps one rate filter per axis: the best-ranked τ wins.
+                    ("temperature rate Y (τ 8 s)", true),
                     ("campaign time (ageing)", true),
                 ],
             ),
@@ -745,7 +766,7 @@ mod tests {
             terms,
             [
                 Term::TemperatureRate {
-                    time_constant_ms: RATE_TIME_CONSTANT_MS
+                    time_constant_ms: 30_000
                 },
                 Term::AxisRise { axis: 0 },
                 Term::Aux {
@@ -755,6 +776,10 @@ mod tests {
             ]
         );
         assert_eq!(plan.aux_inputs, ["supply_voltage"]);
+        assert_eq!(
+            plan.terms[0].candidate,
+            "temperature rate (own axis, τ 30 s)"
+        );
         // Ageing and insignificant candidates never become terms.
         assert!(plan.terms.iter().all(|t| !t.candidate.contains("ageing")));
     }

@@ -24,6 +24,7 @@ use crate::tables::PyModifiedTables;
 pub struct PyDiagnosis {
     unit_id: String,
     axes: [AxisDiagnosis; 3],
+    paper_axes: [AxisDiagnosis; 3],
     proposed: Vec<String>,
     admissions: Vec<Admission>,
     stage3: [Stage3Choice; 3],
@@ -146,6 +147,7 @@ pub fn diagnose_unit(
                 ("diagnosed", closed.series.len()),
             ],
             axes: closed.axes,
+            paper_axes: closed.paper_axes,
         })
     })?;
     Ok(diagnosis)
@@ -163,7 +165,16 @@ impl PyDiagnosis {
     /// whole_p_value, significant, coefficient, absorbed_by_model): a new list of dicts.
     #[getter]
     fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &self.records())
+        to_python(py, &records(&self.axes))
+    }
+
+    /// The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's
+    /// initial bias), as records like `ranking`: what the paper's model lacked, which the loop's
+    /// choices (`stage3`, `warm_start`) and terms answer. Equal to `ranking` when the loop kept
+    /// the paper's model.
+    #[getter]
+    fn paper_ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &records(&self.paper_axes))
     }
 
     /// The ranking as a pandas DataFrame (needs pandas; raises ImportError without it).
@@ -173,7 +184,7 @@ impl PyDiagnosis {
                 "Diagnosis.to_dataframe needs pandas (pip install pandas): {error}"
             ))
         })?;
-        pandas.call_method1("DataFrame", (to_python(py, &self.records())?,))
+        pandas.call_method1("DataFrame", (to_python(py, &records(&self.axes))?,))
     }
 
     /// Per axis ("X", "Y", "Z"), the significant winner's name, or None when no significant
@@ -262,24 +273,22 @@ impl PyDiagnosis {
     }
 }
 
-impl PyDiagnosis {
-    fn records(&self) -> Vec<RankRecord<'_>> {
-        self.axes
-            .iter()
-            .flat_map(|axis| {
-                axis.ranking.iter().enumerate().map(|(i, c)| RankRecord {
-                    axis: axis.axis,
-                    rank: i + 1,
-                    candidate: &c.name,
-                    level: c.level,
-                    explained: c.explained,
-                    p_value: c.p_value,
-                    whole_p_value: c.whole_p_value,
-                    significant: c.significant,
-                    coefficient: c.coefficient,
-                    absorbed_by_model: c.absorbed_by_model,
-                })
+/// The rankings of `axes` as flat records.
+fn records(axes: &[AxisDiagnosis; 3]) -> Vec<RankRecord<'_>> {
+    axes.iter()
+        .flat_map(|axis| {
+            axis.ranking.iter().enumerate().map(|(i, c)| RankRecord {
+                axis: axis.axis,
+                rank: i + 1,
+                candidate: &c.name,
+                level: c.level,
+                explained: c.explained,
+                p_value: c.p_value,
+                whole_p_value: c.whole_p_value,
+                significant: c.significant,
+                coefficient: c.coefficient,
+                absorbed_by_model: c.absorbed_by_model,
             })
-            .collect()
-    }
+        })
+        .collect()
 }

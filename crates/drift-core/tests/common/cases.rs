@@ -296,7 +296,7 @@ fn scenarios() -> Vec<Scenario> {
         },
         Scenario {
             name: "history-ambient-changed",
-            description: "tables keyed by history: X switched on above its last switch-off temperature (the ambient rose: cold start); Y with 13 °C of apparent residual heat, beyond every stored history (the ambient rose: cold start, flagged HISTORY_OUT_OF_SPAN); Z colder than its last ambient (the ambient fell: cold start at the new ambient)",
+            description: "tables keyed by history: X switched on above its last switch-off temperature (the ambient rose: cold start); Y with 13 °C of apparent residual heat, beyond every stored history (without a clock an ambient that rose by less than the unit cooled reads as a short off-time: the warmest history and warm start, flagged HISTORY_OUT_OF_SPAN); Z colder than its last ambient (the ambient fell: cold start at the new ambient)",
             model: "by_history",
             switch_on_celsius: Some([33.0, 33.0, 33.0]),
             final_rise: [4.0, 4.0, 4.0],
@@ -318,7 +318,7 @@ fn scenarios() -> Vec<Scenario> {
         },
         Scenario {
             name: "warm-start-initial-bias",
-            description: "the paper's tables (keyed by rise) with warm starts' initial bias, power_on_after: switched on at 33 °C after a short off-time, 2.0 °C of residual heat on X (on a stored warm start), 0.2 °C on Y (between a cold start and the first), 5.0 °C on Z (more than the warmest stored start left: the ambient rose, the paper's cold start at the switch-on temperature, flagged HISTORY_OUT_OF_SPAN); the warm starts' initial bias is read at the kept ambient, stage 2 at the switch-on temperature as the paper's",
+            description: "the paper's tables (keyed by rise) with warm starts' initial bias, power_on_after: switched on at 33 °C after a short off-time, 2.0 °C of residual heat on X (on a stored warm start), 0.2 °C on Y (between a cold start and the first), 5.0 °C on Z (more than the warmest stored start left, as after an off-time shorter than the calibration's: held at the warmest, flagged HISTORY_OUT_OF_SPAN); the warm starts' initial bias is read at the kept ambient, stage 2 at the switch-on temperature as the paper's",
             model: "warm_started",
             switch_on_celsius: Some([33.0, 33.2, 33.0]),
             final_rise: [3.0, 2.5, 3.5],

@@ -778,6 +778,12 @@ class Diagnosis:
     def ranking(self) -> list[dict[str, Any]]:
         """The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
         whole_p_value, significant, coefficient, absorbed_by_model): a new list of dicts."""
+    @property
+    def paper_ranking(self) -> list[dict[str, Any]]:
+        """The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's
+        initial bias), as records like `ranking`: what the paper's model lacked, which the loop's
+        choices (`stage3`, `warm_start`) and terms answer. Equal to `ranking` when the loop kept
+        the paper's model."""
     def to_dataframe(self) -> Any:
         """The ranking as a pandas DataFrame (needs pandas; raises ImportError without it)."""
     @property
