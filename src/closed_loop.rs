@@ -324,17 +324,11 @@ pub fn run(
     ] {
         for axis in axes {
             for c in axis.ranking.iter().take(6) {
+                let significant = if c.significant { " (significant)" } else { "" };
                 eprintln!(
-                "  ranking behind the {model}, {}: {} explained {:.3}, p {:.1e} (whole residual {:.1e}){}, absorbed by the tables {:.3}, {}",
-                axis.axis,
-                c.name,
-                c.explained,
-                c.p_value,
-                c.whole_p_value,
-                if c.significant { " (significant)" } else { "" },
-                c.absorbed_by_model,
-                c.level
-            );
+                    "  ranking behind the {model}, {}: {} explained {:.3}, p {:.1e} (whole residual {:.1e}){significant}, absorbed by the tables {:.3}, {}",
+                    axis.axis, c.name, c.explained, c.p_value, c.whole_p_value, c.absorbed_by_model, c.level
+                );
             }
         }
     }

@@ -114,6 +114,9 @@ fn simulate_fit_and_report_from_the_command_line() {
         unit["axes"][0]["ranking"][0]["whole_p_value"].is_number(),
         "{unit}"
     );
+    // The loop kept the paper's model: what it lacked is what is left, and said once.
+    assert_eq!(unit["paper_axes"], unit["axes"], "{unit}");
+    assert!(!md.contains("What the paper's model lacked"), "{md}");
     // Closing the loop on a campaign without field sessions: the section says what it could do.
     let extended = dir.path().join("extended");
     run(&[
