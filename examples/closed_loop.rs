@@ -58,8 +58,8 @@ fn cut(before: f64, after: f64, floor: f64, ratio: f64) -> String {
 }
 
 const USAGE: &str = "closed_loop [--seeds 1] [--first-seed 1] [--sessions 6] [--scale 1] \
-[--effects none,thermal_lag,…] [--calibration 30,40] [--clock yes|no]";
-const FLAGS: [&str; 7] = [
+[--effects none,thermal_lag,…] [--calibration 30,40] [--clock yes|no] [--per-activation no|yes]";
+const FLAGS: [&str; 8] = [
     "--seeds",
     "--first-seed",
     "--sessions",
@@ -67,6 +67,7 @@ const FLAGS: [&str; 7] = [
     "--effects",
     "--calibration",
     "--clock",
+    "--per-activation",
 ];
 
 fn main() -> anyhow::Result<()> {
@@ -101,6 +102,11 @@ fn main() -> anyhow::Result<()> {
             None | Some("yes") => true,
             Some("no") => false,
             Some(other) => anyhow::bail!("--clock takes yes or no, got `{other}`"),
+        },
+        per_activation: match value("--per-activation").as_deref() {
+            None | Some("no") => false,
+            Some("yes") => true,
+            Some(other) => anyhow::bail!("--per-activation takes yes or no, got `{other}`"),
         },
     };
     plan.check()?;

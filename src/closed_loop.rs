@@ -207,6 +207,35 @@ impl Row {
     }
 }
 
+/// One line per activation, in order of off-time: the mean (the activation's offset) and the drift
+/// of the corrected output per axis, paper's model → loop's model, °/s.
+fn print_activations(measured: &[BeforeAfter]) {
+    let mut sorted: Vec<&BeforeAfter> = measured.iter().collect();
+    sorted.sort_by(|a, b| {
+        let off = |r: &BeforeAfter| r.off_before_s.unwrap_or(f64::INFINITY);
+        off(a).total_cmp(&off(b))
+    });
+    eprintln!("  held-out +{VALIDATION} °C field activations (mean and drift of the corrected output, °/s, paper's → loop's):");
+    for r in sorted {
+        let off = r
+            .off_before_s
+            .map_or("unknown".to_owned(), |s| format!("{s:.0} s"));
+        let heat = r.residual_heat_celsius;
+        let mut line = format!(
+            "    off {off:>8}, residual heat {:.2} / {:.2} / {:.2} °C",
+            heat[0], heat[1], heat[2]
+        );
+        for (a, name) in ["X", "Y", "Z"].iter().enumerate() {
+            let (mean, drift) = (r.mean_dps[a], r.drift_dps[a]);
+            line += &format!(
+                " | {name}: mean {:+.4} → {:+.4}, drift {:.4} → {:.4}",
+                mean.0, mean.1, drift.0, drift.1
+            );
+        }
+        eprintln!("{line}");
+    }
+}
+
 /// The experiment's size and calibration.
 #[derive(Debug, Clone)]
 pub struct Plan {
@@ -223,6 +252,10 @@ pub struct Plan {
     /// was off longer than the calibration's cool-down (`drift_fit::evaluate::cooled_before`);
     /// without one it has only the temperatures it kept.
     pub clock: bool,
+    /// Whether to print, on standard error, every held-out +33 °C field activation: off-time,
+    /// residual heat at switch-on, and per axis the mean and drift before and after — where an
+    /// average's error comes from.
+    pub per_activation: bool,
 }
 
 impl Default for Plan {
@@ -233,6 +266,7 @@ impl Default for Plan {
             scale: 1.0,
             calibration: DEFAULT_CALIBRATION.to_vec(),
             clock: true,
+            per_activation: false,
         }
     }
 }
@@ -395,6 +429,9 @@ pub fn run(
         .into_iter()
         .filter(|r| r.series_kind == "field" && is(VALIDATION, r.set_point_celsius))
         .collect();
+    if plan_size.per_activation {
+        print_activations(&measured);
+    }
     let before: [Vec<(f64, f64)>; 3] = std::array::from_fn(|a| {
         measured
             .iter()

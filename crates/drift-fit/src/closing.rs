@@ -5,7 +5,7 @@
 //! activations. The command line (`gyrodrift diagnose [--extend]`), the Python module and the
 //! closed-loop experiment all run this.
 
-use drift_core::Previous;
+use drift_core::{Previous, SwitchOn};
 use drift_recording::Segment;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -64,6 +64,15 @@ pub struct BeforeAfter {
     pub by_history_drift_dps: [f64; 3],
     /// Per axis, the RMS with the curves keyed by heating history, °/s.
     pub by_history_rms_dps: [f64; 3],
+    /// Per axis, the mean of the corrected output, °/s: before, after — the activation's offset,
+    /// which the drift metric cannot see.
+    pub mean_dps: [(f64, f64); 3],
+    /// Per axis, the residual heat at switch-on as firmware estimates it from what it kept of the
+    /// unit's previous activation (`drift_core::SwitchOn::estimate`; 0 when nothing was kept), °C.
+    pub residual_heat_celsius: [f64; 3],
+    /// The off-time before the activation, as the recording labels it (the bench's clock; the
+    /// firmware does not know it), s.
+    pub off_before_s: Option<f64>,
 }
 
 /// Whether stage 3 keyed by heating history ([`FittedUnit::by_history`]) replaces the paper's
@@ -245,15 +254,19 @@ impl Closed<'_> {
                     &every_axis.correct(&fitted.by_history, segment, on).0,
                     window,
                 );
-                let (drift_before, rms_before) = metric(
-                    &correct_with_terms(&fitted.modified, &plan, segment, on, None),
-                    window,
-                );
                 let previous = self.keying.previous(segment);
-                let (drift_after, rms_after) = metric(
-                    &correct_with_terms(&*model, &plan, segment, on, previous),
-                    window,
-                );
+                let before = correct_with_terms(&fitted.modified, &plan, segment, on, None);
+                let after = correct_with_terms(&*model, &plan, segment, on, previous);
+                let (drift_before, rms_before) = metric(&before, window);
+                let (drift_after, rms_after) = metric(&after, window);
+                let mean = |rates: &[f32]| {
+                    rates.iter().map(|&r| f64::from(r)).sum::<f64>() / rates.len().max(1) as f64
+                };
+                let kept = self.keying.kept(segment);
+                let residual_heat_celsius = std::array::from_fn(|a| {
+                    let celsius = fitted.modified.settings.celsius(on[a]);
+                    f64::from(SwitchOn::estimate(celsius, Some(kept[a])).residual_heat_celsius)
+                });
                 BeforeAfter {
                     set_point_celsius: segment.labels.nominal_set_point_celsius(),
                     series_kind: segment.labels.series_kind.as_str(),
@@ -261,6 +274,9 @@ impl Closed<'_> {
                     rms_dps: std::array::from_fn(|a| (rms_before[a], rms_after[a])),
                     by_history_drift_dps: history_drift,
                     by_history_rms_dps: history_rms,
+                    mean_dps: std::array::from_fn(|a| (mean(&before[a]), mean(&after[a]))),
+                    residual_heat_celsius,
+                    off_before_s: segment.labels.off_before_s,
                 }
             })
             .collect()

@@ -102,6 +102,15 @@ impl Keying {
         })
     }
 
+    /// What firmware kept before `segment`, whether or not an axis reads it (nothing, for an
+    /// activation this keying was not built with).
+    pub fn kept(&self, segment: &Segment) -> [Previous; 3] {
+        self.kept
+            .get(&segment.power_on_ns)
+            .copied()
+            .unwrap_or(Previous::NOTHING)
+    }
+
     /// Corrects `segment` with `tables` (from [`Self::tables`]), started after what firmware kept
     /// before it when an axis is keyed by history.
     pub fn correct(

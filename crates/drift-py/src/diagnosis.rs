@@ -242,8 +242,11 @@ impl PyDiagnosis {
     }
 
     /// Per held-out activation, the error before (paper's model) and after (extended model):
-    /// records with set_point_celsius, series_kind, drift_dps and rms_dps (per axis, [before,
-    /// after]); empty unless `extend=True` and terms were proposed.
+    /// records with set_point_celsius, series_kind, drift_dps, rms_dps and mean_dps (per axis,
+    /// [before, after]; the mean is the activation's offset), by_history_drift_dps,
+    /// by_history_rms_dps, residual_heat_celsius (per axis, as firmware estimates it at switch-on)
+    /// and off_before_s (the recording's label, or None); empty unless `extend=True` and terms
+    /// were proposed.
     #[getter]
     fn before_after<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.before_after)

@@ -58,6 +58,10 @@ def test_the_hidden_supply_effect_is_found_admitted_and_lowers_the_held_out_erro
         r for r in diagnosis.before_after if r["series_kind"] == "field" and r["set_point_celsius"] == 33.0
     ]
     assert field33
+    for r in field33:
+        assert len(r["mean_dps"]) == 3 and len(r["residual_heat_celsius"]) == 3, r
+        assert all(h >= 0.0 for h in r["residual_heat_celsius"]), r
+        assert r["off_before_s"] is None or r["off_before_s"] > 0.0, r
     for axis in found:
         a = "XYZ".index(axis)
         before = sum(r["rms_dps"][a][0] for r in field33) / len(field33)

@@ -818,8 +818,11 @@ class Diagnosis:
     @property
     def before_after(self) -> list[dict[str, Any]]:
         """Per held-out activation, the error before (paper's model) and after (extended model):
-        records with set_point_celsius, series_kind, drift_dps and rms_dps (per axis, [before,
-        after]); empty unless `extend=True` and terms were proposed."""
+        records with set_point_celsius, series_kind, drift_dps, rms_dps and mean_dps (per axis,
+        [before, after]; the mean is the activation's offset), by_history_drift_dps,
+        by_history_rms_dps, residual_heat_celsius (per axis, as firmware estimates it at switch-on)
+        and off_before_s (the recording's label, or None); empty unless `extend=True` and terms
+        were proposed."""
     @property
     def activations(self) -> list[tuple[str, int]]:
         """How many activations played each part: calibration, training, held_out, outside_range,
