@@ -94,12 +94,7 @@ impl Keying {
     /// `power_on`). An activation this keying was not built with has nothing kept (a
     /// cold start, flagged).
     pub fn previous(&self, segment: &Segment) -> Option<[Previous; 3]> {
-        self.any().then(|| {
-            self.kept
-                .get(&segment.power_on_ns)
-                .copied()
-                .unwrap_or(Previous::NOTHING)
-        })
+        self.any().then(|| self.kept(segment))
     }
 
     /// What firmware kept before `segment`, whether or not an axis reads it (nothing, for an
