@@ -89,6 +89,17 @@ impl Kind {
         }
     }
 
+    /// The low-pass time constant, s, of a temperature-rate candidate's name (what [`Self::name`]
+    /// writes: "temperature rate X (τ 30 s)"); `None` for any other name.
+    pub fn rate_time_constant_s(name: &str) -> Option<u32> {
+        name.strip_prefix("temperature rate ")?
+            .split_once("(τ ")?
+            .1
+            .strip_suffix(" s)")?
+            .parse()
+            .ok()
+    }
+
     /// The candidate's values on every axis of `segment`, one per sample; `switch_on` is the raw
     /// switch-on temperature per axis. `None` when the segment lacks what the kind needs.
     pub fn values(&self, segment: &Segment, switch_on: [f32; 3]) -> Option<[Vec<f32>; 3]> {
@@ -172,6 +183,22 @@ pub fn filtered_rate(rise: &[f64], tau_s: f64, step_s: f64) -> Vec<f32> {
 mod tests {
     use super::*;
     use drift_core::{Extension, ExtensionState, ExtraTerm, Term, TermInputs};
+
+    /// A rate candidate's name gives back its filter; no other name does.
+    #[test]
+    fn a_rate_candidates_name_carries_its_time_constant() {
+        for time_constant_s in RATE_TIME_CONSTANTS_S {
+            let name = Kind::TemperatureRate { time_constant_s }.name(1);
+            assert_eq!(
+                Kind::rate_time_constant_s(&name),
+                Some(time_constant_s),
+                "{name}"
+            );
+        }
+        for other in [Kind::RiseSquared.name(0), "temperature rate X".to_owned()] {
+            assert_eq!(Kind::rate_time_constant_s(&other), None, "{other}");
+        }
+    }
 
     /// The diagnosis scores the rate the firmware's term computes: drift-core's filter, fed the
     /// same rise, gives the same values.

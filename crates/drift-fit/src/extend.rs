@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use crate::absorb::Absorber;
 use crate::analyse::analyse;
-use crate::candidates::SET_POINT_CHANNEL;
+use crate::candidates::{Kind, SET_POINT_CHANNEL};
 use crate::diagnose::AxisDiagnosis;
 use crate::error::FitError;
 use crate::evaluate::{metric, sample_at, switch_on_raw};
@@ -31,10 +31,6 @@ use crate::fit::{fit_unit, FittedUnit};
 use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
-
-/// Time constant of the temperature-rate filter, ms, for a candidate that does not name one: the
-/// diagnosis's shortest (`candidates::RATE_TIME_CONSTANTS_S`), about a ±1 s difference.
-pub const RATE_TIME_CONSTANT_MS: u32 = 2000;
 
 /// Time constant of an auxiliary term's low-pass, ms: the diagnosis scores a channel through the
 /// fit's 1-s window, and a recorded channel's sample noise (2 mV on a 5 V supply at 100 Hz) passed
@@ -70,16 +66,9 @@ impl TermPlan {
     /// Time since switch-on, switch-on temperature and the off-time estimate are the table's own
     /// inputs; campaign time is ageing, which no thermal term should model.
     fn term_for(&mut self, candidate: &str) -> Option<Term> {
-        if let Some(rest) = candidate.strip_prefix("temperature rate ") {
-            // "X (τ 30 s)": the filter the diagnosis scored the rate through.
-            let time_constant_ms = match rest.split_once("(τ ") {
-                Some((_, tau)) => tau
-                    .strip_suffix(" s)")?
-                    .parse::<u32>()
-                    .ok()?
-                    .checked_mul(1000)?,
-                None => RATE_TIME_CONSTANT_MS,
-            };
+        if let Some(time_constant_s) = Kind::rate_time_constant_s(candidate) {
+            // The filter the diagnosis scored the rate through.
+            let time_constant_ms = time_constant_s.checked_mul(1000)?;
             // drift-core keeps one rate filter per axis, so every rate term shares its τ: the
             // best-ranked rate candidate sets it.
             if self.terms.iter().any(|t| {
