@@ -8,7 +8,8 @@
 //! ```
 //!
 //! `--calibration` sets the calibration set points (°C, increasing; +33 °C is the validation set
-//! point and cannot be one); the protocol and field sessions are recorded at each.
+//! point and cannot be one); the protocol and field sessions are recorded at each. `--intervals`
+//! sets the calibration protocol's off-times (min, increasing; default 1,2,5,10,30).
 
 use gyrodrift::closed_loop::{run, Plan, Row};
 
@@ -58,14 +59,16 @@ fn cut(before: f64, after: f64, floor: f64, ratio: f64) -> String {
 }
 
 const USAGE: &str = "closed_loop [--seeds 1] [--first-seed 1] [--sessions 6] [--scale 1] \
-[--effects none,thermal_lag,…] [--calibration 30,40] [--clock yes|no] [--per-activation no|yes]";
-const FLAGS: [&str; 8] = [
+[--effects none,thermal_lag,…] [--calibration 30,40] [--intervals 1,2,5,10,30] [--clock yes|no] \
+[--per-activation no|yes]";
+const FLAGS: [&str; 9] = [
     "--seeds",
     "--first-seed",
     "--sessions",
     "--scale",
     "--effects",
     "--calibration",
+    "--intervals",
     "--clock",
     "--per-activation",
 ];
@@ -108,11 +111,15 @@ fn main() -> anyhow::Result<()> {
             Some("yes") => true,
             Some(other) => anyhow::bail!("--per-activation takes yes or no, got `{other}`"),
         },
+        intervals_min: value("--intervals").map_or(Ok(defaults.intervals_min), |s| {
+            s.split(',').map(|t| t.trim().parse::<f64>()).collect()
+        })?,
     };
     plan.check()?;
     eprintln!(
-        "calibration set points {:?} °C; history-keyed firmware {} a clock",
+        "calibration set points {:?} °C, off-times {:?} min; history-keyed firmware {} a clock",
         plan.calibration,
+        plan.intervals_min,
         if plan.clock { "with" } else { "without" }
     );
     let effects: Vec<String> = value("--effects").map_or_else(

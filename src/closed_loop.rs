@@ -23,6 +23,9 @@ use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, Uni
 
 /// The paper's calibration set points (°C).
 pub const DEFAULT_CALIBRATION: [f64; 2] = [30.0, 40.0];
+
+/// The calibration protocol's off-times, min: the paper's 1–30 min.
+pub const DEFAULT_INTERVALS_MIN: [f64; 5] = [1.0, 2.0, 5.0, 10.0, 30.0];
 /// The set point the error is measured at (°C): never a calibration one.
 pub const VALIDATION: f64 = 33.0;
 
@@ -95,7 +98,7 @@ pub fn campaign(
         }
     } else {
         Protocol {
-            intervals_min: vec![1.0, 2.0, 5.0, 10.0, 30.0],
+            intervals_min: plan.intervals_min.clone(),
             repeats: 2,
             ..Protocol::default()
         }
@@ -256,6 +259,10 @@ pub struct Plan {
     /// residual heat at switch-on, and per axis the mean and drift before and after — where an
     /// average's error comes from.
     pub per_activation: bool,
+    /// The calibration protocol's off-times, min, increasing (each a series of activations,
+    /// twice). The shortest is the warmest start the tables measure; the field switches the unit
+    /// off for 0.5–40 min, and a shorter off-time is extrapolated from the warmest.
+    pub intervals_min: Vec<f64>,
 }
 
 impl Default for Plan {
@@ -267,6 +274,7 @@ impl Default for Plan {
             calibration: DEFAULT_CALIBRATION.to_vec(),
             clock: true,
             per_activation: false,
+            intervals_min: DEFAULT_INTERVALS_MIN.to_vec(),
         }
     }
 }
@@ -288,6 +296,13 @@ impl Plan {
         anyhow::ensure!(
             !c.iter().any(|&t| is(VALIDATION, t)),
             "{VALIDATION} °C is the validation set point: it cannot be calibrated on"
+        );
+        let i = &self.intervals_min;
+        anyhow::ensure!(
+            !i.is_empty()
+                && i.iter().all(|m| m.is_finite() && *m > 0.0)
+                && i.windows(2).all(|w| w[0] < w[1]),
+            "calibration intervals must be positive and strictly increasing (min), got {i:?}"
         );
         Ok(())
     }
@@ -531,6 +546,22 @@ mod tests {
         for refused in [vec![30.0], vec![40.0, 30.0], vec![30.0, 33.0, 40.0]] {
             let plan = Plan {
                 calibration: refused,
+                ..Plan::default()
+            };
+            assert!(plan.check().is_err(), "{plan:?}");
+        }
+    }
+
+    #[test]
+    fn calibration_off_times_must_be_positive_and_increasing() {
+        let shorter = Plan {
+            intervals_min: vec![0.5, 1.0, 2.0, 5.0, 10.0, 30.0],
+            ..Plan::default()
+        };
+        shorter.check().unwrap();
+        for refused in [vec![], vec![0.0, 1.0], vec![5.0, 1.0], vec![1.0, f64::NAN]] {
+            let plan = Plan {
+                intervals_min: refused,
                 ..Plan::default()
             };
             assert!(plan.check().is_err(), "{plan:?}");
