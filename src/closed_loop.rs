@@ -23,11 +23,10 @@ use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, Uni
 
 /// The paper's calibration set points (°C).
 pub const DEFAULT_CALIBRATION: [f64; 2] = [30.0, 40.0];
-
-/// The calibration protocol's off-times, min: the paper's 1–30 min.
-pub const DEFAULT_INTERVALS_MIN: [f64; 5] = [1.0, 2.0, 5.0, 10.0, 30.0];
 /// The set point the error is measured at (°C): never a calibration one.
 pub const VALIDATION: f64 = 33.0;
+/// The calibration protocol's off-times, min: the paper's 1–30 min.
+pub const DEFAULT_INTERVALS_MIN: [f64; 5] = [1.0, 2.0, 5.0, 10.0, 30.0];
 
 /// Field-like use without ambient ramps or carried units (the paper's own field gap, reported
 /// on its own row): random off-times, supply voltage and orientation changing per activation,
@@ -261,7 +260,7 @@ pub struct Plan {
     pub per_activation: bool,
     /// The calibration protocol's off-times, min, increasing (each a series of activations,
     /// twice). The shortest is the warmest start the tables measure; the field switches the unit
-    /// off for 0.5–40 min, and a shorter off-time is extrapolated from the warmest.
+    /// off for 0.5–40 min, and a start after a shorter off-time is held at the warmest.
     pub intervals_min: Vec<f64>,
 }
 
