@@ -10,6 +10,9 @@
 //! `--calibration` sets the calibration set points (°C, increasing; +33 °C is the validation set
 //! point and cannot be one); the protocol and field sessions are recorded at each. `--intervals`
 //! sets the calibration protocol's off-times (min, increasing; default 1,2,5,10,30).
+//! `--per-activation yes` prints each held-out +33 °C field activation's offset and drift before
+//! and after; `--profile yes` where within the activations the loop's residual sits, by time since
+//! switch-on and off-time before.
 
 use gyrodrift::closed_loop::{run, Plan, Row};
 
@@ -60,8 +63,8 @@ fn cut(before: f64, after: f64, floor: f64, ratio: f64) -> String {
 
 const USAGE: &str = "closed_loop [--seeds 1] [--first-seed 1] [--sessions 6] [--scale 1] \
 [--effects none,thermal_lag,…] [--calibration 30,40] [--intervals 1,2,5,10,30] [--clock yes|no] \
-[--per-activation no|yes]";
-const FLAGS: [&str; 9] = [
+[--per-activation no|yes] [--profile no|yes]";
+const FLAGS: [&str; 10] = [
     "--seeds",
     "--first-seed",
     "--sessions",
@@ -71,6 +74,7 @@ const FLAGS: [&str; 9] = [
     "--intervals",
     "--clock",
     "--per-activation",
+    "--profile",
 ];
 
 fn main() -> anyhow::Result<()> {
@@ -110,6 +114,11 @@ fn main() -> anyhow::Result<()> {
             None | Some("no") => false,
             Some("yes") => true,
             Some(other) => anyhow::bail!("--per-activation takes yes or no, got `{other}`"),
+        },
+        profile: match value("--profile").as_deref() {
+            None | Some("no") => false,
+            Some("yes") => true,
+            Some(other) => anyhow::bail!("--profile takes yes or no, got `{other}`"),
         },
         intervals_min: value("--intervals").map_or(Ok(defaults.intervals_min), |s| {
             s.split(',').map(|t| t.trim().parse::<f64>()).collect()

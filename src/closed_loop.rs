@@ -14,7 +14,7 @@ use std::path::Path;
 
 use anyhow::Context;
 use drift_fit::analyse::analyse;
-use drift_fit::closing::{close, BeforeAfter};
+use drift_fit::closing::{close, BeforeAfter, Profile, PROFILE_EDGES_S};
 use drift_fit::evaluate;
 use drift_fit::roles::Roles;
 use drift_fit::{fit_unit, FitSettings};
@@ -238,6 +238,65 @@ fn print_activations(measured: &[BeforeAfter]) {
     }
 }
 
+/// Prints, on standard error, where within the held-out +33 °C activations the loop's residual
+/// sits: per group (the protocol; the field by the off-time before) and axis, the mean over the
+/// group of each activation's [`Profile`], 10⁻⁴ °/s.
+fn print_profiles(profiles: &[Profile]) {
+    const GROUPS: [&str; 4] = [
+        "protocol",
+        "field, off < 90 s",
+        "field, off 90–600 s",
+        "field, off ≥ 600 s",
+    ];
+    let group_of = |p: &Profile| -> Option<&str> {
+        let off = p.off_before_s.unwrap_or(f64::INFINITY);
+        match p.series_kind {
+            "protocol" => Some(GROUPS[0]),
+            "field" if off < 90.0 => Some(GROUPS[1]),
+            "field" if off < 600.0 => Some(GROUPS[2]),
+            "field" => Some(GROUPS[3]),
+            _ => None,
+        }
+    };
+    let bins: Vec<String> = PROFILE_EDGES_S
+        .windows(2)
+        .map(|b| {
+            if b[1].is_finite() {
+                format!("{}–{} s", b[0], b[1])
+            } else {
+                format!("{} s–end", b[0])
+            }
+        })
+        .collect();
+    eprintln!(
+        "  held-out +{VALIDATION} °C residual of the loop's model less each activation's mean, 10⁻⁴ °/s, by time since switch-on: {}",
+        bins.join(" | ")
+    );
+    for name in GROUPS {
+        let group: Vec<&Profile> = profiles
+            .iter()
+            .filter(|p| is(VALIDATION, p.set_point_celsius) && group_of(p) == Some(name))
+            .collect();
+        for (a, axis) in ["X", "Y", "Z"].iter().enumerate() {
+            let means: Vec<String> = (0..bins.len())
+                .map(|b| {
+                    let values: Vec<f64> = group
+                        .iter()
+                        .filter_map(|p| p.after_dps[a].get(b).copied())
+                        .filter(|v| v.is_finite())
+                        .collect();
+                    if values.is_empty() {
+                        "–".to_owned()
+                    } else {
+                        format!("{:+.0}", mean(&values) * 1e4)
+                    }
+                })
+                .collect();
+            eprintln!("    {name} ({}), {axis}: {}", group.len(), means.join(" "));
+        }
+    }
+}
+
 /// The experiment's size and calibration.
 #[derive(Debug, Clone)]
 pub struct Plan {
@@ -258,6 +317,9 @@ pub struct Plan {
     /// residual heat at switch-on, and per axis the mean and drift before and after — where an
     /// average's error comes from.
     pub per_activation: bool,
+    /// Whether to print, on standard error, where within the held-out +33 °C activations the
+    /// loop's residual sits, by time since switch-on ([`drift_fit::closing::Closed::profiles`]).
+    pub profile: bool,
     /// The calibration protocol's off-times, min, increasing (each a series of activations,
     /// twice). The shortest is the warmest start the tables measure; the field switches the unit
     /// off for 0.5–40 min, and a start after a shorter off-time is held at the warmest.
@@ -273,6 +335,7 @@ impl Default for Plan {
             calibration: DEFAULT_CALIBRATION.to_vec(),
             clock: true,
             per_activation: false,
+            profile: false,
             intervals_min: DEFAULT_INTERVALS_MIN.to_vec(),
         }
     }
@@ -445,6 +508,9 @@ pub fn run(
         .collect();
     if plan_size.per_activation {
         print_activations(&measured);
+    }
+    if plan_size.profile {
+        print_profiles(&closed.profiles(&base, settings));
     }
     let before: [Vec<(f64, f64)>; 3] = std::array::from_fn(|a| {
         measured

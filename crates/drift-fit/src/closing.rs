@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use crate::diagnose::{diagnose, paired_choice, ActivationSeries, AxisDiagnosis, Diagnoser};
 use crate::error::FitError;
-use crate::evaluate::{correct_segment_after, kept_before, metric, switch_on_raw};
+use crate::evaluate::{correct_segment_after, kept_before, metric, profile, switch_on_raw};
 use crate::extend::{correct_with_terms, extend, Extended, TermPlan};
 use crate::fit::FittedUnit;
 use crate::keying::Keying;
@@ -73,6 +73,38 @@ pub struct BeforeAfter {
     /// The off-time before the activation, as the recording labels it (the bench's clock; the
     /// firmware does not know it), s.
     pub off_before_s: Option<f64>,
+}
+
+/// Bins of [`Closed::profiles`], s since switch-on: fine over the first 30 s, where a warm start's
+/// transient fades, coarser after; the last bin runs to the activation's end.
+pub const PROFILE_EDGES_S: [f64; 13] = [
+    0.0,
+    1.0,
+    2.0,
+    4.0,
+    7.0,
+    10.0,
+    15.0,
+    20.0,
+    30.0,
+    45.0,
+    60.0,
+    90.0,
+    f64::INFINITY,
+];
+
+/// Where within one held-out activation the loop's residual sits ([`Closed::profiles`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Profile {
+    /// The set point the activation belongs to, °C.
+    pub set_point_celsius: f64,
+    /// `protocol` or `field`.
+    pub series_kind: &'static str,
+    /// The off-time before the activation, as the recording labels it, s.
+    pub off_before_s: Option<f64>,
+    /// Per axis and [`PROFILE_EDGES_S`] bin, the loop's 1-s residual there less its activation
+    /// mean, °/s ([`crate::evaluate::profile`]).
+    pub after_dps: [Vec<f64>; 3],
 }
 
 /// Whether stage 3 keyed by heating history ([`FittedUnit::by_history`]) replaces the paper's
@@ -234,6 +266,45 @@ impl Closed<'_> {
         )
     }
 
+    /// The loop's output on `segment` (one of the unit's activations): [`Closed::model`] with the
+    /// admitted terms (`plan`), started after what firmware kept before it.
+    fn corrected(
+        &self,
+        model: &drift_core::ModifiedTables,
+        plan: &TermPlan,
+        segment: &Segment,
+        on: [f32; 3],
+    ) -> [Vec<f32>; 3] {
+        correct_with_terms(model, plan, segment, on, self.keying.previous(segment))
+    }
+
+    /// Where within each held-out activation the loop's residual sits, in
+    /// [`PROFILE_EDGES_S`] bins since switch-on: what separates a transient after switch-on
+    /// from an offset or a ramp (`docs/closed-loop.md`, *Session 11*).
+    pub fn profiles(&self, fitted: &FittedUnit, settings: &FitSettings) -> Vec<Profile> {
+        let plan = self.admitted();
+        let model = self.model(fitted);
+        self.roles
+            .held_out
+            .par_iter()
+            .map(|segment| {
+                let on = switch_on_raw(segment, settings);
+                let after = self.corrected(&model, &plan, segment, on);
+                Profile {
+                    set_point_celsius: segment.labels.nominal_set_point_celsius(),
+                    series_kind: segment.labels.series_kind.as_str(),
+                    off_before_s: segment.labels.off_before_s,
+                    after_dps: profile(
+                        &after,
+                        settings.lowpass_window_samples,
+                        f64::from(segment.sample_rate_hz),
+                        &PROFILE_EDGES_S,
+                    ),
+                }
+            })
+            .collect()
+    }
+
     /// The error before (the paper's model `fitted`) and after (the loop's model,
     /// [`Closed::model`]: the paper's when nothing was chosen or admitted) on every held-out
     /// activation.
@@ -254,9 +325,8 @@ impl Closed<'_> {
                     &every_axis.correct(&fitted.by_history, segment, on).0,
                     window,
                 );
-                let previous = self.keying.previous(segment);
                 let before = correct_with_terms(&fitted.modified, &plan, segment, on, None);
-                let after = correct_with_terms(&*model, &plan, segment, on, previous);
+                let after = self.corrected(&model, &plan, segment, on);
                 let (drift_before, rms_before) = metric(&before, window);
                 let (drift_after, rms_after) = metric(&after, window);
                 let mean = |rates: &[f32]| {

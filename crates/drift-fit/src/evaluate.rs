@@ -91,6 +91,35 @@ pub fn metric(rates: &[Vec<f32>; 3], window: usize) -> ([f64; 3], [f64; 3]) {
     (drift, rms)
 }
 
+/// Per axis, where within the activation the low-passed rate sits: its mean over each time bin
+/// since switch-on (`edges_s`, s, increasing; bin `i` is `[edges_s[i], edges_s[i + 1])`) less its
+/// mean over the whole activation, °/s; NaN for a bin the activation ends before. The drift metric
+/// says how far the residual moves within an activation; this says when, which separates an
+/// offset (no profile), a transient after switch-on, and a slow ramp.
+pub fn profile(
+    rates: &[Vec<f32>; 3],
+    window: usize,
+    rate_hz: f64,
+    edges_s: &[f64],
+) -> [Vec<f64>; 3] {
+    std::array::from_fn(|axis| {
+        let low = centred_moving_average(&rates[axis], window);
+        let whole = low.iter().sum::<f64>() / low.len().max(1) as f64;
+        let index = |s: f64| ((s * rate_hz).max(0.0) as usize).min(low.len());
+        edges_s
+            .windows(2)
+            .map(|bin| {
+                let part = &low[index(bin[0])..index(bin[1]).max(index(bin[0]))];
+                if part.is_empty() {
+                    f64::NAN
+                } else {
+                    part.iter().sum::<f64>() / part.len() as f64 - whole
+                }
+            })
+            .collect()
+    })
+}
+
 /// The noise floor of `activations` (one zero-drift unit's, recorded like the unit they stand
 /// beside): per axis, the mean over them of [`metric`]'s drift and RMS of the uncorrected rate
 /// less the unit's constant bias (its mean over every one of them). What a perfect model would
@@ -338,6 +367,19 @@ mod tests {
     use drift_recording::{SegmentLabels, SeriesKind};
 
     use super::*;
+
+    /// A step 10 s after switch-on, sampled at 10 Hz for 30 s, unfiltered: the bins read the step
+    /// against the activation's mean, and a bin past the end is NaN.
+    #[test]
+    fn a_profile_places_a_step_in_its_bin() {
+        let step: Vec<f32> = (0..300).map(|i| if i < 100 { 0.0 } else { 3.0 }).collect();
+        let rates = [step.clone(), vec![1.0; 300], step];
+        let [x, y, _] = profile(&rates, 1, 10.0, &[0.0, 10.0, 30.0, 60.0]);
+        // Mean 2.0: the first 10 s stand 2 below it, the next 20 s 1 above.
+        assert_eq!(x[..2], [-2.0, 1.0]);
+        assert!(x[2].is_nan(), "{x:?}");
+        assert_eq!(y[..2], [0.0, 0.0], "a constant has no profile");
+    }
 
     /// An activation switched on at `power_on_s` after `off_before_s` off, its temperature
     /// readings going from `on` to `off` °C (200 raw units per °C).
