@@ -5,16 +5,20 @@
 use std::sync::Arc;
 
 use drift_fit::closing::close;
-use drift_fit::closing::{BeforeAfter, Stage3Choice};
+use drift_fit::closing::{BeforeAfter, Profile, Stage3Choice, PROFILE_EDGES_S};
 use drift_fit::diagnose::AxisDiagnosis;
 use drift_fit::extend::Admission;
 use drift_fit::warm_start::WarmStartChoice;
 use drift_fit::{FitSettings, FittedUnit};
 use drift_recording::{read_recording, Segment};
+use numpy::ndarray::Array3;
+use numpy::IntoPyArray;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use serde::Serialize;
 
 use crate::errors::Error;
+use crate::outputs::vector;
 use crate::sources::{self, Source};
 use crate::tables::PyModifiedTables;
 
@@ -32,6 +36,7 @@ pub struct PyDiagnosis {
     extended: Option<PyModifiedTables>,
     aux_inputs: Vec<String>,
     before_after: Vec<BeforeAfter>,
+    profiles: Vec<Profile>,
     counts: [(&'static str, usize); 5],
 }
 
@@ -139,6 +144,7 @@ pub fn diagnose_unit(
                 .map(|e| e.plan.aux_inputs.clone())
                 .unwrap_or_default(),
             before_after,
+            profiles: closed.profiles(unit, settings),
             counts: [
                 ("calibration", closed.roles.calibration.len()),
                 ("training", closed.roles.training.len()),
@@ -250,6 +256,36 @@ impl PyDiagnosis {
     #[getter]
     fn before_after<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.before_after)
+    }
+
+    /// Where within each held-out activation the loop's residual sits, by time since switch-on: a
+    /// dict of numpy arrays — `edges_s` (float64, (13,): bin edges, s; the last is inf, the
+    /// activation's end), `after_dps` (float64, (n, 3, 12): per activation, axis and bin, the
+    /// loop's 1-s residual's mean there less the activation's mean, °/s; NaN for a bin the
+    /// activation ends before), `off_before_s` (float64, (n,); NaN when not recorded),
+    /// `set_point_celsius` (float64, (n,)) — and `series_kind` (list of `protocol` / `field`).
+    #[getter]
+    fn profiles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let bins = PROFILE_EDGES_S.len() - 1;
+        let after: Vec<f64> = self
+            .profiles
+            .iter()
+            .flat_map(|p| p.after_dps.iter().flat_map(|axis| axis.iter().copied()))
+            .collect();
+        let after = Array3::from_shape_vec((self.profiles.len(), 3, bins), after)
+            .map_err(|e| Error::Input(format!("internal: profile shape: {e}")))?;
+        let dict = PyDict::new(py);
+        dict.set_item("edges_s", vector(py, PROFILE_EDGES_S.to_vec()))?;
+        dict.set_item("after_dps", after.into_pyarray(py))?;
+        let of = |f: fn(&Profile) -> f64| self.profiles.iter().map(f).collect::<Vec<f64>>();
+        dict.set_item(
+            "off_before_s",
+            vector(py, of(|p| p.off_before_s.unwrap_or(f64::NAN))),
+        )?;
+        dict.set_item("set_point_celsius", vector(py, of(|p| p.set_point_celsius)))?;
+        let kinds: Vec<&str> = self.profiles.iter().map(|p| p.series_kind).collect();
+        dict.set_item("series_kind", kinds)?;
+        Ok(dict)
     }
 
     /// How many activations played each part: calibration, training, held_out, outside_range,

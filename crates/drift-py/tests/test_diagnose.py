@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 import gyrodrift
@@ -67,6 +68,25 @@ def test_the_hidden_supply_effect_is_found_admitted_and_lowers_the_held_out_erro
         before = sum(r["rms_dps"][a][0] for r in field33) / len(field33)
         after = sum(r["rms_dps"][a][1] for r in field33) / len(field33)
         assert after < 0.8 * before, (axis, before, after)
+
+
+def test_profiles_place_the_held_out_residual_in_time_since_switch_on(
+    diagnosis: gyrodrift.Diagnosis,
+) -> None:
+    profiles = diagnosis.profiles
+    edges = profiles["edges_s"]
+    assert edges[0] == 0.0 and np.isinf(edges[-1]) and np.all(np.diff(edges) > 0)
+    after = profiles["after_dps"]
+    n = dict(diagnosis.activations)["held_out"]
+    assert after.shape == (n, 3, len(edges) - 1) and after.dtype == np.float64
+    assert len(profiles["series_kind"]) == n == profiles["off_before_s"].shape[0]
+    assert set(profiles["series_kind"]) <= {"protocol", "field"}
+    # Every activation outlasts the first minute, and a residual less its own mean has bins on
+    # both sides of zero unless it is flat.
+    first_minute = after[:, :, :10]
+    assert np.all(np.isfinite(first_minute))
+    assert np.all(np.abs(first_minute) < 0.05), np.abs(first_minute).max()
+    assert np.any(first_minute > 0.0) and np.any(first_minute < 0.0)
 
 
 def test_the_ranking_is_records_with_every_axis(diagnosis: gyrodrift.Diagnosis) -> None:

@@ -824,6 +824,14 @@ class Diagnosis:
         and off_before_s (the recording's label, or None); empty unless `extend=True` and terms
         were proposed."""
     @property
+    def profiles(self) -> dict[str, Any]:
+        """Where within each held-out activation the loop's residual sits, by time since
+        switch-on: `edges_s` (float64, (13,): bin edges, s; the last is inf, the activation's end),
+        `after_dps` (float64, (n, 3, 12): per activation, axis and bin, the loop's 1-s residual's
+        mean there less the activation's mean, °/s; NaN for a bin the activation ends before),
+        `off_before_s` (float64, (n,); NaN when not recorded), `set_point_celsius` (float64,
+        (n,)) and `series_kind` (list of "protocol" / "field")."""
+    @property
     def activations(self) -> list[tuple[str, int]]:
         """How many activations played each part: calibration, training, held_out, outside_range,
         diagnosed."""
