@@ -14,12 +14,14 @@ use std::path::Path;
 
 use anyhow::Context;
 use drift_fit::analyse::analyse;
-use drift_fit::closing::{close, BeforeAfter, Profile, PROFILE_EDGES_S};
+use drift_fit::closing::{close, mean_profiles, profile_bin_labels, BeforeAfter, Profile};
 use drift_fit::evaluate;
 use drift_fit::roles::Roles;
 use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{read_recording, Segment, SeriesKind};
 use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, UnitModel};
+
+use crate::report::tables::ten_thousandths;
 
 /// The paper's calibration set points (°C).
 pub const DEFAULT_CALIBRATION: [f64; 2] = [30.0, 40.0];
@@ -242,57 +244,18 @@ fn print_activations(measured: &[BeforeAfter]) {
 /// sits: per group (the protocol; the field by the off-time before) and axis, the mean over the
 /// group of each activation's [`Profile`], 10⁻⁴ °/s.
 fn print_profiles(profiles: &[Profile]) {
-    const GROUPS: [&str; 4] = [
-        "protocol",
-        "field, off < 90 s",
-        "field, off 90–600 s",
-        "field, off ≥ 600 s",
-    ];
-    let group_of = |p: &Profile| -> Option<&str> {
-        let off = p.off_before_s.unwrap_or(f64::INFINITY);
-        match p.series_kind {
-            "protocol" => Some(GROUPS[0]),
-            "field" if off < 90.0 => Some(GROUPS[1]),
-            "field" if off < 600.0 => Some(GROUPS[2]),
-            "field" => Some(GROUPS[3]),
-            _ => None,
-        }
-    };
-    let bins: Vec<String> = PROFILE_EDGES_S
-        .windows(2)
-        .map(|b| {
-            if b[1].is_finite() {
-                format!("{}–{} s", b[0], b[1])
-            } else {
-                format!("{} s–end", b[0])
-            }
-        })
-        .collect();
     eprintln!(
         "  held-out +{VALIDATION} °C residual of the loop's model less each activation's mean, 10⁻⁴ °/s, by time since switch-on: {}",
-        bins.join(" | ")
+        profile_bin_labels().join(" | ")
     );
-    for name in GROUPS {
-        let group: Vec<&Profile> = profiles
-            .iter()
-            .filter(|p| is(VALIDATION, p.set_point_celsius) && group_of(p) == Some(name))
-            .collect();
-        for (a, axis) in ["X", "Y", "Z"].iter().enumerate() {
-            let means: Vec<String> = (0..bins.len())
-                .map(|b| {
-                    let values: Vec<f64> = group
-                        .iter()
-                        .filter_map(|p| p.after_dps[a].get(b).copied())
-                        .filter(|v| v.is_finite())
-                        .collect();
-                    if values.is_empty() {
-                        "–".to_owned()
-                    } else {
-                        format!("{:+.0}", mean(&values) * 1e4)
-                    }
-                })
-                .collect();
-            eprintln!("    {name} ({}), {axis}: {}", group.len(), means.join(" "));
+    let at_validation: Vec<&Profile> = profiles
+        .iter()
+        .filter(|p| is(VALIDATION, p.set_point_celsius))
+        .collect();
+    for (group, count, means) in mean_profiles(&at_validation) {
+        for (axis, means) in ["X", "Y", "Z"].iter().zip(means) {
+            let cells = ten_thousandths(&means);
+            eprintln!("    {group} ({count}), {axis}: {}", cells.join(" "));
         }
     }
 }

@@ -117,6 +117,23 @@ fn simulate_fit_and_report_from_the_command_line() {
     // The loop kept the paper's model: what it lacked is what is left, and said once.
     assert_eq!(unit["paper_axes"], unit["axes"], "{unit}");
     assert!(!md.contains("What the paper's model lacked"), "{md}");
+    // Where within the held-out activations the residual sits: every held-out activation, per
+    // axis one value per bin, and the section's table for the protocol at +33 °C.
+    let profiles = unit["profiles"].as_array().unwrap();
+    assert!(!profiles.is_empty(), "{unit}");
+    for p in profiles {
+        let axes = p["after_dps"].as_array().unwrap();
+        assert!(
+            axes.len() == 3 && axes.iter().all(|a| a.as_array().unwrap().len() == 12),
+            "{p}"
+        );
+    }
+    assert!(
+        md.contains("## Where within the held-out activations the residual sits")
+            && md.contains("| protocol (")
+            && md.contains("| 0–1 s | 1–2 s |"),
+        "{md}"
+    );
     // Closing the loop on a campaign without field sessions: the section says what it could do.
     let extended = dir.path().join("extended");
     run(&[

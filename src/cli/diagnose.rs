@@ -4,7 +4,9 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use drift_fit::closing::{close, BeforeAfter, Closed, Stage3Choice};
+use drift_fit::closing::{
+    close, mean_profiles, profile_bin_labels, BeforeAfter, Closed, Profile, Stage3Choice,
+};
 use drift_fit::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_fit::pipeline;
 use drift_fit::warm_start::WarmStartChoice;
@@ -15,6 +17,7 @@ use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use crate::output::write_atomic;
 use crate::report::plots;
+use crate::report::tables::ten_thousandths;
 
 /// Options of `gyrodrift diagnose`.
 #[derive(Debug, clap::Args)]
@@ -160,6 +163,34 @@ fn history_table(held_out: &[BeforeAfter]) -> String {
         );
     }
     md.push_str("\nDrift in °/s (max − min of the 1-s mean per activation); keyed by history, each activation starts from what firmware kept of the one before (with a clock that tells a full cool-down).\n\n");
+    md
+}
+
+/// Where within the held-out activations the loop's residual sits, as Markdown: per set point, the
+/// mean profile of each group (the protocol, the field by off-time before) and axis.
+fn profile_markdown(profiles: &[Profile]) -> String {
+    let bins = profile_bin_labels();
+    let mut md = String::from("## Where within the held-out activations the residual sits\n\n");
+    md.push_str("The loop's model's residual (1-s mean) less each activation's own mean, averaged over the activations of a group in bins of time since switch-on, 10⁻⁴ °/s. An offset does not show here; a transient after switch-on, or a ramp, does — and when it happens, which the drift metric (max − min) does not say. After a short off-time, a transient that fades within a minute is a warm start the model does not follow (`docs/closed-loop.md`, *Session 11*).\n\n");
+    let mut set_points: Vec<f64> = profiles.iter().map(|p| p.set_point_celsius).collect();
+    set_points.sort_by(f64::total_cmp);
+    set_points.dedup();
+    for set_point in set_points {
+        let here: Vec<&Profile> = profiles
+            .iter()
+            .filter(|p| p.set_point_celsius == set_point)
+            .collect();
+        let _ = writeln!(md, "**{set_point:+} °C**\n");
+        let _ = writeln!(md, "| group | axis | {} |", bins.join(" | "));
+        let _ = writeln!(md, "|---|---|{}", "---:|".repeat(bins.len()));
+        for (group, count, means) in mean_profiles(&here) {
+            for (axis, means) in ["X", "Y", "Z"].iter().zip(means) {
+                let cells = ten_thousandths(&means);
+                let _ = writeln!(md, "| {group} ({count}) | {axis} | {} |", cells.join(" | "));
+            }
+        }
+        md.push('\n');
+    }
     md
 }
 
@@ -462,6 +493,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 );
             }
         }
+        let profiles = closed.profiles(fitted, &options.fit);
+        md.push_str(&profile_markdown(&profiles));
         if args.extend {
             md.push_str(&super::extend::run(
                 unit,
@@ -482,6 +515,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "stage3": stage3,
             "warm_start": warm_start,
             "before_after": before_after,
+            "profiles": profiles,
         }));
     }
     write_atomic(&args.out.join("diagnosis.md"), md.as_bytes())?;

@@ -4,7 +4,7 @@
 mod figures;
 pub mod measured;
 pub mod plots;
-mod tables;
+pub(crate) mod tables;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

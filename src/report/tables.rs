@@ -284,3 +284,30 @@ pub fn residual_rms(records: &[Record], fitted: &[FittedUnit]) -> String {
     md.push('\n');
     md
 }
+
+/// Residuals as table cells in 10⁻⁴ °/s, signed ("+12", "-3"); "–" where there is none (NaN).
+pub fn ten_thousandths(values: &[f64]) -> Vec<String> {
+    values
+        .iter()
+        .map(|v| {
+            if v.is_finite() {
+                format!("{:+.0}", v * 1e4)
+            } else {
+                "–".to_owned()
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ten_thousandths;
+
+    #[test]
+    fn residuals_read_in_ten_thousandths_and_a_missing_one_says_so() {
+        assert_eq!(
+            ten_thousandths(&[0.0012, -0.00004, f64::NAN]),
+            ["+12", "-0", "–"]
+        );
+    }
+}

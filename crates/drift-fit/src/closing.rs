@@ -94,7 +94,7 @@ pub const PROFILE_EDGES_S: [f64; 13] = [
 ];
 
 /// Where within one held-out activation the loop's residual sits ([`Closed::profiles`]).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Profile {
     /// The set point the activation belongs to, °C.
     pub set_point_celsius: f64,
@@ -105,6 +105,75 @@ pub struct Profile {
     /// Per axis and [`PROFILE_EDGES_S`] bin, the loop's 1-s residual there less its activation
     /// mean, °/s ([`crate::evaluate::profile`]).
     pub after_dps: [Vec<f64>; 3],
+}
+
+/// The groups [`mean_profiles`] averages in, in order: the protocol, and the field by the off-time
+/// before (a warm start's transient depends on it).
+pub const PROFILE_GROUPS: [&str; 5] = [
+    "protocol",
+    "field, off < 90 s",
+    "field, off 90–600 s",
+    "field, off ≥ 600 s",
+    "field, off-time not recorded",
+];
+
+impl Profile {
+    /// The one of [`PROFILE_GROUPS`] this activation belongs to.
+    pub fn group(&self) -> &'static str {
+        let [protocol, short, medium, long, unknown] = PROFILE_GROUPS;
+        match (self.series_kind, self.off_before_s) {
+            ("protocol", _) => protocol,
+            (_, None) => unknown,
+            (_, Some(off)) if off < 90.0 => short,
+            (_, Some(off)) if off < 600.0 => medium,
+            (_, Some(_)) => long,
+        }
+    }
+}
+
+/// The mean profile of each group of `profiles` that has any ([`PROFILE_GROUPS`] order): the group,
+/// its activations and per axis and bin the mean over them (NaN where none reaches the bin).
+pub fn mean_profiles(profiles: &[&Profile]) -> Vec<(&'static str, usize, [Vec<f64>; 3])> {
+    PROFILE_GROUPS
+        .iter()
+        .filter_map(|&group| {
+            let members: Vec<&&Profile> = profiles.iter().filter(|p| p.group() == group).collect();
+            if members.is_empty() {
+                return None;
+            }
+            let means = std::array::from_fn(|axis| {
+                (0..PROFILE_EDGES_S.len() - 1)
+                    .map(|bin| {
+                        let values: Vec<f64> = members
+                            .iter()
+                            .filter_map(|p| p.after_dps[axis].get(bin).copied())
+                            .filter(|v| v.is_finite())
+                            .collect();
+                        if values.is_empty() {
+                            f64::NAN
+                        } else {
+                            values.iter().sum::<f64>() / values.len() as f64
+                        }
+                    })
+                    .collect()
+            });
+            Some((group, members.len(), means))
+        })
+        .collect()
+}
+
+/// The bins of [`PROFILE_EDGES_S`] as labels ("0–1 s", …, "90 s–end").
+pub fn profile_bin_labels() -> Vec<String> {
+    PROFILE_EDGES_S
+        .windows(2)
+        .map(|b| {
+            if b[1].is_finite() {
+                format!("{}–{} s", b[0], b[1])
+            } else {
+                format!("{} s–end", b[0])
+            }
+        })
+        .collect()
 }
 
 /// Whether stage 3 keyed by heating history ([`FittedUnit::by_history`]) replaces the paper's
