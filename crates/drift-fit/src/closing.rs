@@ -421,3 +421,64 @@ impl Closed<'_> {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn profile(series_kind: &'static str, off_before_s: Option<f64>, value: f64) -> Profile {
+        let bins = PROFILE_EDGES_S.len() - 1;
+        let mut after = vec![value; bins];
+        // The activation ends before the last bin.
+        after[bins - 1] = f64::NAN;
+        Profile {
+            set_point_celsius: 33.0,
+            series_kind,
+            off_before_s,
+            after_dps: [after.clone(), after.clone(), after],
+        }
+    }
+
+    /// Activations fall in their off-time's group, and a group's mean skips the bins an activation
+    /// never reached; groups without activations are left out, in a fixed order.
+    #[test]
+    fn profiles_average_by_protocol_and_off_time() {
+        let all = [
+            profile("field", Some(1200.0), 1.0),
+            profile("field", Some(45.0), 2.0),
+            profile("field", Some(60.0), 4.0),
+            profile("protocol", Some(60.0), 8.0),
+            profile("field", None, 16.0),
+        ];
+        let groups: Vec<&str> = all.iter().map(Profile::group).collect();
+        assert_eq!(
+            groups,
+            [
+                PROFILE_GROUPS[3],
+                PROFILE_GROUPS[1],
+                PROFILE_GROUPS[1],
+                PROFILE_GROUPS[0],
+                PROFILE_GROUPS[4]
+            ]
+        );
+        let refs: Vec<&Profile> = all.iter().collect();
+        let means = mean_profiles(&refs);
+        let summary: Vec<(&str, usize, f64)> = means
+            .iter()
+            .map(|(group, n, axes)| (*group, *n, axes[2][0]))
+            .collect();
+        assert_eq!(
+            summary,
+            [
+                (PROFILE_GROUPS[0], 1, 8.0),
+                (PROFILE_GROUPS[1], 2, 3.0),
+                (PROFILE_GROUPS[3], 1, 1.0),
+                (PROFILE_GROUPS[4], 1, 16.0)
+            ]
+        );
+        assert!(means
+            .iter()
+            .all(|(_, _, axes)| axes[0].last().unwrap().is_nan()));
+        assert_eq!(profile_bin_labels().last().unwrap(), "90 s–end");
+    }
+}
