@@ -96,6 +96,14 @@ fn main() -> anyhow::Result<()> {
             .position(|a| a == flag)
             .and_then(|i| args.get(i + 1).cloned())
     };
+    let yes_no = |flag: &str, default: bool| -> anyhow::Result<bool> {
+        match value(flag).as_deref() {
+            None => Ok(default),
+            Some("yes") => Ok(true),
+            Some("no") => Ok(false),
+            Some(other) => anyhow::bail!("{flag} takes yes or no, got `{other}`"),
+        }
+    };
     let seeds: u64 = value("--seeds").map_or(Ok(1), |s| s.parse())?;
     let first_seed: u64 = value("--first-seed").map_or(Ok(1), |s| s.parse())?;
     let defaults = Plan::default();
@@ -105,21 +113,9 @@ fn main() -> anyhow::Result<()> {
         calibration: value("--calibration").map_or(Ok(defaults.calibration), |s| {
             s.split(',').map(|t| t.trim().parse::<f64>()).collect()
         })?,
-        clock: match value("--clock").as_deref() {
-            None | Some("yes") => true,
-            Some("no") => false,
-            Some(other) => anyhow::bail!("--clock takes yes or no, got `{other}`"),
-        },
-        per_activation: match value("--per-activation").as_deref() {
-            None | Some("no") => false,
-            Some("yes") => true,
-            Some(other) => anyhow::bail!("--per-activation takes yes or no, got `{other}`"),
-        },
-        profile: match value("--profile").as_deref() {
-            None | Some("no") => false,
-            Some("yes") => true,
-            Some(other) => anyhow::bail!("--profile takes yes or no, got `{other}`"),
-        },
+        clock: yes_no("--clock", true)?,
+        per_activation: yes_no("--per-activation", false)?,
+        profile: yes_no("--profile", false)?,
         intervals_min: value("--intervals").map_or(Ok(defaults.intervals_min), |s| {
             s.split(',').map(|t| t.trim().parse::<f64>()).collect()
         })?,
