@@ -14,6 +14,7 @@
 //! and after; `--profile yes` where within the activations the loop's residual sits, by time since
 //! switch-on and off-time before.
 
+use anyhow::Context;
 use gyrodrift::closed_loop::{run, Plan, Row};
 
 const EFFECTS: [&str; 8] = [
@@ -104,21 +105,32 @@ fn main() -> anyhow::Result<()> {
             Some(other) => anyhow::bail!("{flag} takes yes or no, got `{other}`"),
         }
     };
-    let seeds: u64 = value("--seeds").map_or(Ok(1), |s| s.parse())?;
-    let first_seed: u64 = value("--first-seed").map_or(Ok(1), |s| s.parse())?;
+    // The error names the flag: a bare "invalid float literal" does not say which of two lists.
+    fn parsed<T: std::str::FromStr>(flag: &str, text: &str) -> anyhow::Result<T>
+    where
+        T::Err: std::error::Error + Send + Sync + 'static,
+    {
+        text.trim()
+            .parse()
+            .with_context(|| format!("{flag}: cannot read `{}`", text.trim()))
+    }
+    let list = |flag: &str, default: Vec<f64>| {
+        value(flag).map_or(Ok(default), |s| {
+            s.split(',').map(|t| parsed::<f64>(flag, t)).collect()
+        })
+    };
+    let number = |flag: &str| value(flag).map(|s| (flag.to_owned(), s));
+    let seeds: u64 = number("--seeds").map_or(Ok(1), |(f, s)| parsed(&f, &s))?;
+    let first_seed: u64 = number("--first-seed").map_or(Ok(1), |(f, s)| parsed(&f, &s))?;
     let defaults = Plan::default();
     let plan = Plan {
-        sessions: value("--sessions").map_or(Ok(defaults.sessions), |s| s.parse())?,
-        scale: value("--scale").map_or(Ok(defaults.scale), |s| s.parse())?,
-        calibration: value("--calibration").map_or(Ok(defaults.calibration), |s| {
-            s.split(',').map(|t| t.trim().parse::<f64>()).collect()
-        })?,
+        sessions: number("--sessions").map_or(Ok(defaults.sessions), |(f, s)| parsed(&f, &s))?,
+        scale: number("--scale").map_or(Ok(defaults.scale), |(f, s)| parsed(&f, &s))?,
+        calibration: list("--calibration", defaults.calibration)?,
         clock: yes_no("--clock", true)?,
         per_activation: yes_no("--per-activation", false)?,
         profile: yes_no("--profile", false)?,
-        intervals_min: value("--intervals").map_or(Ok(defaults.intervals_min), |s| {
-            s.split(',').map(|t| t.trim().parse::<f64>()).collect()
-        })?,
+        intervals_min: list("--intervals", defaults.intervals_min)?,
     };
     plan.check()?;
     eprintln!(

@@ -117,6 +117,18 @@ fn simulate_fit_and_report_from_the_command_line() {
     // The loop kept the paper's model: what it lacked is what is left, and said once.
     assert_eq!(unit["paper_axes"], unit["axes"], "{unit}");
     assert!(!md.contains("What the paper's model lacked"), "{md}");
+    // The residual plots follow the ranking they show, before the next section.
+    let at = |text: &str| {
+        md.find(text)
+            .unwrap_or_else(|| panic!("no `{text}` in {md}"))
+    };
+    let plot = at("![Residual of unit GIU-01, axis X");
+    assert!(
+        at("## Diagnosis of the residual after the loop's model") < plot
+            && plot < at("## Where within the held-out activations"),
+        "{md}"
+    );
+    assert!(diagnosis.join("residual-GIU-01-X.svg").exists());
     // Where within the held-out activations the residual sits: every held-out activation, per
     // axis one value per bin, and the section's table for the protocol at +33 °C.
     let profiles = unit["profiles"].as_array().unwrap();

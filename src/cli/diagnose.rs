@@ -315,6 +315,36 @@ fn residual_plot(
     )
 }
 
+/// Writes each axis's plot of the residual against its top candidate (unless the model absorbs
+/// it) and returns the report's links to them.
+fn residual_plots(
+    unit: &str,
+    activations: &[ActivationSeries],
+    axes: &[AxisDiagnosis],
+    out: &std::path::Path,
+) -> anyhow::Result<String> {
+    let mut md = String::new();
+    for (axis_index, axis) in axes.iter().enumerate() {
+        if let Some(top) = axis
+            .ranking
+            .first()
+            .filter(|c| c.level != "absorbed by the model")
+        {
+            let file = format!("residual-{unit}-{}.svg", axis.axis);
+            write_atomic(
+                &out.join(&file),
+                residual_plot(activations, axis_index, top)?.as_bytes(),
+            )?;
+            let _ = writeln!(
+                md,
+                "![Residual of unit {unit}, axis {}, against {}]({file})\n",
+                axis.axis, top.name
+            );
+        }
+    }
+    Ok(md)
+}
+
 /// Runs `gyrodrift diagnose`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
@@ -410,6 +440,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             &before_after,
         ));
         md.push_str(&markdown(axes, args.top));
+        // The plots show the ranking just above them (behind the loop's model), so they follow
+        // it rather than the paper's ranking.
+        md.push_str(&residual_plots(unit, activations, axes, &args.out)?);
         if closed.keying.any() {
             md.push_str(&paper_markdown(&closed.paper_axes, args.top));
         }
@@ -472,24 +505,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     c.explained,
                     c.p_value,
                     if c.significant { "  *" } else { "" }
-                );
-            }
-        }
-        for (axis_index, axis) in axes.iter().enumerate() {
-            if let Some(top) = axis
-                .ranking
-                .first()
-                .filter(|c| c.level != "absorbed by the model")
-            {
-                let file = format!("residual-{unit}-{}.svg", axis.axis);
-                write_atomic(
-                    &args.out.join(&file),
-                    residual_plot(activations, axis_index, top)?.as_bytes(),
-                )?;
-                let _ = writeln!(
-                    md,
-                    "![Residual of unit {unit}, axis {}, against {}]({file})\n",
-                    axis.axis, top.name
                 );
             }
         }
