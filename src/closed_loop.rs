@@ -408,12 +408,13 @@ pub fn run(
     }
     for a in closed.extended.iter().flat_map(|e| &e.admissions) {
         eprintln!(
-            "  guard: {} on {}: held-out gain {:.2e} (°/s)², p {:.3}, drift gain {:+.2e} °/s → {}",
+            "  guard: {} on {}: held-out gain {:.2e} (°/s)², p {:.3}, drift gain {:+.2e} °/s, p {:.3} → {}",
             a.candidate,
             a.axis,
             a.improvement,
             a.p_value,
             a.drift_gain_dps,
+            a.drift_p_value,
             if a.admitted { "admitted" } else { "left out" }
         );
     }

@@ -57,6 +57,7 @@ struct RankRecord<'a> {
     explained: f64,
     p_value: f64,
     whole_p_value: f64,
+    drift_p_value: f64,
     significant: bool,
     coefficient: f64,
     absorbed_by_model: f64,
@@ -168,7 +169,9 @@ impl PyDiagnosis {
     }
 
     /// The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
-    /// whole_p_value, significant, coefficient, absorbed_by_model): a new list of dicts.
+    /// whole_p_value, drift_p_value, significant, coefficient, absorbed_by_model): a new list of
+    /// dicts. `drift_p_value` (the held-out drift's reduction) is reported, not part of
+    /// `significant`.
     #[getter]
     fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &records(&self.axes))
@@ -203,14 +206,17 @@ impl PyDiagnosis {
             .collect()
     }
 
-    /// The terms the diagnosis proposes for the extended model.
+    /// The terms proposed for the extended model: the diagnosis's significant candidates and the
+    /// element's heating rate, which is offered on every unit.
     #[getter]
     fn proposed_terms(&self) -> Vec<String> {
         self.proposed.clone()
     }
 
     /// The guard's decision for every proposed term and axis (records: candidate, axis,
-    /// improvement, p_value, drift_gain_dps, admitted); empty unless `extend=True`.
+    /// improvement, p_value, drift_gain_dps, drift_p_value, admitted); empty unless
+    /// `extend=True`. A shape term (rate, rise², another axis's rise) is admitted on
+    /// `drift_p_value`, an auxiliary input on `p_value`.
     #[getter]
     fn admissions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.admissions)
@@ -324,6 +330,7 @@ fn records(axes: &[AxisDiagnosis; 3]) -> Vec<RankRecord<'_>> {
                 explained: c.explained,
                 p_value: c.p_value,
                 whole_p_value: c.whole_p_value,
+                drift_p_value: c.drift_p_value,
                 significant: c.significant,
                 coefficient: c.coefficient,
                 absorbed_by_model: c.absorbed_by_model,

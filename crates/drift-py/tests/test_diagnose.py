@@ -52,6 +52,12 @@ def test_the_hidden_supply_effect_is_found_admitted_and_lowers_the_held_out_erro
     assert "supply_voltage" in diagnosis.aux_inputs
     admitted = {(a["candidate"], a["axis"]) for a in diagnosis.admissions if a["admitted"]}
     assert all(("aux:supply_voltage", axis) in admitted for axis in found), diagnosis.admissions
+    # An auxiliary input is admitted on the squared residual; a shape term (the element's heating
+    # rate, offered on every unit) on the drift.
+    for a in diagnosis.admissions:
+        shape = not a["candidate"].startswith("aux:")
+        if a["admitted"]:
+            assert (a["drift_p_value"] if shape else a["p_value"]) < 0.05, a
     extended = diagnosis.extended
     assert extended is not None and len(extended.extension) >= 1
     # The error before/after on the held-out +33 °C field activations, per axis where it was found.
@@ -100,6 +106,7 @@ def test_the_ranking_is_records_with_every_axis(diagnosis: gyrodrift.Diagnosis) 
         "explained",
         "p_value",
         "whole_p_value",
+        "drift_p_value",
         "significant",
         "absorbed_by_model",
     }

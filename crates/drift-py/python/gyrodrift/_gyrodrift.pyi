@@ -777,7 +777,9 @@ class Diagnosis:
     @property
     def ranking(self) -> list[dict[str, Any]]:
         """The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
-        whole_p_value, significant, coefficient, absorbed_by_model): a new list of dicts."""
+        whole_p_value, drift_p_value, significant, coefficient, absorbed_by_model): a new list of
+        dicts. `drift_p_value` (the held-out drift's reduction) is reported, not part of
+        `significant`."""
     @property
     def paper_ranking(self) -> list[dict[str, Any]]:
         """The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's
@@ -792,11 +794,14 @@ class Diagnosis:
         systematic effect is left."""
     @property
     def proposed_terms(self) -> list[str]:
-        """The terms the diagnosis proposes for the extended model."""
+        """The terms proposed for the extended model: the diagnosis's significant candidates and the
+        element's heating rate, which is offered on every unit."""
     @property
     def admissions(self) -> list[dict[str, Any]]:
         """The guard's decision for every proposed term and axis (records: candidate, axis,
-        improvement, p_value, drift_gain_dps, admitted); empty unless `extend=True`."""
+        improvement, p_value, drift_gain_dps, drift_p_value, admitted); empty unless
+        `extend=True`. A shape term (rate, rise², another axis's rise) is admitted on
+        `drift_p_value`, an auxiliary input on `p_value`."""
     @property
     def stage3(self) -> list[dict[str, Any]]:
         """Per axis, stage 3's lookup as the loop chose it on the training activations (records:
