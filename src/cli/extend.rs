@@ -99,7 +99,7 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
             .terms
             .iter()
             .find(|t| t.standing)
-            .map_or("none this time: a rate candidate was significant, or the tables absorb every one", |t| t.candidate.as_str())
+            .map_or("none this time: a rate candidate was significant, the tables absorb every one, or four terms leave no room", |t| t.candidate.as_str())
     );
     md.push_str(
         "| term | axis | held-out gain, (°/s)² | p | held-out drift gain, °/s | p drift | admitted |\n|---|---|---:|---:|---:|---:|:---:|\n",

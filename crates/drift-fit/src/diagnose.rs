@@ -358,8 +358,6 @@ fn line(train: &[&Vec<Point>]) -> Option<(f64, f64)> {
     Some((slope, my - slope * mx))
 }
 
-/// Scores one candidate on groups of points (one group per activation), cross-validated by
-/// group. Returns (explained share, one-sided p, coefficient on all data).
 /// A candidate's cross-validated score at one level.
 struct Score {
     explained: f64,
@@ -385,6 +383,9 @@ fn spread(values: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
+/// Scores one candidate on groups of points (one group per activation), cross-validated by
+/// group: the explained share, the p-values of the held-out squared residual's and drift's
+/// reductions, and the coefficient on all data.
 fn score(groups: &[Vec<Point>], folds: usize) -> Score {
     let finite = |p: &&Point| p.0.is_finite() && p.1.is_finite();
     let all: Vec<&Point> = groups.iter().flatten().filter(finite).collect();

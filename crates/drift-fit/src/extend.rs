@@ -120,7 +120,8 @@ impl TermPlan {
     /// this one. It shows as a shape within activations that the drift metric sees and the
     /// squared residual, dominated by offsets, hardly does: the diagnosis's whole-residual test
     /// misses it even for the element's true rate (docs/closed-loop.md, session 12), so the
-    /// guard's drift route decides per axis. Its filter is the best-explaining rate candidate's.
+    /// guard's drift test decides per axis. Its filter is the rate candidate's whose drift test is
+    /// strongest (then the best-explaining one's).
     ///
     /// A component of a vector channel (`accel_x`) brings its siblings (`accel_y`, `accel_z`):
     /// a sensitivity to a vector quantity is a matrix, so every axis's bias may follow every
@@ -884,8 +885,9 @@ mod tests {
     fn nothing_significant_leaves_the_element_rate_alone_and_at_most_four() {
         let quiet = [axis("X", &[("aux:supply_voltage", false)])];
         assert!(TermPlan::choose(&quiet).terms.is_empty());
-        // The element's heating rate is offered anyway, through the best-explaining filter on
-        // any axis, and marked as offered rather than found.
+        // The element's heating rate is offered anyway, through the filter whose drift test is
+        // strongest on any axis (here a tie, so the best-explaining), marked as offered rather
+        // than found.
         let mut rates = [
             axis("X", &[("temperature rate X (τ 8 s)", false)]),
             axis("Y", &[("temperature rate Y (τ 30 s)", false)]),
@@ -901,6 +903,13 @@ mod tests {
                 },
                 true
             )]
+        );
+        rates[0].ranking[0].drift_p_value = 0.01;
+        assert_eq!(
+            TermPlan::choose(&rates).terms[0].term,
+            Term::TemperatureRate {
+                time_constant_ms: 8_000
+            }
         );
         // A rate the tables absorb is not offered.
         rates[1].ranking[0].level = "absorbed by the model";
