@@ -170,9 +170,13 @@ fn main() -> anyhow::Result<()> {
             )
         };
         println!(
-            "{effect}: diagnosis significant on {}; a term admitted on {}; stage 3 keyed by history chosen on {}; warm starts' initial bias chosen on {}; scale {}, calibration at {:?} °C, {} field activations measured and {} trained on per run",
+            "{effect}: diagnosis significant on {}; a term admitted on {}; drift excess cut ≥ 2× on {} (RMS excess on {}); stage 3 keyed by history chosen on {}; warm starts' initial bias chosen on {}; scale {}, calibration at {:?} °C, {} field activations measured and {} trained on per run",
             share(&|r| r.significant),
             share(&|r| !r.admitted.is_empty()),
+            // To the table's rounding: 1.95× prints as 2.0×. A model that ends at the floor
+            // has cut all there was (before above the floor).
+            share(&|r| r.before.0 > r.floor.0 && r.drift_cut() >= 1.95),
+            share(&|r| r.before.1 > r.floor.1 && r.excess_cut() >= 1.95),
             share(&|r| r.history_chosen),
             share(&|r| r.warm_start_chosen),
             plan.scale,

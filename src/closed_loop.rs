@@ -205,6 +205,12 @@ impl Row {
         (self.before.1 - self.floor.1) / (self.after.1 - self.floor.1).max(1e-9)
     }
 
+    /// How many times the loop's model cuts the drift excess over the noise floor: the issue's
+    /// floor for a hidden effect is ≥ 2×.
+    pub fn drift_cut(&self) -> f64 {
+        (self.before.0 - self.floor.0) / (self.after.0 - self.floor.0).max(1e-9)
+    }
+
     /// How many times stage 3 keyed by history cuts the drift excess over the noise floor.
     pub fn history_drift_cut(&self) -> f64 {
         (self.before.0 - self.floor.0) / (self.by_history.0 - self.floor.0).max(1e-9)
