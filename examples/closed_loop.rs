@@ -78,6 +78,29 @@ const FLAGS: [&str; 10] = [
     "--profile",
 ];
 
+/// `text` read as a number; the error names the flag (a bare "invalid float literal" does not say
+/// which of two lists).
+fn parsed<T: std::str::FromStr>(flag: &str, text: &str) -> anyhow::Result<T>
+where
+    T::Err: std::error::Error + Send + Sync + 'static,
+{
+    text.trim()
+        .parse()
+        .with_context(|| format!("{flag}: cannot read `{}`", text.trim()))
+}
+
+/// The number after `flag`, or `default` without one.
+fn number<T: std::str::FromStr>(
+    value: &dyn Fn(&str) -> Option<String>,
+    flag: &str,
+    default: T,
+) -> anyhow::Result<T>
+where
+    T::Err: std::error::Error + Send + Sync + 'static,
+{
+    value(flag).map_or(Ok(default), |s| parsed(flag, &s))
+}
+
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--help" || a == "-h") {
@@ -105,27 +128,17 @@ fn main() -> anyhow::Result<()> {
             Some(other) => anyhow::bail!("{flag} takes yes or no, got `{other}`"),
         }
     };
-    // The error names the flag: a bare "invalid float literal" does not say which of two lists.
-    fn parsed<T: std::str::FromStr>(flag: &str, text: &str) -> anyhow::Result<T>
-    where
-        T::Err: std::error::Error + Send + Sync + 'static,
-    {
-        text.trim()
-            .parse()
-            .with_context(|| format!("{flag}: cannot read `{}`", text.trim()))
-    }
     let list = |flag: &str, default: Vec<f64>| {
         value(flag).map_or(Ok(default), |s| {
             s.split(',').map(|t| parsed::<f64>(flag, t)).collect()
         })
     };
-    let number = |flag: &str| value(flag).map(|s| (flag.to_owned(), s));
-    let seeds: u64 = number("--seeds").map_or(Ok(1), |(f, s)| parsed(&f, &s))?;
-    let first_seed: u64 = number("--first-seed").map_or(Ok(1), |(f, s)| parsed(&f, &s))?;
+    let seeds: u64 = number(&value, "--seeds", 1)?;
+    let first_seed: u64 = number(&value, "--first-seed", 1)?;
     let defaults = Plan::default();
     let plan = Plan {
-        sessions: number("--sessions").map_or(Ok(defaults.sessions), |(f, s)| parsed(&f, &s))?,
-        scale: number("--scale").map_or(Ok(defaults.scale), |(f, s)| parsed(&f, &s))?,
+        sessions: number(&value, "--sessions", defaults.sessions)?,
+        scale: number(&value, "--scale", defaults.scale)?,
         calibration: list("--calibration", defaults.calibration)?,
         clock: yes_no("--clock", true)?,
         per_activation: yes_no("--per-activation", false)?,

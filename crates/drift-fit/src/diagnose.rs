@@ -34,7 +34,7 @@ use serde::Serialize;
 use crate::absorb::Absorber;
 use crate::candidates::{Kind, SET_POINT_CHANNEL};
 use crate::error::FitError;
-use crate::evaluate::switch_on_raw;
+use crate::evaluate::{spread, switch_on_raw};
 use crate::fit::FittedUnit;
 use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
@@ -369,20 +369,6 @@ struct Score {
     coefficient: f64,
 }
 
-/// Max − min of the finite values (0 for none).
-fn spread(values: impl Iterator<Item = f64>) -> f64 {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
-    if hi >= lo {
-        hi - lo
-    } else {
-        0.0
-    }
-}
-
 /// Scores one candidate on groups of points (one group per activation), cross-validated by
 /// group: the explained share, the p-values of the held-out squared residual's and drift's
 /// reductions, and the coefficient on all data.
@@ -603,8 +589,8 @@ mod tests {
             .map(|k| activation(k, &|ramp| (13.0 * ramp).cos()))
             .collect();
         assert!(score(&unrelated, 5).drift_p_value > 0.05);
-        assert_eq!(spread([1.0, f64::NAN, -2.0].into_iter()), 3.0);
-        assert_eq!(spread(std::iter::empty()), 0.0);
+        assert_eq!(spread([1.0, f64::NAN, -2.0]), 3.0);
+        assert_eq!(spread([]), 0.0);
     }
 
     #[test]

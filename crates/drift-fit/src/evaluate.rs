@@ -73,6 +73,21 @@ pub struct ActivationResult {
     pub models: Vec<ModelResult>,
 }
 
+/// The paper's drift metric of a series: max − min of its finite values (0 for none).
+pub fn spread(values: impl IntoIterator<Item = f64>) -> f64 {
+    let (lo, hi) = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if hi >= lo {
+        hi - lo
+    } else {
+        0.0
+    }
+}
+
 /// Per axis, the paper's drift metric (max − min of the low-passed rate) and the RMS of the
 /// low-passed rate, with a `window`-sample centred moving average.
 pub fn metric(rates: &[Vec<f32>; 3], window: usize) -> ([f64; 3], [f64; 3]) {
@@ -80,12 +95,7 @@ pub fn metric(rates: &[Vec<f32>; 3], window: usize) -> ([f64; 3], [f64; 3]) {
     let mut rms = [0.0; 3];
     for axis in 0..3 {
         let low = centred_moving_average(&rates[axis], window);
-        let (lo, hi) = low
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            });
-        drift[axis] = hi - lo;
+        drift[axis] = spread(low.iter().copied());
         rms[axis] = (low.iter().map(|v| v * v).sum::<f64>() / low.len().max(1) as f64).sqrt();
     }
     (drift, rms)

@@ -170,12 +170,11 @@ impl TermPlan {
                 }
             }
         }
-        let has_rate = |plan: &Self| {
-            plan.terms
-                .iter()
-                .any(|t| matches!(t.term, Term::TemperatureRate { .. }))
-        };
-        if plan.terms.len() < MAX_TERMS && !has_rate(&plan) {
+        let has_rate = plan
+            .terms
+            .iter()
+            .any(|t| matches!(t.term, Term::TemperatureRate { .. }));
+        if plan.terms.len() < MAX_TERMS && !has_rate {
             let best_rate = axes
                 .iter()
                 .flat_map(|a| &a.ranking)

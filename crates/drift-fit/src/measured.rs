@@ -20,6 +20,8 @@
 use drift_recording::Segment;
 use serde::Serialize;
 
+use crate::evaluate::spread;
+
 /// Thresholds of [`obstacles`] and the averaging window of [`characterise`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct MeasuredSettings {
@@ -290,12 +292,6 @@ fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
-fn spread(v: &[f64]) -> f64 {
-    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-    hi - lo
-}
-
 /// Overlapping Allan deviation of a rate sampled at `rate_hz`, at averaging times of 1, 2, 4, …
 /// samples up to a third of the record: `(tau_s, adev)` pairs in the rate's unit.
 pub fn allan_deviation(rate: &[f64], rate_hz: f64) -> Vec<(f64, f64)> {
@@ -469,7 +465,7 @@ fn activation(segment: &Segment, means: &Means, settings: &MeasuredSettings) -> 
             mean_spread_dps: (m.iter().map(|v| (v - mm).powi(2)).sum::<f64>()
                 / (m.len().max(2) - 1) as f64)
                 .sqrt(),
-            drift_dps: spread(m),
+            drift_dps: spread(m.iter().copied()),
             slow_drift_dps_per_h: slope(&times, m, 2).map(|(e, _)| Estimate {
                 value: e.value * 3600.0,
                 standard_error: e.standard_error * 3600.0,
@@ -544,8 +540,8 @@ fn axis_summary(axis: usize, all: &[Means], activations: &[Activation]) -> AxisS
             .zip(&m.temperature)
             .map(|(r, t)| r - b.value * (t - mt))
             .collect();
-        drift.0.push(spread(&raw));
-        drift.1.push(spread(&corrected));
+        drift.0.push(spread(raw.iter().copied()));
+        drift.1.push(spread(corrected.iter().copied()));
         before.extend(raw);
         after.extend(corrected);
     }
