@@ -293,6 +293,10 @@ pub struct Plan {
     /// twice). The shortest is the warmest start the tables measure; the field switches the unit
     /// off for 0.5–40 min, and a start after a shorter off-time is held at the warmest.
     pub intervals_min: Vec<f64>,
+    /// The unit simulated: [`UnitModel::Physical`], or [`UnitModel::PaperExact`] for a null case
+    /// that is null for the paper's model too (its element does not lag its sensor). The noise
+    /// floor is always measured on the zero-drift twin.
+    pub unit: UnitModel,
 }
 
 impl Default for Plan {
@@ -306,6 +310,7 @@ impl Default for Plan {
             per_activation: false,
             profile: false,
             intervals_min: DEFAULT_INTERVALS_MIN.to_vec(),
+            unit: UnitModel::Physical,
         }
     }
 }
@@ -372,7 +377,7 @@ pub fn run(
     let dir = work.join(format!("{effect}-{seed}"));
     let twin_dir = work.join(format!("{effect}-{seed}-floor"));
     simulate_campaign(
-        &campaign(seed, effect, UnitModel::Physical, plan_size)?,
+        &campaign(seed, effect, plan_size.unit, plan_size)?,
         &dir,
         |_| {},
     )

@@ -10,7 +10,7 @@ use crate::rng;
 use crate::schedule::{ActivationPlan, FilePlan};
 use crate::thermal::network::{asic, element, NODES};
 use crate::thermal::rc::{Discrete, RcNetwork};
-use crate::unit::{UnitParams, NOMINAL_SUPPLY_V, REFERENCE_CELSIUS};
+use crate::unit::{UnitModel, UnitParams, NOMINAL_SUPPLY_V, REFERENCE_CELSIUS};
 use drift_recording::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use drift_recording::writer::McapFile;
 use drift_recording::{AUX_RATE_HZ, RAW_PER_CELSIUS};
@@ -330,6 +330,15 @@ impl FileSim<'_> {
         });
         let temp_noise: [f64; 3] =
             std::array::from_fn(|a| unit.axes[a].temperature_noise_raw * noise);
+        // The node whose temperature the bias follows: the element, or for a unit the paper's
+        // model represents exactly, the sensor's own site.
+        let biasing = |a: usize| {
+            if unit.model == UnitModel::PaperExact {
+                asic(a)
+            } else {
+                element(a)
+            }
+        };
         let lag_on = unit
             .axes
             .iter()
@@ -381,7 +390,7 @@ impl FileSim<'_> {
                         + unit.accel.bias_g[a]
                         + unit.accel.noise_g * noise * normal(r);
                     buf.accel[a].push(g as f32);
-                    buf.truth_element[a].push(x[element(a)] as f32);
+                    buf.truth_element[a].push(x[biasing(a)] as f32);
                     buf.truth_asic[a].push(x[asic(a)] as f32);
                     buf.truth_instability[a].push(instability[a] as f32);
                 }
@@ -392,7 +401,7 @@ impl FileSim<'_> {
             let frac = f64::from(phase) / f64::from(aux_every);
             for a in 0..3 {
                 let axis = &unit.axes[a];
-                let (e, s) = (element(a), asic(a));
+                let (e, s) = (biasing(a), asic(a));
                 let element_c = x[e] + frac * (next[e] - x[e]);
                 let asic_c = x[s] + frac * (next[s] - x[s]);
                 let inputs = BiasInputs {

@@ -14,7 +14,8 @@ use std::path::Path;
 pub struct TruthSegment {
     /// Noise-free bias per sample, including the turn-on jitter (°/s).
     pub systematic_bias_dps: [Vec<f32>; 3],
-    /// Element temperatures at 100 Hz (°C).
+    /// Element temperatures at 100 Hz (°C): the temperature the bias follows, which for a
+    /// [`crate::unit::UnitModel::PaperExact`] unit is the sensor's site.
     pub element_celsius: [Vec<f32>; 3],
     /// ASIC (temperature-sensor site) true temperatures at 100 Hz (°C).
     pub asic_celsius: [Vec<f32>; 3],

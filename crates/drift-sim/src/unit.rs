@@ -28,6 +28,11 @@ pub enum UnitModel {
     /// No systematic drift at all: same heating, same noise, zero temperature
     /// coefficients and no hidden effects. The noise floor for evaluations.
     ZeroSystematicDrift,
+    /// A unit the paper's model represents exactly: the bias follows the temperature at the
+    /// sensor's site, linearly (no element lagging the sensor, no curvature). Same heating and
+    /// noise as [`UnitModel::Physical`]. Without hidden effects it is a true null case for the
+    /// closed loop's diagnosis, which the physical unit is not: its element lags its sensor.
+    PaperExact,
 }
 
 /// The bias and noise parameters of one axis.
@@ -218,6 +223,11 @@ impl UnitParams {
             }
             unit.axes = axes;
             return unit;
+        }
+        if model == UnitModel::PaperExact {
+            for a in &mut axes {
+                a.tempco2_dps_per_c2 = 0.0;
+            }
         }
         unit.axes = axes;
         unit.apply_effects(seed, effects);

@@ -137,6 +137,48 @@ fn noise_free_physics_matches_the_paper() {
     }
 }
 
+/// The true drift/rise ratio at 119 s of every activation of a noise-free 1-min and 30-min
+/// protocol, per axis, for `unit_model`.
+fn true_ratios_of(unit_model: UnitModel) -> Vec<[f64; 3]> {
+    let c = Campaign {
+        unit_model,
+        ..protocol_campaign(&[1.0, 30.0], 1, 0.0)
+    };
+    let (dir, rec) = record(&c);
+    let name = rec.path.file_name().unwrap().to_string_lossy();
+    let truth = read_truth(&dir.path().join("truth").join(name.replace(".mcap", ".truth.mcap")))
+        .unwrap();
+    assert_eq!(truth.len(), 10);
+    truth
+        .iter()
+        .map(|t| std::array::from_fn(|a| true_ratio(t, a)))
+        .collect()
+}
+
+/// Largest relative spread of the ratio over activations, over the axes.
+fn ratio_spread(ratios: &[[f64; 3]]) -> f64 {
+    (0..3)
+        .map(|a| {
+            let v: Vec<f64> = ratios.iter().map(|r| r[a]).collect();
+            let (lo, hi) = v
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+            (hi - lo) / v[0].abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_paper_exact_unit_drifts_by_one_ratio_whatever_its_history() {
+    // The bias follows the sensor's site linearly: drift/rise is the tempco (and the pressure's
+    // linear term) at every time and after every off-time, which the paper's tables represent
+    // exactly. The physical unit's element lags the sensor, so its ratio depends on history.
+    let exact = ratio_spread(&true_ratios_of(UnitModel::PaperExact));
+    let physical = ratio_spread(&true_ratios_of(UnitModel::Physical));
+    assert!(exact < 1e-3, "paper-exact ratio varies by {exact:.2e}");
+    assert!(physical > 0.05, "physical ratio varies by only {physical:.2e}");
+}
+
 #[test]
 fn cool_down_is_mostly_done_by_15_min_and_complete_within_the_hour() {
     let (_dir, rec) = record(&protocol_campaign(&[15.0, 30.0], 2, 0.0));
