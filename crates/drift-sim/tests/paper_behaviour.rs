@@ -146,8 +146,12 @@ fn true_ratios_of(unit_model: UnitModel) -> Vec<[f64; 3]> {
     };
     let (dir, rec) = record(&c);
     let name = rec.path.file_name().unwrap().to_string_lossy();
-    let truth = read_truth(&dir.path().join("truth").join(name.replace(".mcap", ".truth.mcap")))
-        .unwrap();
+    let truth = read_truth(
+        &dir.path()
+            .join("truth")
+            .join(name.replace(".mcap", ".truth.mcap")),
+    )
+    .unwrap();
     assert_eq!(truth.len(), 10);
     truth
         .iter()
@@ -176,7 +180,10 @@ fn a_paper_exact_unit_drifts_by_one_ratio_whatever_its_history() {
     let exact = ratio_spread(&true_ratios_of(UnitModel::PaperExact));
     let physical = ratio_spread(&true_ratios_of(UnitModel::Physical));
     assert!(exact < 1e-3, "paper-exact ratio varies by {exact:.2e}");
-    assert!(physical > 0.05, "physical ratio varies by only {physical:.2e}");
+    assert!(
+        physical > 0.05,
+        "physical ratio varies by only {physical:.2e}"
+    );
 }
 
 #[test]
