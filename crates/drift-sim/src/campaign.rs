@@ -25,7 +25,8 @@ pub struct Campaign {
     pub sample_rate_hz: u32,
     /// Chamber set points (°C), recorded in this order (one file per unit and set point).
     pub set_points_celsius: Vec<f64>,
-    /// Physical units, or units with zero systematic drift (noise floor).
+    /// Physical units, units with zero systematic drift (noise floor), or units the paper's model
+    /// represents exactly (a true null case).
     pub unit_model: UnitModel,
     /// Scales every random component (white noise, bias instability, turn-on jitter,
     /// temperature-sensor noise, heating scatter): 1 = physical, 0 = noise-free truth.
