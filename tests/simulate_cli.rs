@@ -76,5 +76,45 @@ fn simulate_rejects_bad_flags_with_a_named_reason() {
     ])
     .unwrap();
     assert!(run(cli).unwrap_err().to_string().contains("abc"));
+    // One unit model at a time: clap names both flags.
+    let error = Cli::try_parse_from([
+        "gyrodrift",
+        "simulate",
+        "--zero-drift",
+        "--paper-exact",
+        "--out",
+        out_arg,
+    ])
+    .unwrap_err()
+    .to_string();
+    assert!(
+        error.contains("--zero-drift") && error.contains("--paper-exact"),
+        "{error}"
+    );
     assert!(!out.exists());
+}
+
+#[test]
+fn simulate_records_a_paper_exact_unit_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cli = Cli::try_parse_from([
+        "gyrodrift",
+        "simulate",
+        "--paper-exact",
+        "--intervals",
+        "1",
+        "--repeats",
+        "1",
+        "--set-points",
+        "30",
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+    ])
+    .unwrap();
+    run(cli).unwrap();
+    let truth = std::fs::read_to_string(out.join("truth").join("campaign.json")).unwrap();
+    let campaign: serde_json::Value = serde_json::from_str(&truth).unwrap();
+    assert_eq!(campaign["unit_model"], "paper_exact", "{truth}");
 }

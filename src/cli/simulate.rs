@@ -39,6 +39,10 @@ pub struct Args {
     /// Units without systematic drift (noise only): the evaluation's noise floor.
     #[arg(long)]
     pub zero_drift: bool,
+    /// Units the paper's model represents exactly (bias linear in the sensor site's temperature,
+    /// no element lag): a true null case for a diagnosis.
+    #[arg(long, conflicts_with = "zero_drift")]
+    pub paper_exact: bool,
     /// Hidden effects to switch on (default magnitudes): thermal_lag, acceleration,
     /// supply_voltage, cross_axis, rise_nonlinearity, ageing.
     #[arg(long, value_delimiter = ',')]
@@ -105,6 +109,9 @@ pub fn campaign_from(args: &Args) -> anyhow::Result<Campaign> {
     }
     if args.zero_drift {
         c.unit_model = UnitModel::ZeroSystematicDrift;
+    }
+    if args.paper_exact {
+        c.unit_model = UnitModel::PaperExact;
     }
     for name in &args.effects {
         c.effects.enable(name.trim()).map_err(anyhow::Error::msg)?;

@@ -24,6 +24,7 @@ struct Overrides {
     field: bool,
     field_only: bool,
     zero_drift: bool,
+    paper_exact: bool,
     effects: Vec<String>,
     noise_scale: Option<f64>,
     truth_at_aux_rate: bool,
@@ -92,8 +93,16 @@ impl Overrides {
         if self.field_only {
             c.protocol = None;
         }
+        if self.zero_drift && self.paper_exact {
+            return Err(Error::Input(
+                "`zero_drift` and `paper_exact` cannot both be set".into(),
+            ));
+        }
         if self.zero_drift {
             c.unit_model = UnitModel::ZeroSystematicDrift;
+        }
+        if self.paper_exact {
+            c.unit_model = UnitModel::PaperExact;
         }
         for name in &self.effects {
             c.effects
@@ -170,6 +179,7 @@ fn resolve(
     field: bool,
     field_only: bool,
     zero_drift: bool,
+    paper_exact: bool,
     effects: Option<&Bound<'_, PyAny>>,
     noise_scale: Option<&Bound<'_, PyAny>>,
     truth_at_aux_rate: bool,
@@ -190,6 +200,7 @@ fn resolve(
         field,
         field_only,
         zero_drift,
+        paper_exact,
         effects: args::optional("effects", "a sequence of effect names (str)", effects)?
             .unwrap_or_default(),
         noise_scale: args::optional("noise_scale", "a float ≥ 0", noise_scale)?,
@@ -215,7 +226,8 @@ fn to_dict<'py>(py: Python<'py>, campaign: &Campaign) -> PyResult<Bound<'py, PyA
 #[pyfunction]
 #[pyo3(signature = (
     campaign = None, *, seed = None, units = None, set_points = None, intervals = None,
-    repeats = None, field = false, field_only = false, zero_drift = false, effects = None,
+    repeats = None, field = false, field_only = false, zero_drift = false, paper_exact = false,
+    effects = None,
     noise_scale = None, truth_at_aux_rate = false,
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -230,6 +242,7 @@ pub fn resolve_campaign<'py>(
     field: bool,
     field_only: bool,
     zero_drift: bool,
+    paper_exact: bool,
     effects: Option<&Bound<'py, PyAny>>,
     noise_scale: Option<&Bound<'py, PyAny>>,
     truth_at_aux_rate: bool,
@@ -245,6 +258,7 @@ pub fn resolve_campaign<'py>(
         field,
         field_only,
         zero_drift,
+        paper_exact,
         effects,
         noise_scale,
         truth_at_aux_rate,
@@ -257,7 +271,8 @@ pub fn resolve_campaign<'py>(
 #[pyfunction]
 #[pyo3(signature = (
     out, campaign = None, *, seed = None, units = None, set_points = None, intervals = None,
-    repeats = None, field = false, field_only = false, zero_drift = false, effects = None,
+    repeats = None, field = false, field_only = false, zero_drift = false, paper_exact = false,
+    effects = None,
     noise_scale = None, truth_at_aux_rate = false,
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -273,6 +288,7 @@ pub fn simulate<'py>(
     field: bool,
     field_only: bool,
     zero_drift: bool,
+    paper_exact: bool,
     effects: Option<&Bound<'py, PyAny>>,
     noise_scale: Option<&Bound<'py, PyAny>>,
     truth_at_aux_rate: bool,
@@ -289,6 +305,7 @@ pub fn simulate<'py>(
         field,
         field_only,
         zero_drift,
+        paper_exact,
         effects,
         noise_scale,
         truth_at_aux_rate,

@@ -33,6 +33,9 @@ def test_overrides_mean_what_the_flags_mean() -> None:
     assert field_only["protocol"] is None and field_only["field"] is not None
     assert field_only["noise_scale"] == 0.0
     assert gyrodrift.resolve_campaign(zero_drift=True)["unit_model"] == "zero_systematic_drift"
+    assert gyrodrift.resolve_campaign(paper_exact=True)["unit_model"] == "paper_exact"
+    with pytest.raises(gyrodrift.InputError, match="`zero_drift` and `paper_exact`"):
+        gyrodrift.resolve_campaign(zero_drift=True, paper_exact=True)
     effects = gyrodrift.resolve_campaign(effects=["thermal_lag", "ageing"])["effects"]
     assert effects["thermal_lag"] is not None and effects["ageing"] is not None
 
