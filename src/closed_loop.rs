@@ -202,19 +202,25 @@ impl Row {
 
     /// How many times the extended model cuts the RMS excess over the noise floor.
     pub fn excess_cut(&self) -> f64 {
-        (self.before.1 - self.floor.1) / (self.after.1 - self.floor.1).max(1e-9)
+        excess_ratio(self.before.1, self.after.1, self.floor.1)
     }
 
     /// How many times the loop's model cuts the drift excess over the noise floor: the issue's
     /// floor for a hidden effect is ≥ 2×.
     pub fn drift_cut(&self) -> f64 {
-        (self.before.0 - self.floor.0) / (self.after.0 - self.floor.0).max(1e-9)
+        excess_ratio(self.before.0, self.after.0, self.floor.0)
     }
 
     /// How many times stage 3 keyed by history cuts the drift excess over the noise floor.
     pub fn history_drift_cut(&self) -> f64 {
-        (self.before.0 - self.floor.0) / (self.by_history.0 - self.floor.0).max(1e-9)
+        excess_ratio(self.before.0, self.by_history.0, self.floor.0)
     }
+}
+
+/// `(before − floor) / (after − floor)`: how many times a model cuts the excess over the noise
+/// floor (an `after` at the floor counts as 1e-9 above it, not a division by zero).
+fn excess_ratio(before: f64, after: f64, floor: f64) -> f64 {
+    (before - floor) / (after - floor).max(1e-9)
 }
 
 /// One line per activation, in order of off-time: the mean (the activation's offset) and the drift

@@ -331,9 +331,10 @@ impl FileSim<'_> {
         let temp_noise: [f64; 3] =
             std::array::from_fn(|a| unit.axes[a].temperature_noise_raw * noise);
         // The node whose temperature the bias follows: the element, or for a unit the paper's
-        // model represents exactly, the sensor's own site.
+        // model represents exactly, the sensor's own site (decided once, not per sample).
+        let sensor_site = unit.model == UnitModel::PaperExact;
         let biasing = |a: usize| {
-            if unit.model == UnitModel::PaperExact {
+            if sensor_site {
                 asic(a)
             } else {
                 element(a)
