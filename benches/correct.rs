@@ -52,6 +52,7 @@ fn extended(modified: &ModifiedTables) -> ModifiedTables {
     ];
     let extension = Extension {
         terms: terms.into_iter().collect(),
+        ..Extension::NONE
     };
     modified
         .clone()

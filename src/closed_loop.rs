@@ -423,6 +423,13 @@ pub fn run(
             }
         }
     }
+    for fit in closed.extended.iter().flat_map(|e| &e.switch_on_rate) {
+        let rate = &fit.rate;
+        eprintln!(
+            "  rate at switch-on on {}: heating {:.4} °C/s ({} cold starts) less {:.5}/s + {:.5}/s · remaining per °C of residual heat ({} warm starts, RMS off the fit {:.1e} °C/s)",
+            fit.axis, rate.heating_celsius_per_s, fit.cold_starts, rate.cooling_per_second, rate.cooling_per_second_per_remaining, fit.warm_starts, fit.cooling_rms_error_celsius_per_s
+        );
+    }
     for a in closed.extended.iter().flat_map(|e| &e.admissions) {
         eprintln!(
             "  guard: {} on {}: held-out gain {:.2e} (°/s)², p {:.3}, drift gain {:+.2e} °/s, p {:.3} → {}",

@@ -151,6 +151,30 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
             extended.plan.aux_inputs.join(", ")
         );
     }
+    if let Some(element) = extended.plan.element_rate {
+        let _ = writeln!(
+            md,
+            "\nThe rate filter starts at the rate the unit has at switch-on ({}), measured on the calibration activations: heating − residual heat · (cooling + faster · remaining), where remaining is the fraction of the previous switch-off's heat still there (firmware: `power_on_after`; `power_on` starts a cold start's).\n\n| axis | heating, °C/s (cold starts) | cooling, 1/s | faster, 1/s (warm starts) | warm starts' RMS about the fit, °C/s |\n|---|---:|---:|---:|---:|",
+            if element {
+                "the element's: it has not started heating, so only the cooling"
+            } else {
+                "the sensor's: its heating less its cooling"
+            }
+        );
+        for fit in &extended.switch_on_rate {
+            let _ = writeln!(
+                md,
+                "| {} | {:.4} ({}) | {:.5} | {:.5} ({}) | {:.1e} |",
+                fit.axis,
+                fit.rate.heating_celsius_per_s,
+                fit.cold_starts,
+                fit.rate.cooling_per_second,
+                fit.rate.cooling_per_second_per_remaining,
+                fit.warm_starts,
+                fit.cooling_rms_error_celsius_per_s
+            );
+        }
+    }
     md
 }
 

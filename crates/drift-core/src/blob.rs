@@ -5,7 +5,7 @@
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 4 | magic `GYDT` |
-//! | 4 | 2 | format version ([`FORMAT_VERSION`]; versions 1 to 3 still read) |
+//! | 4 | 2 | format version ([`FORMAT_VERSION`]; versions 1 to 5 still read) |
 //! | 6 | 1 | model kind ([`Kind`]) |
 //! | 7 | 1 | reserved, 0 |
 //! | 8 | 4 | payload length `n`, bytes |
@@ -21,7 +21,7 @@ use core::fmt;
 use serde::{de::DeserializeOwned, Serialize};
 
 use crate::error::Error;
-use crate::extension::{Extension, ExtraTerm, Term, MAX_TERMS};
+use crate::extension::{Extension, ExtraTerm, SwitchOnRate, Term, MAX_TERMS};
 use crate::model::Model;
 use crate::polynomial::PolynomialTables;
 use crate::settings::Settings;
@@ -34,11 +34,13 @@ pub const MAGIC: [u8; 4] = *b"GYDT";
 /// to [`ModifiedTables`]; version 3 gave the auxiliary-input term a low-pass time constant
 /// ([`Term::Aux`]); version 4 lets stage 3 be keyed by heating history
 /// ([`AmbientCurves::residual_heat_celsius`]); version 5 gives warm starts their own initial bias
-/// ([`AmbientCurves::warm_starts`]). This build still reads version-1 images (they load with no
-/// extra terms), version-2 images (their auxiliary terms load unfiltered, time constant 0, as they
-/// were meant), version-3 images (stage 3 keyed by rise, as the paper's) and version-4 images (the
-/// paper's initial bias, a function of the switch-on temperature alone).
-pub const FORMAT_VERSION: u16 = 5;
+/// ([`AmbientCurves::warm_starts`]); version 6 starts the temperature-rate filter at the rate
+/// the unit has at switch-on ([`Extension::switch_on_rate`]). This build still reads version-1 images (they
+/// load with no extra terms), version-2 images (their auxiliary terms load unfiltered, time
+/// constant 0, as they were meant), version-3 images (stage 3 keyed by rise, as the paper's),
+/// version-4 images (the paper's initial bias, a function of the switch-on temperature alone) and
+/// version-5 images (the rate filter starts at rest, [`SwitchOnRate::AT_REST`]).
+pub const FORMAT_VERSION: u16 = 6;
 /// The oldest image format version this build reads.
 pub const OLDEST_READABLE_VERSION: u16 = 1;
 /// Bytes before the payload.
@@ -163,12 +165,35 @@ impl<const R: usize, const A: usize, const C: usize> From<AxisTableV4<R, A, C>>
     }
 }
 
+/// The extension of versions 3 to 5: the rate filter started at rest.
+#[derive(serde::Deserialize)]
+struct ExtensionV5 {
+    terms: heapless::Vec<ExtraTerm, MAX_TERMS>,
+}
+
+impl From<ExtensionV5> for Extension {
+    fn from(v5: ExtensionV5) -> Self {
+        Self {
+            terms: v5.terms,
+            switch_on_rate: [SwitchOnRate::AT_REST; AXES],
+        }
+    }
+}
+
+/// A version-5 modified-model payload.
+#[derive(serde::Deserialize)]
+struct ModifiedTablesV5<const R: usize, const A: usize, const C: usize> {
+    settings: Settings,
+    axes: [AxisTable<R, A, C>; AXES],
+    extension: ExtensionV5,
+}
+
 /// A version-4 modified-model payload.
 #[derive(serde::Deserialize)]
 struct ModifiedTablesV4<const R: usize, const A: usize, const C: usize> {
     settings: Settings,
     axes: [AxisTableV4<R, A, C>; AXES],
-    extension: Extension,
+    extension: ExtensionV5,
 }
 
 /// A version-1 modified-model payload: the tables before the extended model existed.
@@ -183,7 +208,7 @@ struct ModifiedTablesV1<const R: usize, const A: usize, const C: usize> {
 struct ModifiedTablesV3<const R: usize, const A: usize, const C: usize> {
     settings: Settings,
     axes: [AxisTableV3<R, A, C>; AXES],
-    extension: Extension,
+    extension: ExtensionV5,
 }
 
 /// A version-2 extra term: the auxiliary input had no time constant.
@@ -244,6 +269,7 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
             2 => from_v2(payload),
             3 => from_v3(payload),
             4 => from_v4(payload),
+            5 => from_v5(payload),
             _ => from_current(payload),
         }
     }
@@ -272,7 +298,7 @@ fn from_v3<const R: usize, const A: usize, const C: usize>(
     let tables = ModifiedTables {
         settings: v3.settings,
         axes: v3.axes.map(AxisTable::from),
-        extension: v3.extension,
+        extension: v3.extension.into(),
     };
     whole(Ok((tables, rest)))
 }
@@ -286,7 +312,21 @@ fn from_v4<const R: usize, const A: usize, const C: usize>(
     let tables = ModifiedTables {
         settings: v4.settings,
         axes: v4.axes.map(AxisTable::from),
-        extension: v4.extension,
+        extension: v4.extension.into(),
+    };
+    whole(Ok((tables, rest)))
+}
+
+#[inline(never)]
+fn from_v5<const R: usize, const A: usize, const C: usize>(
+    payload: &[u8],
+) -> Result<ModifiedTables<R, A, C>, BlobError> {
+    let (v5, rest) = postcard::take_from_bytes::<ModifiedTablesV5<R, A, C>>(payload)
+        .map_err(BlobError::Malformed)?;
+    let tables = ModifiedTables {
+        settings: v5.settings,
+        axes: v5.axes,
+        extension: v5.extension.into(),
     };
     whole(Ok((tables, rest)))
 }

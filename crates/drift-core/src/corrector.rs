@@ -188,15 +188,17 @@ impl<S: Copy + Default> CorrectorState<S> {
         }
         let settings = model.settings();
         let mut flags = [Flags::NONE; AXES];
-        for (a, (((state, axis), raw), flags)) in self
+        let mut switch_ons = [SwitchOn::estimate(0.0, None); AXES];
+        for (a, ((((state, axis), raw), flags), switch_on)) in self
             .axes
             .iter_mut()
             .zip(model.axes())
             .zip(switch_on_raw)
             .zip(&mut flags)
+            .zip(&mut switch_ons)
             .enumerate()
         {
-            let switch_on = SwitchOn::estimate(
+            *switch_on = SwitchOn::estimate(
                 settings.celsius(raw),
                 previous.and_then(|p| p.get(a)).copied(),
             );
@@ -209,7 +211,7 @@ impl<S: Copy + Default> CorrectorState<S> {
                 ..AxisState::default()
             };
             let (initial_bias, mut activation) =
-                axis.power_on_after(settings, &switch_on, &mut state.model);
+                axis.power_on_after(settings, switch_on, &mut state.model);
             if plausible(initial_bias) {
                 state.initial_bias_dps = initial_bias;
             } else {
@@ -220,7 +222,8 @@ impl<S: Copy + Default> CorrectorState<S> {
             state.activation_flags = activation;
             *flags = activation;
         }
-        self.extension = ExtensionState::POWER_ON;
+        // Without a history every start is unknown and the rate filters start at rest.
+        self.extension = ExtensionState::power_on_after(model.extension(), &switch_ons);
         Ok(flags)
     }
 

@@ -13,6 +13,7 @@
 use heapless::Vec;
 
 use crate::error::{Error, Location, Problem};
+use crate::history::SwitchOn;
 use crate::AXES;
 
 /// Most extra terms a model carries.
@@ -72,12 +73,85 @@ pub struct ExtraTerm {
     pub coefficient: [f32; AXES],
 }
 
+/// One axis's temperature rate at switch-on, from what firmware knows then: where
+/// [`Term::TemperatureRate`]'s filter starts.
+///
+/// A filter started at rest reads a rate of 0 at every switch-on, while the unit's own heating
+/// starts at once (the temperature sensor sits on the heated ASIC: ~0.15 °C/s in the simulator)
+/// and, after a short off-time, the unit is still cooling by an amount that depends on the
+/// off-time. The first seconds of the estimate are then wrong, partly by a history-dependent
+/// amount, and the drift curves, which start from the first seconds' bias, carry that error as an
+/// offset the tables spread into a ramp (docs/closed-loop.md, sessions 13 and 14). The rate at
+/// switch-on is
+/// `heating − residual_heat · (cooling_per_second + cooling_per_second_per_remaining · remaining)`
+/// ([`SwitchOn`]): a unit cools faster per °C while the fast part of its heat is still there
+/// (`remaining`, the fraction of the switch-off heat left, is high after a short off-time), which
+/// needs no clock. A start with no history known is taken as cold: the heating alone.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SwitchOnRate {
+    /// The rate of a cold start at switch-on, °C/s.
+    pub heating_celsius_per_s: f32,
+    /// Cooling rate per °C of residual heat once the fast part of the heat has gone
+    /// (`remaining` → 0), 1/s (≥ 0).
+    pub cooling_per_second: f32,
+    /// How much faster per unit of `remaining`, 1/s (`cooling_per_second` + it ≥ 0: a unit never
+    /// warms itself while off).
+    pub cooling_per_second_per_remaining: f32,
+}
+
+impl SwitchOnRate {
+    /// Start the rate filter at rest, whatever the history (what images before format version 6
+    /// did).
+    pub const AT_REST: Self = Self {
+        heating_celsius_per_s: 0.0,
+        cooling_per_second: 0.0,
+        cooling_per_second_per_remaining: 0.0,
+    };
+
+    /// The sensor's temperature rate at `switch_on`, °C/s.
+    pub fn rate(&self, switch_on: &SwitchOn) -> f32 {
+        let per_second =
+            self.cooling_per_second + self.cooling_per_second_per_remaining * switch_on.remaining;
+        let rate = self.heating_celsius_per_s - switch_on.residual_heat_celsius * per_second;
+        if rate.is_finite() {
+            rate
+        } else {
+            0.0
+        }
+    }
+
+    fn validate(&self, axis: usize) -> Result<(), Error> {
+        let at = Location::axis(axis);
+        let values = [
+            self.heating_celsius_per_s,
+            self.cooling_per_second,
+            self.cooling_per_second_per_remaining,
+        ];
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(Error::new("switch_on_rate", at, Problem::NonFinite));
+        }
+        // Over the whole range of `remaining` (0 ..= 1) the cooling per °C stays ≥ 0.
+        if self.cooling_per_second < 0.0
+            || self.cooling_per_second + self.cooling_per_second_per_remaining < 0.0
+        {
+            return Err(Error::new("switch_on_rate", at, Problem::Negative));
+        }
+        Ok(())
+    }
+}
+
 /// The extra terms of a model; empty for the paper's model as published.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Extension {
     /// At most [`MAX_TERMS`] terms.
     pub terms: Vec<ExtraTerm, MAX_TERMS>,
+    /// Per axis, where the temperature-rate filter starts at a switch-on (a plain
+    /// [`crate::CorrectorState::power_on`] knows no history: a cold start, the heating alone).
+    /// Unused without a [`Term::TemperatureRate`]. JSON tables without the field start at rest.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub switch_on_rate: [SwitchOnRate; AXES],
 }
 
 /// The term values of one sample: `values[axis][term]`, centred (value − centre). Terms past the
@@ -86,15 +160,22 @@ pub type TermValues = [[f32; MAX_TERMS]; AXES];
 
 impl Extension {
     /// No extra terms.
-    pub const NONE: Self = Self { terms: Vec::new() };
+    pub const NONE: Self = Self {
+        terms: Vec::new(),
+        switch_on_rate: [SwitchOnRate::AT_REST; AXES],
+    };
 
     /// Whether the model has no extra terms (the per-sample path then skips the extension).
     pub fn is_empty(&self) -> bool {
         self.terms.is_empty()
     }
 
-    /// Checks every term: known inputs and axes, positive time constants, finite numbers.
+    /// Checks every term: known inputs and axes, positive time constants, finite numbers; and the
+    /// switch-on rate: finite, its cooling never a warming.
     pub fn validate(&self) -> Result<(), Error> {
+        for (axis, start) in self.switch_on_rate.iter().enumerate() {
+            start.validate(axis)?;
+        }
         for (index, term) in self.terms.iter().enumerate() {
             let at = Location::default().index(index);
             let bad_index = match term.term {
@@ -218,6 +299,31 @@ impl ExtensionState {
     /// The state at switch-on ([`Self::POWER_ON`]).
     pub fn power_on() -> Self {
         Self::POWER_ON
+    }
+
+    /// The state at switch-on: each axis's rate filter starts at the rate `extension`'s
+    /// [`SwitchOnRate`] gives for its `switch_on` (as if it had been following that rate), the
+    /// auxiliary filters as at [`Self::POWER_ON`].
+    pub fn power_on_after(extension: &Extension, switch_on: &[SwitchOn; AXES]) -> Self {
+        let mut state = Self::POWER_ON;
+        let time_constant_ms = extension.terms.iter().find_map(|t| match t.term {
+            Term::TemperatureRate { time_constant_ms } => Some(time_constant_ms),
+            _ => None,
+        });
+        if let Some(time_constant_ms) = time_constant_ms {
+            let tau_s = time_constant_ms as f32 / 1000.0;
+            for ((filtered, start_rate), switch_on) in state
+                .filtered_rise
+                .iter_mut()
+                .zip(&extension.switch_on_rate)
+                .zip(switch_on)
+            {
+                // The rate estimate is (rise − filtered)/τ and the rise is 0 at switch-on.
+                let start = -start_rate.rate(switch_on) * tau_s;
+                *filtered = if start.is_finite() { start } else { 0.0 };
+            }
+        }
+        state
     }
 
     /// Advances the filters to this sample and returns the centred term values: the values the

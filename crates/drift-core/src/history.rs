@@ -44,6 +44,11 @@ pub struct SwitchOn {
     pub ambient_celsius: f32,
     /// How far the switch-on temperature stands above it, °C (≥ 0): where stage 3 looks.
     pub residual_heat_celsius: f32,
+    /// The residual heat as a fraction of the heat the unit had at the previous switch-off
+    /// (switch-off temperature − ambient), 0 ..= 1; 0 for a cold or unknown start. How far the
+    /// cooling had gone: after a short off-time the fast part of the heat is still leaving, and the
+    /// unit cools faster per °C of residual heat ([`crate::SwitchOnRate`]).
+    pub remaining: f32,
     /// False when nothing was kept (or it was not finite): then the start is taken as fully cooled,
     /// which is what the paper's cold start is.
     pub known: bool,
@@ -67,6 +72,7 @@ impl SwitchOn {
             switch_on_celsius,
             ambient_celsius: switch_on_celsius,
             residual_heat_celsius: 0.0,
+            remaining: 0.0,
             known,
         };
         let Some(previous) = previous else {
@@ -82,10 +88,19 @@ impl SwitchOn {
             return cold(true);
         }
         let ambient = previous.ambient_celsius.min(switch_on_celsius);
+        let residual_heat_celsius = switch_on_celsius - ambient;
+        // Here switch-off > switch-on ≥ ambient, so the heat at switch-off is positive; the
+        // quotient is in 0 ..= 1 unless rounding or an overflow says otherwise.
+        let remaining = residual_heat_celsius / (previous.switch_off_celsius - ambient);
         Self {
             switch_on_celsius,
             ambient_celsius: ambient,
-            residual_heat_celsius: switch_on_celsius - ambient,
+            residual_heat_celsius,
+            remaining: if remaining.is_finite() {
+                remaining.clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
             known: true,
         }
     }
@@ -129,6 +144,8 @@ mod tests {
             (s.ambient_celsius, s.residual_heat_celsius, s.known),
             (30.0, 2.0, true)
         );
+        // 2 of the 5 °C it had at switch-off.
+        assert_eq!(s.remaining, 0.4);
     }
 
     #[test]

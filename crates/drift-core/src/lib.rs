@@ -37,7 +37,8 @@ pub use corrector::{
 };
 pub use error::{Error, Location, Problem};
 pub use extension::{
-    Extension, ExtensionState, ExtraTerm, Term, TermInputs, TermValues, AUX_INPUTS, MAX_TERMS,
+    Extension, ExtensionState, ExtraTerm, SwitchOnRate, Term, TermInputs, TermValues, AUX_INPUTS,
+    MAX_TERMS,
 };
 pub use flags::Flags;
 pub use history::{Previous, SwitchOn};

@@ -274,7 +274,7 @@ fn version_2_images_still_load_with_unfiltered_aux_terms() {
     .unwrap();
     assert_eq!(u16::from_le_bytes([v2[4], v2[5]]), 2);
     let tables: FixtureTables = decode(&v2).unwrap();
-    let mut expected = fixture::extended();
+    let mut expected = cooling_at_rest(fixture::extended());
     for term in &mut expected.extension.terms {
         if let Term::Aux {
             time_constant_ms, ..
@@ -305,7 +305,7 @@ fn version_3_images_still_load_keyed_by_rise() {
     assert_eq!(u16::from_le_bytes([v3[4], v3[5]]), 3);
     let tables: FixtureTables = decode(&v3).unwrap();
     assert!(tables.axes.iter().all(|axis| !axis.keyed_by_history()));
-    assert_eq!(tables, fixture::extended());
+    assert_eq!(tables, cooling_at_rest(fixture::extended()));
     let by_history = fixture::by_history();
     let mut buffer = vec![0; 64 * 1024];
     let len = encode(&by_history, &mut buffer).unwrap();
@@ -313,6 +313,34 @@ fn version_3_images_still_load_keyed_by_rise() {
     let back: FixtureTables = decode(&buffer[..len]).unwrap();
     assert!(back.axes.iter().all(|axis| axis.keyed_by_history()));
     assert_eq!(back, by_history);
+}
+
+/// `tables` with every axis's rate filter started at rest, as images before version 6 meant.
+fn cooling_at_rest(mut tables: FixtureTables) -> FixtureTables {
+    tables.extension.switch_on_rate = [drift_core::SwitchOnRate::AT_REST; 3];
+    tables
+}
+
+/// The extended fixture as the version-5 build wrote it (`testdata/image-v5-extended.bin`, the
+/// `extended` image of `testdata/vectors.json` before version 6), committed as it was: it still
+/// loads, its rate filter started at rest at every switch-on, everything else as it was; the
+/// fixture with a switch-on cooling round-trips through the current version.
+#[test]
+fn version_5_images_still_load_with_the_rate_filter_at_rest() {
+    let v5 = std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../testdata/image-v5-extended.bin"
+    ))
+    .unwrap();
+    assert_eq!(u16::from_le_bytes([v5[4], v5[5]]), 5);
+    let tables: FixtureTables = decode(&v5).unwrap();
+    assert_eq!(tables, cooling_at_rest(fixture::extended()));
+    let extended = fixture::extended();
+    assert_ne!(extended, tables);
+    let mut buffer = vec![0; 64 * 1024];
+    let len = encode(&extended, &mut buffer).unwrap();
+    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
+    assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), extended);
 }
 
 /// The history-keyed fixture as the version-4 build wrote it (`testdata/image-v4-by_history.bin`,
@@ -462,5 +490,39 @@ fn extended_images_round_trip_and_bad_terms_are_named() {
             .unwrap_err()
             .to_string(),
         "axes[1].term_coefficient[2]: value is NaN or infinite"
+    );
+    let bad_cooling = |cooling_per_second: f32, cooling_per_second_per_remaining: f32| {
+        let mut extension = extended.extension.clone();
+        extension.switch_on_rate[2] = drift_core::SwitchOnRate {
+            cooling_per_second,
+            cooling_per_second_per_remaining,
+            ..extension.switch_on_rate[2]
+        };
+        fixture::modified()
+            .with_extension(extension)
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        bad_cooling(f32::INFINITY, 0.0),
+        "axes[2].switch_on_rate: value is NaN or infinite"
+    );
+    let mut nan_heating = extended.extension.clone();
+    nan_heating.switch_on_rate[0].heating_celsius_per_s = f32::NAN;
+    assert_eq!(
+        fixture::modified()
+            .with_extension(nan_heating)
+            .unwrap_err()
+            .to_string(),
+        "axes[0].switch_on_rate: value is NaN or infinite"
+    );
+    // A unit that would warm itself while off, at either end of `remaining`.
+    assert_eq!(
+        bad_cooling(-0.001, 0.01),
+        "axes[2].switch_on_rate: must not be negative"
+    );
+    assert_eq!(
+        bad_cooling(0.004, -0.005),
+        "axes[2].switch_on_rate: must not be negative"
     );
 }

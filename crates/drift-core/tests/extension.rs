@@ -17,7 +17,8 @@ mod common;
 
 use common::fixture;
 use drift_core::{
-    Corrector, Extension, ExtensionState, ExtraTerm, Flags, Sample, Term, TermInputs, AXES,
+    Corrector, Extension, ExtensionState, ExtraTerm, Flags, Previous, Sample, SwitchOn,
+    SwitchOnRate, Term, TermInputs, AXES,
 };
 use proptest::prelude::*;
 
@@ -29,6 +30,7 @@ fn rate_only(time_constant_ms: u32) -> Extension {
             coefficient: [1.0; AXES],
         }])
         .unwrap(),
+        ..Extension::NONE
     }
 }
 
@@ -54,6 +56,63 @@ fn temperature_rate_term_follows_a_ramp() {
 }
 
 #[test]
+fn a_rate_filter_started_from_the_cooling_reads_it_until_the_heating_takes_over() {
+    // Heating at 0.15 °C/s; cooling at 1/250 s per °C plus 1/100 s per unit of the switch-off
+    // heat left.
+    let extension = Extension {
+        switch_on_rate: [SwitchOnRate {
+            heating_celsius_per_s: 0.15,
+            cooling_per_second: 0.004,
+            cooling_per_second_per_remaining: 0.01,
+        }; AXES],
+        ..rate_only(30_000)
+    };
+    let kept = Previous {
+        ambient_celsius: 30.0,
+        switch_off_celsius: 35.0,
+    };
+    // X: 2 °C of the 5 °C left; Y: nothing kept (taken as cold: the heating alone); Z: known
+    // cooled (cold).
+    let starts = [
+        SwitchOn::estimate(32.0, Some(kept)),
+        SwitchOn::estimate(32.0, None),
+        SwitchOn::estimate(32.0, Some(Previous::COOLED[2])),
+    ];
+    let expected_x = 0.15 - 2.0 * (0.004 + 0.01 * 0.4);
+    assert!((extension.switch_on_rate[0].rate(&starts[0]) - expected_x).abs() < 1e-7);
+    let mut state = ExtensionState::power_on_after(&extension, &starts);
+    let first = state.values(
+        &extension,
+        &TermInputs {
+            since_power_on_ms: 0,
+            ..TermInputs::default()
+        },
+    );
+    assert!((first[0][0] - expected_x).abs() < 1e-6, "{first:?}");
+    assert!((first[1][0] - 0.15).abs() < 1e-6 && (first[2][0] - 0.15).abs() < 1e-6);
+    // Without a rate term the start changes nothing.
+    assert_eq!(
+        ExtensionState::power_on_after(&Extension::NONE, &starts),
+        ExtensionState::POWER_ON
+    );
+    // A steady heating of 0.03 °C/s from switch-on: the estimate moves from the start towards it
+    // with the filter's τ (30 s), and after 10 τ it reads the ramp alone.
+    let mut last = first;
+    for ms in (100..=300_000).step_by(100) {
+        let t = ms as f32 / 1000.0;
+        last = state.values(
+            &extension,
+            &TermInputs {
+                since_power_on_ms: ms,
+                rise_celsius: [0.03 * t; AXES],
+                ..TermInputs::default()
+            },
+        );
+    }
+    assert!((last[0][0] - 0.03).abs() < 1e-4, "{last:?}");
+}
+
+#[test]
 fn each_term_reads_what_it_names() {
     let terms = [
         Term::Aux {
@@ -70,6 +129,7 @@ fn each_term_reads_what_it_names() {
     });
     let extension = Extension {
         terms: heapless::Vec::from_slice(&terms).unwrap(),
+        ..Extension::NONE
     };
     let mut state = ExtensionState::power_on();
     let values = state.values(
@@ -163,6 +223,7 @@ fn aux_only(time_constant_ms: u32) -> Extension {
             coefficient: [1.0; AXES],
         }])
         .unwrap(),
+        ..Extension::NONE
     }
 }
 

@@ -91,6 +91,7 @@ fn warm_start(ambient_celsius: f32, heat: f32) -> SwitchOn {
         switch_on_celsius: ambient_celsius + heat,
         ambient_celsius,
         residual_heat_celsius: heat,
+        remaining: 0.5, // the tables do not read it
         known: true,
     }
 }

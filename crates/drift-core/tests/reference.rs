@@ -434,10 +434,17 @@ fn vectors_agree_with_an_independent_f64_reference() {
                 .collect(),
             _ => Vec::new(),
         };
+        let kept: [Option<(f64, f64)>; 3] = std::array::from_fn(|i| {
+            case.previous.map(|kept| {
+                let [ambient, off] = kept[i].map(|b| f64::from(f32::from_bits(b)));
+                (ambient, off)
+            })
+        });
         let mut extension = switch_on.filter(|_| powered).map(|raw| {
             Extension::new(
                 &tables["extension"],
                 raw.map(|r| (f64::from(r) - s.zero) / s.per),
+                kept,
             )
         });
         for (i, (input, expected)) in case.samples.iter().zip(&case.expected).enumerate() {
@@ -529,7 +536,9 @@ struct Extension {
 }
 
 impl Extension {
-    fn new(json: &Value, switch_on_celsius: [f64; 3]) -> Self {
+    /// The state at switch-on; the rate filter starts at the cooling rate the kept `previous`
+    /// activation implies (at rest without one).
+    fn new(json: &Value, switch_on_celsius: [f64; 3], previous: [Option<(f64, f64)>; 3]) -> Self {
         let triple = |v: &Value| [f(&v[0]), f(&v[1]), f(&v[2])];
         let terms: Vec<_> = json["terms"]
             .as_array()
@@ -555,10 +564,35 @@ impl Extension {
                     .collect()
             })
             .unwrap_or_default();
+        let tau_s = terms
+            .iter()
+            .find(|t| t.0 == "TemperatureRate")
+            .map_or(0.0, |t| f(&t.1["time_constant_ms"]) / 1000.0);
+        let filtered = std::array::from_fn(|axis| {
+            let celsius = switch_on_celsius[axis];
+            let start = &json["switch_on_rate"][axis];
+            let (heating, a, b) = if start.is_null() {
+                (0.0, 0.0, 0.0)
+            } else {
+                (
+                    f(&start["heating_celsius_per_s"]),
+                    f(&start["cooling_per_second"]),
+                    f(&start["cooling_per_second_per_remaining"]),
+                )
+            };
+            let (ambient, heat, _) = estimate(celsius, previous[axis]);
+            let remaining = match previous[axis] {
+                Some((_, off)) if heat > 0.0 => (heat / (off - ambient)).clamp(0.0, 1.0),
+                _ => 0.0,
+            };
+            // Started as if it had followed the rate at switch-on: heating − heat · (a + b·remaining).
+            let rate = heating - heat * (a + b * remaining);
+            celsius - rate * tau_s
+        });
         Self {
             aux_filtered: vec![None; terms.len()],
             terms,
-            filtered: switch_on_celsius,
+            filtered,
             last_ms: 0.0,
         }
     }

@@ -12,10 +12,24 @@ use crate::lowpass::centred_moving_average;
 
 const AXES: [&str; 3] = ["X", "Y", "Z"];
 
-/// The temperature-rate filters' time constants the diagnosis offers, s: from the sensor's own
-/// rate (2 s, about a ±1 s difference) to a lag of minutes, a factor of ~4 apart, so whatever the
-/// element's lag one of them is within a factor of 2 of it.
-pub const RATE_TIME_CONSTANTS_S: [u32; 4] = [2, 8, 30, 120];
+/// The time constants the diagnosis offers for the sensor's own temperature rate, s: a derivative
+/// smoothed over about ±τ/2 (2 s, 8 s).
+pub const SENSOR_RATE_TIME_CONSTANTS_S: [u32; 2] = [2, 8];
+/// The time constants the diagnosis offers for the element's rate, s: lags from seconds to minutes,
+/// a factor of ~4 apart, so whatever the element's lag one of them is within a factor of 2 of it.
+pub const ELEMENT_RATE_TIME_CONSTANTS_S: [u32; 3] = [8, 30, 120];
+
+/// Where a rate candidate's filter starts at switch-on, °C/s per axis (`drift_core::SwitchOnRate`
+/// as the fitter measured it on the calibration): the sensor's rate, its own heating included,
+/// and the element's, which has not started heating (only the cooling of the heat it switched on
+/// with).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StartRates {
+    /// The temperature sensor's rate at switch-on: heating less cooling.
+    pub sensor: [f32; 3],
+    /// The element's rate at switch-on: the cooling alone.
+    pub element: [f32; 3],
+}
 
 /// The auxiliary channel holding the chamber's set point (the ambient the unit is kept at).
 pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
@@ -27,13 +41,20 @@ pub enum Kind {
     Aux(String),
     /// The axis's own temperature rate, °C/s, through a first-order low-pass of time constant
     /// `time_constant_s`: the rise since switch-on (1-s low-passed) less its low-passed self, over
-    /// τ — what drift-core's rate term computes (`Term::TemperatureRate`). Several τ, because the
-    /// sensing element sits in its capsule behind the temperature sensor and follows it through a
-    /// lag of its own, seconds to minutes, which nobody tells the fitter: the rate a bias follows
-    /// is the element's, the sensor's rate low-passed by that lag. The data chooses among
-    /// [`RATE_TIME_CONSTANTS_S`].
+    /// τ — what drift-core's rate term computes (`Term::TemperatureRate`) — started at the
+    /// sensor's rate at switch-on ([`StartRates::sensor`]): a bias that follows the temperature
+    /// sensor's own rate, the filter only smoothing it ([`SENSOR_RATE_TIME_CONSTANTS_S`]).
     TemperatureRate {
         /// The low-pass's time constant, s.
+        time_constant_s: u32,
+    },
+    /// The same filter started at the element's rate at switch-on ([`StartRates::element`]): the
+    /// sensing element sits in its capsule behind the temperature sensor and follows it through a
+    /// lag of its own, seconds to minutes, which nobody tells the fitter. The rate such a bias
+    /// follows is the sensor's rate low-passed by that lag, and at switch-on the element has not
+    /// started heating. The data chooses among [`ELEMENT_RATE_TIME_CONSTANTS_S`].
+    ElementRate {
+        /// The low-pass's time constant (the element's lag), s.
         time_constant_s: u32,
     },
     /// The axis's own temperature rise since switch-on, squared, °C².
@@ -56,7 +77,12 @@ impl Kind {
     pub fn all(aux_channels: impl IntoIterator<Item = String>, has_set_point: bool) -> Vec<Self> {
         let mut kinds: Vec<Self> = aux_channels.into_iter().map(Self::Aux).collect();
         kinds.extend(
-            RATE_TIME_CONSTANTS_S.map(|time_constant_s| Self::TemperatureRate { time_constant_s }),
+            SENSOR_RATE_TIME_CONSTANTS_S
+                .map(|time_constant_s| Self::TemperatureRate { time_constant_s }),
+        );
+        kinds.extend(
+            ELEMENT_RATE_TIME_CONSTANTS_S
+                .map(|time_constant_s| Self::ElementRate { time_constant_s }),
         );
         kinds.extend([
             Self::RiseSquared,
@@ -80,6 +106,9 @@ impl Kind {
             Self::TemperatureRate { time_constant_s } => {
                 format!("temperature rate {own} (τ {time_constant_s} s)")
             }
+            Self::ElementRate { time_constant_s } => {
+                format!("element rate {own} (τ {time_constant_s} s)")
+            }
             Self::RiseSquared => format!("rise² {own}"),
             Self::OtherAxisRise(offset) => format!("rise {}", AXES[(axis + offset) % 3]),
             Self::SinceSwitchOn => "time since switch-on".into(),
@@ -89,10 +118,11 @@ impl Kind {
         }
     }
 
-    /// The low-pass time constant, s, of a temperature-rate candidate's name (what [`Self::name`]
-    /// writes: "temperature rate X (τ 30 s)"); `None` for any other name.
+    /// The low-pass time constant, s, of a rate candidate's name (what [`Self::name`] writes:
+    /// "temperature rate X (τ 8 s)", "element rate X (τ 30 s)"); `None` for any other name.
     pub fn rate_time_constant_s(name: &str) -> Option<u32> {
-        name.strip_prefix("temperature rate ")?
+        name.strip_prefix("temperature rate ")
+            .or_else(|| name.strip_prefix("element rate "))?
             .split_once("(τ ")?
             .1
             .strip_suffix(" s)")?
@@ -100,9 +130,21 @@ impl Kind {
             .ok()
     }
 
+    /// Whether a rate candidate's name is the element's rate (its filter starts without the
+    /// heating) rather than the sensor's.
+    pub fn is_element_rate(name: &str) -> bool {
+        name.starts_with("element rate ") && Self::rate_time_constant_s(name).is_some()
+    }
+
     /// The candidate's values on every axis of `segment`, one per sample; `switch_on` is the raw
-    /// switch-on temperature per axis. `None` when the segment lacks what the kind needs.
-    pub fn values(&self, segment: &Segment, switch_on: [f32; 3]) -> Option<[Vec<f32>; 3]> {
+    /// switch-on temperature per axis, `start` where a rate's filter starts (as the firmware's term
+    /// starts). `None` when the segment lacks what the kind needs.
+    pub fn values(
+        &self,
+        segment: &Segment,
+        switch_on: [f32; 3],
+        start: &StartRates,
+    ) -> Option<[Vec<f32>; 3]> {
         let n = segment.len();
         let rate_hz = f64::from(segment.sample_rate_hz.max(1));
         let on_celsius = switch_on.map(|r| f64::from(r) / RAW_PER_CELSIUS);
@@ -135,7 +177,20 @@ impl Kind {
                 )
             }
             Self::TemperatureRate { time_constant_s } => per_axis(&|axis| {
-                filtered_rate(&rise(axis), f64::from(*time_constant_s), 1.0 / rate_hz)
+                filtered_rate(
+                    &rise(axis),
+                    f64::from(*time_constant_s),
+                    1.0 / rate_hz,
+                    f64::from(start.sensor[axis]),
+                )
+            }),
+            Self::ElementRate { time_constant_s } => per_axis(&|axis| {
+                filtered_rate(
+                    &rise(axis),
+                    f64::from(*time_constant_s),
+                    1.0 / rate_hz,
+                    f64::from(start.element[axis]),
+                )
             }),
             Self::RiseSquared => {
                 per_axis(&|axis| rise(axis).into_iter().map(|r| (r * r) as f32).collect())
@@ -166,13 +221,16 @@ impl Kind {
 
 /// The rate of `rise` (°C, one value per `step_s`) through a first-order low-pass of time constant
 /// `tau_s`, as drift-core's rate term steps it (backward Euler on the lag `rise − filtered`, the
-/// filter starting at the first rise): 0 at switch-on, the rate of a steady ramp after a few τ.
-pub fn filtered_rate(rise: &[f64], tau_s: f64, step_s: f64) -> Vec<f32> {
+/// filter starting `start_rate · τ` below the first rise): `start_rate` at switch-on, the rate of a
+/// steady ramp after a few τ.
+pub fn filtered_rate(rise: &[f64], tau_s: f64, step_s: f64, start_rate: f64) -> Vec<f32> {
     let keep = tau_s / (tau_s + step_s);
-    let mut filtered = rise.first().copied().unwrap_or(0.0);
+    let mut filtered = rise.first().copied().unwrap_or(0.0) - start_rate * tau_s;
     rise.iter()
-        .map(|&r| {
-            let lag = (r - filtered) * keep;
+        .enumerate()
+        .map(|(i, &r)| {
+            // The first sample is the switch-on itself: no time has passed to step over.
+            let lag = (r - filtered) * if i == 0 { 1.0 } else { keep };
             filtered = r - lag;
             (lag / tau_s) as f32
         })
@@ -186,17 +244,32 @@ mod tests {
 
     /// A rate candidate's name gives back its filter; no other name does.
     #[test]
-    fn a_rate_candidates_name_carries_its_time_constant() {
-        for time_constant_s in RATE_TIME_CONSTANTS_S {
+    fn a_rate_candidates_name_carries_its_time_constant_and_start() {
+        for time_constant_s in SENSOR_RATE_TIME_CONSTANTS_S {
             let name = Kind::TemperatureRate { time_constant_s }.name(1);
             assert_eq!(
                 Kind::rate_time_constant_s(&name),
                 Some(time_constant_s),
                 "{name}"
             );
+            assert!(!Kind::is_element_rate(&name), "{name}");
         }
-        for other in [Kind::RiseSquared.name(0), "temperature rate X".to_owned()] {
+        for time_constant_s in ELEMENT_RATE_TIME_CONSTANTS_S {
+            let name = Kind::ElementRate { time_constant_s }.name(2);
+            assert_eq!(
+                Kind::rate_time_constant_s(&name),
+                Some(time_constant_s),
+                "{name}"
+            );
+            assert!(Kind::is_element_rate(&name), "{name}");
+        }
+        for other in [
+            Kind::RiseSquared.name(0),
+            "temperature rate X".to_owned(),
+            "element rate Y".to_owned(),
+        ] {
             assert_eq!(Kind::rate_time_constant_s(&other), None, "{other}");
+            assert!(!Kind::is_element_rate(&other), "{other}");
         }
     }
 
@@ -208,7 +281,7 @@ mod tests {
         let rise: Vec<f64> = (0..6000)
             .map(|i| 5.0 * (1.0 - (-f64::from(i * step_ms) / 60_000.0).exp()))
             .collect();
-        let ours = filtered_rate(&rise, f64::from(tau_s), f64::from(step_ms) / 1000.0);
+        let ours = filtered_rate(&rise, f64::from(tau_s), f64::from(step_ms) / 1000.0, 0.0);
 
         let mut extension = Extension::NONE;
         let term = ExtraTerm {
@@ -243,5 +316,27 @@ mod tests {
             "{at} vs {expected}"
         );
         assert_eq!(ours[0], 0.0);
+
+        // Started at a rate, as drift-core starts it for a cold start heating at 0.12 °C/s.
+        let started = filtered_rate(&rise, f64::from(tau_s), f64::from(step_ms) / 1000.0, 0.12);
+        extension.switch_on_rate = [drift_core::SwitchOnRate {
+            heating_celsius_per_s: 0.12,
+            ..drift_core::SwitchOnRate::AT_REST
+        }; 3];
+        let cold = [drift_core::SwitchOn::estimate(30.0, None); 3];
+        let mut state = ExtensionState::power_on_after(&extension, &cold);
+        for (i, (&r, &mine)) in rise.iter().zip(&started).enumerate() {
+            let inputs = TermInputs {
+                since_power_on_ms: u32::try_from(i).unwrap() * step_ms,
+                rise_celsius: [r as f32; 3],
+                ..TermInputs::default()
+            };
+            let firmware = state.values(&extension, &inputs)[0][0];
+            assert!(
+                (firmware - mine).abs() < 2e-5,
+                "sample {i}: {firmware} vs {mine}"
+            );
+        }
+        assert!((started[0] - 0.12).abs() < 1e-6, "{}", started[0]);
     }
 }

@@ -27,6 +27,7 @@
 
 use std::collections::BTreeMap;
 
+use drift_core::SwitchOnRate;
 use drift_recording::{Segment, SegmentLabels};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -39,6 +40,7 @@ use crate::fit::FittedUnit;
 use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
+use crate::switch_on_rate::{fit_switch_on_rate, start_rates};
 
 /// Spacing of the diagnosis grid, ms: the residual is low-passed at 1 s, so 10 Hz keeps it whole.
 pub const GRID_MS: u32 = 100;
@@ -78,6 +80,11 @@ pub struct Diagnoser {
     /// Each candidate kind with the tables fitted to it; a kind the calibration activations cannot
     /// carry (an auxiliary channel they lack) is not offered.
     kinds: Vec<(Kind, Absorber)>,
+    /// Each axis's rate at switch-on measured on the calibration, where a rate candidate's filter
+    /// starts, as the firmware's term would.
+    switch_on_rate: [SwitchOnRate; 3],
+    /// The tables' sensor settings.
+    core: drift_core::Settings,
 }
 
 impl Diagnoser {
@@ -98,12 +105,19 @@ impl Diagnoser {
             .unwrap_or_default();
         channels.retain(|c| calibration.iter().all(|s| s.aux.contains_key(c)));
         let has_set_point = channels.iter().any(|c| c == SET_POINT_CHANNEL);
+        let core = fitted.modified.settings;
+        let switch_on_rate =
+            fit_switch_on_rate(calibration, &keying, &core, settings).map(|fit| fit.rate);
         let kinds = Kind::all(channels, has_set_point)
             .into_iter()
             .map(|kind| {
                 let absorber = Absorber::fit(
                     calibration,
-                    |s| kind.values(s, switch_on_raw(s, settings)),
+                    |s| {
+                        let on = switch_on_raw(s, settings);
+                        let start = start_rates(&switch_on_rate, &core, on, keying.previous(s));
+                        kind.values(s, on, &start)
+                    },
                     settings,
                     &keying,
                 )?;
@@ -115,6 +129,8 @@ impl Diagnoser {
             tables: keying.tables(&fitted.modified, &fitted.by_history),
             keying,
             kinds,
+            switch_on_rate,
+            core,
         })
     }
 
@@ -124,6 +140,12 @@ impl Diagnoser {
         let step = (segment.sample_rate_hz as usize * GRID_MS as usize / 1000).max(1);
         let switch_on = switch_on_raw(segment, &self.settings);
         let (corrected, _) = self.keying.correct(&self.tables, segment, switch_on);
+        let start = start_rates(
+            &self.switch_on_rate,
+            &self.core,
+            switch_on,
+            self.keying.previous(segment),
+        );
         let residual: [Vec<f64>; 3] = [0, 1, 2].map(|a| on_grid(&corrected[a], window, step));
         let mut candidates: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
         let mut left_over: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
@@ -131,7 +153,7 @@ impl Diagnoser {
             .kinds
             .par_iter()
             .filter_map(|(kind, absorber)| {
-                let values = kind.values(segment, switch_on)?;
+                let values = kind.values(segment, switch_on, &start)?;
                 let left = absorber.left_over(segment, values.clone(), switch_on, &self.keying);
                 Some((kind, values, left))
             })

@@ -15,7 +15,7 @@
 
 use drift_core::{
     Corrector, Extension, ExtensionState, ExtraTerm, Model, ModifiedTables, Previous, Settings,
-    Term, TermInputs, AUX_INPUTS, MAX_TERMS,
+    SwitchOnRate, Term, TermInputs, AUX_INPUTS, MAX_TERMS,
 };
 use drift_recording::Segment;
 use rayon::prelude::*;
@@ -31,6 +31,7 @@ use crate::fit::{fit_unit, FittedUnit};
 use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
+use crate::switch_on_rate::{fit_switch_on_rate, switch_ons, without_heating, SwitchOnRateFit};
 
 /// Time constant of an auxiliary term's low-pass, ms: the diagnosis scores a channel through the
 /// fit's 1-s window, and a recorded channel's sample noise (2 mV on a 5 V supply at 100 Hz) passed
@@ -62,6 +63,13 @@ pub struct TermPlan {
     pub terms: Vec<ChosenTerm>,
     /// `aux_inputs[i]` is the recording's auxiliary channel the firmware passes as input `i`.
     pub aux_inputs: Vec<String>,
+    /// Whether the rate terms are the element's rate (the filter starts at the cooling alone) or
+    /// the sensor's (heating included); `None` without a rate term.
+    pub element_rate: Option<bool>,
+    /// Per axis, where the rate filter starts at switch-on ([`extend`] measures it on the
+    /// calibration; at rest until then).
+    #[serde(skip)]
+    pub switch_on_rate: [SwitchOnRate; 3],
 }
 
 impl TermPlan {
@@ -70,15 +78,18 @@ impl TermPlan {
     /// inputs; campaign time is ageing, which no thermal term should model.
     fn term_for(&mut self, candidate: &str) -> Option<Term> {
         if let Some(time_constant_s) = Kind::rate_time_constant_s(candidate) {
-            // The filter the diagnosis scored the rate through.
+            // The filter the diagnosis scored the rate through, started as it started it.
             let time_constant_ms = time_constant_s.checked_mul(1000)?;
-            // drift-core keeps one rate filter per axis, so every rate term shares its τ: the
-            // best-ranked rate candidate sets it.
-            if self.terms.iter().any(|t| {
+            let element = Kind::is_element_rate(candidate);
+            // drift-core keeps one rate filter per axis, so every rate term shares its τ and its
+            // start: the best-ranked rate candidate sets them.
+            let other_filter = self.terms.iter().any(|t| {
                 matches!(t.term, Term::TemperatureRate { time_constant_ms: other } if other != time_constant_ms)
-            }) {
+            });
+            if other_filter || self.element_rate.is_some_and(|e| e != element) {
                 return None;
             }
+            self.element_rate = Some(element);
             return Some(Term::TemperatureRate { time_constant_ms });
         }
         if candidate.starts_with("rise² ") {
@@ -204,6 +215,15 @@ impl TermPlan {
     /// renumbered.
     fn keeping(&self, keep: &[usize]) -> Self {
         let mut kept = Self::default();
+        // Without a rate term the start is unused: the image carries none.
+        if keep
+            .iter()
+            .filter_map(|&t| self.terms.get(t))
+            .any(|t| matches!(t.term, Term::TemperatureRate { .. }))
+        {
+            kept.element_rate = self.element_rate;
+            kept.switch_on_rate = self.switch_on_rate;
+        }
         for chosen in keep.iter().filter_map(|&t| self.terms.get(t)) {
             let mut chosen = chosen.clone();
             if let Term::Aux {
@@ -253,7 +273,10 @@ impl TermPlan {
 
     /// The extension with these terms and the given centres and coefficients per term.
     fn extension(&self, centre: &[[f32; 3]], coefficient: &[[f32; 3]]) -> Extension {
-        let mut extension = Extension::NONE;
+        let mut extension = Extension {
+            switch_on_rate: self.switch_on_rate,
+            ..Extension::NONE
+        };
         for (i, chosen) in self.terms.iter().enumerate() {
             let _ = extension.terms.push(ExtraTerm {
                 term: chosen.term,
@@ -270,7 +293,12 @@ impl TermPlan {
 fn describe(term: Term, candidate: &str) -> String {
     match term {
         Term::TemperatureRate { time_constant_ms } => format!(
-            "temperature rate (own axis, τ {} s)",
+            "{} (own axis, τ {} s)",
+            if Kind::is_element_rate(candidate) {
+                "element rate"
+            } else {
+                "temperature rate"
+            },
             f64::from(time_constant_ms) / 1000.0
         ),
         Term::RiseSquared => "rise² (own axis)".into(),
@@ -309,15 +337,18 @@ pub fn correct_with_terms<M: Model>(
 }
 
 /// Per term, the uncentred values of every sample on every axis, as the corrector computes them
-/// (the last good temperature is held through faults).
+/// (the last good temperature is held through faults; the rate filter started from what firmware
+/// kept before, `previous`, as `power_on_after` starts it).
 fn term_values(
     plan: &TermPlan,
     settings: &Settings,
     segment: &Segment,
     switch_on: [f32; 3],
+    previous: Option<[Previous; 3]>,
 ) -> Vec<[Vec<f32>; 3]> {
     let shape = plan.extension(&[], &[]);
-    let mut state = ExtensionState::power_on();
+    let starts = switch_ons(settings, switch_on, previous);
+    let mut state = ExtensionState::power_on_after(&shape, &starts);
     let mut held = switch_on;
     // The corrector's conversion: times the reciprocal, the same bits.
     let celsius_per_raw = 1.0 / settings.raw_per_celsius;
@@ -401,7 +432,13 @@ fn training_series(
     };
     let switch_on = switch_on_raw(segment, settings);
     let residual = correct_with_terms(base, plan, segment, switch_on, keying.previous(segment));
-    let values = term_values(plan, base.settings(), segment, switch_on);
+    let values = term_values(
+        plan,
+        base.settings(),
+        segment,
+        switch_on,
+        keying.previous(segment),
+    );
     let raw_sum = values
         .iter()
         .map(|per_axis| {
@@ -468,7 +505,7 @@ fn refit(
             .par_iter()
             .map(|s| {
                 analyse(
-                    &without_terms(extension, plan, &core_settings, s, settings),
+                    &without_terms(extension, plan, &core_settings, s, keying, settings),
                     settings,
                 )
             })
@@ -606,6 +643,8 @@ pub struct Extended {
     pub admissions: Vec<Admission>,
     /// The unit refitted with the terms' contribution removed (its baselines are unchanged).
     pub refitted: FittedUnit,
+    /// Per axis, the rate at switch-on measured on the calibration, where the rate filter starts.
+    pub switch_on_rate: [SwitchOnRateFit; 3],
 }
 
 /// Fits the extended model of one unit: `plan`'s terms (from the diagnosis) are admitted on an
@@ -625,12 +664,23 @@ pub fn extend(
     settings: &FitSettings,
 ) -> Result<Extended, FitError> {
     let core_settings = *base.modified.settings();
+    let mut switch_on_rate = fit_switch_on_rate(calibration, keying, &core_settings, settings);
+    if plan.element_rate == Some(true) {
+        for fit in &mut switch_on_rate {
+            fit.rate = without_heating(fit.rate);
+        }
+    }
+    let plan = &TermPlan {
+        switch_on_rate: switch_on_rate.clone().map(|fit| fit.rate),
+        ..plan.clone()
+    };
     let absorbers = (0..plan.terms.len())
         .map(|t| {
             Absorber::fit(
                 calibration,
                 |s| {
-                    term_values(plan, &core_settings, s, switch_on_raw(s, settings))
+                    let on = switch_on_raw(s, settings);
+                    term_values(plan, &core_settings, s, on, keying.previous(s))
                         .into_iter()
                         .nth(t)
                 },
@@ -731,6 +781,7 @@ pub fn extend(
         plan: kept,
         admissions,
         refitted,
+        switch_on_rate,
     })
 }
 
@@ -741,10 +792,17 @@ fn without_terms(
     plan: &TermPlan,
     core_settings: &Settings,
     segment: &Segment,
+    keying: &Keying,
     settings: &FitSettings,
 ) -> Segment {
     let switch_on = switch_on_raw(segment, settings);
-    let values = term_values(plan, core_settings, segment, switch_on);
+    let values = term_values(
+        plan,
+        core_settings,
+        segment,
+        switch_on,
+        keying.previous(segment),
+    );
     let mut adjusted = segment.clone();
     for (axis, rates) in adjusted.rate_dps.iter_mut().enumerate() {
         for (t, term) in extension.terms.iter().enumerate() {
@@ -878,6 +936,34 @@ mod tests {
         );
         assert_eq!(kept.aux_inputs, ["b"]);
         assert!(plan.keeping(&[]).terms.is_empty() && plan.keeping(&[]).aux_inputs.is_empty());
+    }
+
+    #[test]
+    fn the_best_rate_candidate_sets_the_filters_start_and_a_rate_started_otherwise_is_refused() {
+        let axes = [
+            axis("X", &[("element rate X (τ 30 s)", true)]),
+            // The same τ started as the sensor's rate: the one filter cannot start both ways.
+            axis(
+                "Y",
+                &[("temperature rate Y (τ 30 s)", true), ("rise² Y", true)],
+            ),
+        ];
+        let plan = TermPlan::choose(&axes);
+        let names: Vec<&str> = plan.terms.iter().map(|t| t.candidate.as_str()).collect();
+        assert_eq!(
+            names,
+            ["element rate (own axis, τ 30 s)", "rise² (own axis)"]
+        );
+        assert_eq!(plan.element_rate, Some(true));
+        let sensor = TermPlan::choose(&[axis("Y", &[("temperature rate Y (τ 8 s)", true)])]);
+        assert_eq!(sensor.element_rate, Some(false));
+        // Dropping the rate term drops its start too.
+        assert_eq!(plan.keeping(&[1]).element_rate, None);
+        assert_eq!(plan.keeping(&[0]).element_rate, Some(true));
+        assert_eq!(
+            TermPlan::choose(&[axis("X", &[("rise² X", true)])]).element_rate,
+            None
+        );
     }
 
     #[test]

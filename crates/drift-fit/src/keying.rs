@@ -90,11 +90,13 @@ impl Keying {
         tables
     }
 
-    /// What firmware kept before `segment`, when an axis reads the history (`None`: the paper's
-    /// `power_on`). An activation this keying was not built with has nothing kept (a
-    /// cold start, flagged).
+    /// What firmware kept before `segment`, to start it with `power_on_after` as the loop's
+    /// firmware does: an axis that reads the history finds its stage 3 or initial bias there, and
+    /// the extension's rate filter its cooling at switch-on; tables that read neither start as
+    /// after `power_on`. An activation this keying was not built with has nothing kept (a cold
+    /// start, flagged where the tables read the history).
     pub fn previous(&self, segment: &Segment) -> Option<[Previous; 3]> {
-        self.any().then(|| self.kept(segment))
+        Some(self.kept(segment))
     }
 
     /// What firmware kept before `segment`, whether or not an axis reads it (nothing, for an

@@ -29,6 +29,7 @@ pub mod pipeline;
 pub mod roles;
 pub mod settings;
 pub mod summary;
+pub mod switch_on_rate;
 pub mod warm_start;
 pub mod windows;
 

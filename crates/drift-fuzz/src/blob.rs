@@ -45,7 +45,8 @@ fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8], ambients: fn(&M)
     // the (empty) extension: postcard writes its length, one byte. A version-2 image gains each
     // auxiliary term's time constant (0: one byte each). Versions 1 to 3 gain, per ambient, the
     // (empty) residual-heat labels of version 4, and versions 1 to 4 the (empty) warm starts of
-    // version 5: their length, one byte each.
+    // version 5: their length, one byte each. Versions 1 to 5 gain version 6's switch-on rate
+    // (at rest): three f32 per axis, 36 bytes.
     let version = u16::from_le_bytes([bytes[4], bytes[5]]);
     let aux_terms = model
         .extension()
@@ -53,11 +54,13 @@ fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8], ambients: fn(&M)
         .iter()
         .filter(|t| matches!(t.term, drift_core::Term::Aux { .. }))
         .count();
+    const SWITCH_ON_RATE_BYTES: usize = 3 * 3 * 4;
     let upgrade = match (version, M::KIND) {
-        (1, Kind::Modified) => 1 + 2 * ambients(&model),
-        (2, Kind::Modified) => aux_terms + 2 * ambients(&model),
-        (3, Kind::Modified) => 2 * ambients(&model),
-        (4, Kind::Modified) => ambients(&model),
+        (1, Kind::Modified) => 1 + 2 * ambients(&model) + SWITCH_ON_RATE_BYTES,
+        (2, Kind::Modified) => aux_terms + 2 * ambients(&model) + SWITCH_ON_RATE_BYTES,
+        (3, Kind::Modified) => 2 * ambients(&model) + SWITCH_ON_RATE_BYTES,
+        (4, Kind::Modified) => ambients(&model) + SWITCH_ON_RATE_BYTES,
+        (5, Kind::Modified) => SWITCH_ON_RATE_BYTES,
         _ => 0,
     };
     assert!(

@@ -1,9 +1,10 @@
 //! Target `corrector`: the run-time corrector fed arbitrary f32 streams and switch-on
 //! temperatures, with valid tables (the shared vectors' models).
 //!
-//! Input: one byte picks the model (`% 4 == 3`: the tables keyed by heating history; otherwise
-//! `% 3`: modified, standard, third-order, as before that model existed, so the committed corpus
-//! keeps its models), then a sequence of operations, each a tag byte and its operands: power on
+//! Input: one byte picks the model (`% 8 == 7`: the tables with warm starts; `% 4 == 3`: the
+//! tables keyed by heating history; `% 16 == 14`: the extended model, whose rate filter starts from
+//! what `power_on_after` was given; otherwise `% 3`: modified, standard, third-order, as before
+//! those models existed, so the committed corpus keeps most of its models), then a sequence of operations, each a tag byte and its operands: power on
 //! (3 raw temperatures), power on after a previous activation (3 raw temperatures, then either the
 //! `[Previous; 3]` the target carries — `NOTHING` at first, updated by every `power_on_after` and
 //! `keep` — or 3 × (ambient °C, switch-off °C) given by the input), keep (record the switch-off
@@ -346,6 +347,10 @@ pub fn run(data: &[u8]) {
     }
     if which % 4 == 3 {
         return drive(&m.by_history, ops, true);
+    }
+    // The extended model reads the history only to start its rate filter: no history flags.
+    if which % 16 == 14 {
+        return drive(&m.extended, ops, false);
     }
     match which % 3 {
         0 => drive(&m.modified, ops, false),

@@ -9,8 +9,9 @@ use drift_core::{ModifiedTables, PolynomialTables};
 const VECTORS: &str = include_str!("../../../testdata/vectors.json");
 
 /// The shared vectors' models: the paper's tables, the two polynomial baselines, the paper's
-/// tables with stage 3 keyed by heating history, and the paper's tables with warm starts' initial
-/// bias.
+/// tables with stage 3 keyed by heating history, the paper's tables with warm starts' initial
+/// bias, and the extended model (four extra terms, the rate filter started at the rate at
+/// switch-on).
 pub struct Models {
     /// The modified (paper's) tables.
     pub modified: ModifiedTables,
@@ -22,6 +23,8 @@ pub struct Models {
     pub by_history: ModifiedTables,
     /// The paper's tables with the initial bias of warm starts (`power_on_after`, `keep`).
     pub warm_started: ModifiedTables,
+    /// The extended model: its rate filter starts from what `power_on_after` was given.
+    pub extended: ModifiedTables,
 }
 
 fn unhex(hex: &str) -> Vec<u8> {
@@ -75,6 +78,7 @@ pub fn models() -> &'static Models {
             third_order: decode(&image("third_order")).unwrap_or_else(|e| bad("third_order", e)),
             by_history: decode(&image("by_history")).unwrap_or_else(|e| bad("by_history", e)),
             warm_started: decode(&image("warm_started")).unwrap_or_else(|e| bad("warm_started", e)),
+            extended: decode(&image("extended")).unwrap_or_else(|e| bad("extended", e)),
         }
     })
 }

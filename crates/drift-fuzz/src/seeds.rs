@@ -177,6 +177,12 @@ pub fn corrector() -> Vec<Vec<u8>> {
         *which = 7;
     }
     out.push(warm);
+    // The same operations on the extended model, whose rate filter starts from what was kept.
+    let mut extended = corrector_by_history();
+    if let Some(which) = extended.first_mut() {
+        *which = 14;
+    }
+    out.push(extended);
     out
 }
 

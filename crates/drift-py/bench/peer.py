@@ -751,7 +751,8 @@ def fit_unit(activations: Sequence[Analysed], settings: FitSettings) -> FittedUn
         )
     return FittedUnit(
         unit_id=unit_id,
-        modified={"settings": settings_json, "axes": axes},
+        # The paper's tables as drift-core writes them: no extra terms, the rate filter at rest.
+        modified={"settings": settings_json, "axes": axes, "extension": _NO_EXTENSION},
         standard={"settings": settings_json, "axes": standard},
         third_order={"settings": settings_json, "axes": third_order},
         curve_names=[_key_name(k) for k in sorted(common)],
@@ -764,6 +765,15 @@ def is_calibration(activation: Activation, set_points: Sequence[float] = (30.0, 
     return activation.series_kind == "protocol" and any(
         abs(s - activation.set_point_celsius) < 1e-6 for s in set_points
     )
+
+
+_NO_EXTENSION: dict[str, Any] = {
+    "terms": [],
+    "switch_on_rate": [
+        {"heating_celsius_per_s": 0.0, "cooling_per_second": 0.0, "cooling_per_second_per_remaining": 0.0}
+    ]
+    * 3,
+}
 
 
 def fit(

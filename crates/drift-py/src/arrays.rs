@@ -365,3 +365,40 @@ pub fn finite_values(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f32>, E
 fn borrow_error(name: &str, error: impl std::fmt::Display) -> Error {
     Error::Input(format!("`{name}` cannot be read: {error}"))
 }
+
+/// A `(3, N)` float32 or float64 array (or nested sequence): `N` numbers per axis X, Y, Z.
+/// `shape` says in the error message what the numbers are.
+pub fn rows_per_axis<const N: usize>(
+    name: &str,
+    shape: &str,
+    value: &Bound<'_, PyAny>,
+) -> Result<[[f64; N]; 3], Error> {
+    fn read<T: Copy + Into<f64>, const N: usize>(
+        view: &ArrayView2<'_, T>,
+    ) -> Option<[[f64; N]; 3]> {
+        if view.shape() != [3, N] {
+            return None;
+        }
+        let mut rows = [[0.0; N]; 3];
+        for (r, row) in rows.iter_mut().enumerate() {
+            for (c, value) in row.iter_mut().enumerate() {
+                *value = (*view.get((r, c))?).into();
+            }
+        }
+        Some(rows)
+    }
+    let wrong = || Error::Input(format!("`{name}` must be {shape}, got {}", describe(value)));
+    let borrow_error = |error| Error::Input(format!("`{name}` cannot be borrowed: {error}"));
+    if let Ok(array) = value.cast::<PyArray2<f32>>() {
+        let array = array.try_readonly().map_err(borrow_error)?;
+        read(&array.as_array()).ok_or_else(wrong)
+    } else if let Ok(array) = value.cast::<PyArray2<f64>>() {
+        let array = array.try_readonly().map_err(borrow_error)?;
+        read(&array.as_array()).ok_or_else(wrong)
+    } else if value.cast::<PyUntypedArray>().is_ok() {
+        // Another dtype or number of dimensions: not read through Python's sequence protocol.
+        Err(wrong())
+    } else {
+        value.extract::<[[f64; N]; 3]>().map_err(|_| wrong())
+    }
+}

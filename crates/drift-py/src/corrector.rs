@@ -9,12 +9,14 @@ use drift_core::{
     AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialTables, Previous,
     Sample, AUX_INPUTS,
 };
-use numpy::ndarray::{Array2, ArrayView1, ArrayView2};
-use numpy::{IntoPyArray, PyArray2, PyArrayMethods};
+use numpy::ndarray::{Array2, ArrayView1};
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 
 use crate::args;
-use crate::arrays::{copy_times, describe, times, BatchArrays, OutArrays, Rows, RowsView};
+use crate::arrays::{
+    copy_times, describe, rows_per_axis, times, BatchArrays, OutArrays, Rows, RowsView,
+};
 use crate::errors::Error;
 use crate::tables::{PyModifiedTables, PyPolynomialTables};
 
@@ -264,36 +266,7 @@ const PREVIOUS_SHAPE: &str =
 /// A `(3, 2)` float array (or nested sequence) of what was kept of the previous activation, as
 /// drift-core takes it (float64 rounded to f32 per value, as `astype(np.float32)` does).
 pub(crate) fn previous_arg(name: &str, value: &Bound<'_, PyAny>) -> Result<[Previous; 3], Error> {
-    fn read<T: Copy + Into<f64>>(view: &ArrayView2<'_, T>) -> Option<[[f64; 2]; 3]> {
-        if view.shape() != [3, 2] {
-            return None;
-        }
-        let at = |row: usize, column: usize| view.get((row, column)).map(|v| (*v).into());
-        let row = |r: usize| Some([at(r, 0)?, at(r, 1)?]);
-        Some([row(0)?, row(1)?, row(2)?])
-    }
-    let wrong = || {
-        Error::Input(format!(
-            "`{name}` must be {PREVIOUS_SHAPE}, got {}",
-            describe(value)
-        ))
-    };
-    let values = if let Ok(array) = value.cast::<PyArray2<f32>>() {
-        let array = array
-            .try_readonly()
-            .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))?;
-        read(&array.as_array()).ok_or_else(wrong)?
-    } else if let Ok(array) = value.cast::<PyArray2<f64>>() {
-        let array = array
-            .try_readonly()
-            .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))?;
-        read(&array.as_array()).ok_or_else(wrong)?
-    } else if value.cast::<numpy::PyUntypedArray>().is_ok() {
-        // Another dtype or number of dimensions: not read through Python's sequence protocol.
-        return Err(wrong());
-    } else {
-        value.extract::<[[f64; 2]; 3]>().map_err(|_| wrong())?
-    };
+    let values = rows_per_axis(name, PREVIOUS_SHAPE, value)?;
     #[allow(clippy::cast_possible_truncation)]
     Ok(values.map(|[ambient, off]| Previous {
         ambient_celsius: ambient as f32,

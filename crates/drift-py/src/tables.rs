@@ -7,7 +7,9 @@
 
 use std::sync::Arc;
 
-use drift_core::{Extension, Model, ModifiedTables, PolynomialTables, MAX_TERMS};
+use drift_core::{Extension, Model, ModifiedTables, PolynomialTables, SwitchOnRate, MAX_TERMS};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyString, PyTuple};
 
@@ -198,9 +200,38 @@ model_class!(
             PyTuple::new(py, self.0.extension.terms.iter().map(|&t| PyExtraTerm(t)))
         }
 
-        /// The same tables with `terms` as the extra terms (replacing any; empty: none), validated
-        /// by drift-core (`TableError` names the term).
-        fn with_extension(&self, terms: &Bound<'_, PyAny>) -> Result<Self, Error> {
+        /// Per axis X, Y, Z, the rate at switch-on the rate term's filter starts from
+        /// (`drift_core::SwitchOnRate`): `[heating °C/s, cooling_per_second,
+        /// cooling_per_second_per_remaining]`, a float32 `(3, 3)` array (zeros: at rest).
+        #[getter]
+        fn switch_on_rate<'py>(&self, py: Python<'py>) -> Result<Bound<'py, PyArray2<f32>>, Error> {
+            let values = self
+                .0
+                .extension
+                .switch_on_rate
+                .iter()
+                .flat_map(|r| {
+                    [
+                        r.heating_celsius_per_s,
+                        r.cooling_per_second,
+                        r.cooling_per_second_per_remaining,
+                    ]
+                })
+                .collect();
+            Array2::from_shape_vec((3, 3), values)
+                .map(|array| array.into_pyarray(py))
+                .map_err(|error| Error::Input(format!("internal: rate shape (3, 3): {error}")))
+        }
+
+        /// The same tables with `terms` as the extra terms (replacing any; empty: none) and, if
+        /// given, `switch_on_rate` (`(3, 3)`; `None` keeps the current one), validated by
+        /// drift-core (`TableError` names the term or the axis).
+        #[pyo3(signature = (terms, switch_on_rate = None))]
+        fn with_extension(
+            &self,
+            terms: &Bound<'_, PyAny>,
+            switch_on_rate: Option<&Bound<'_, PyAny>>,
+        ) -> Result<Self, Error> {
             let wrong = || {
                 Error::Input(format!(
                     "`terms` must be a sequence of gyrodrift.ExtraTerm, got {}",
@@ -217,7 +248,25 @@ model_class!(
                     items.len()
                 )));
             }
-            let mut extension = Extension::NONE;
+            let mut extension = Extension {
+                switch_on_rate: self.0.extension.switch_on_rate,
+                ..Extension::NONE
+            };
+            if let Some(value) = switch_on_rate {
+                let rows = crate::arrays::rows_per_axis(
+                    "switch_on_rate",
+                    "a float32 or float64 array of shape (3, 3): per axis X, Y, Z, [heating °C/s, \
+                     cooling_per_second, cooling_per_second_per_remaining]",
+                    value,
+                )?;
+                #[allow(clippy::cast_possible_truncation)]
+                let rates = rows.map(|[heating, cooling, faster]| SwitchOnRate {
+                    heating_celsius_per_s: heating as f32,
+                    cooling_per_second: cooling as f32,
+                    cooling_per_second_per_remaining: faster as f32,
+                });
+                extension.switch_on_rate = rates;
+            }
             for (index, item) in items.iter().enumerate() {
                 let term = item.cast::<PyExtraTerm>().map_err(|_| {
                     Error::Input(format!(

@@ -23,6 +23,10 @@ def extended(models: dict[str, Model]) -> ModifiedTables:
     return model
 
 
+# The vectors' extended model's rate at switch-on, per axis [heating, cooling, faster per remaining].
+SWITCH_ON_RATE = [[0.15, 0.004, 0.0085], [0.15, 0.0035, 0.0085], [0.15, 0.003, 0.0085]]
+
+
 def terms() -> list[ExtraTerm]:
     return [
         ExtraTerm("temperature_rate", 5000, centre=(0.01, 0.012, 0.008), coefficient=(0.1, -0.08, 0.05)),
@@ -84,13 +88,53 @@ def test_extra_terms_compare_by_value() -> None:
 def test_with_extension_rebuilds_the_extended_model(
     modified: ModifiedTables, extended: ModifiedTables
 ) -> None:
-    """The vectors' extended model is the paper's model plus these four terms."""
-    rebuilt = modified.with_extension(terms())
+    """The vectors' extended model is the paper's model plus these four terms and its rate at
+    switch-on."""
+    rebuilt = modified.with_extension(terms(), switch_on_rate=SWITCH_ON_RATE)
     assert rebuilt == extended
     assert rebuilt.to_image() == extended.to_image()
     assert modified.extension == ()  # immutable: the original is untouched
-    assert extended.with_extension([]) == modified
+    # Without the rate the filter starts at rest: another model.
+    assert modified.with_extension(terms()) != extended
+    assert extended.with_extension([], np.zeros((3, 3))) == modified
     assert extended.with_extension(()).extension == ()
+
+
+def test_switch_on_rate_reads_as_given_and_none_keeps_it(
+    modified: ModifiedTables, extended: ModifiedTables
+) -> None:
+    rate = extended.switch_on_rate
+    assert rate.dtype == np.float32 and rate.shape == (3, 3)
+    np.testing.assert_array_equal(rate, np.asarray(SWITCH_ON_RATE, dtype=np.float32))
+    np.testing.assert_array_equal(modified.switch_on_rate, np.zeros((3, 3), dtype=np.float32))
+    # `None` keeps it, whatever the terms; a float64 array is taken as f32 values.
+    np.testing.assert_array_equal(extended.with_extension(terms()[:1]).switch_on_rate, rate)
+    doubled = extended.with_extension(terms(), np.asarray(SWITCH_ON_RATE) * 2)
+    np.testing.assert_array_equal(doubled.switch_on_rate, rate * 2)
+
+
+@pytest.mark.parametrize(
+    ("rate", "error", "message"),
+    [
+        (np.zeros((3, 2)), InputError, "`switch_on_rate` must be a float32 or float64 array of shape (3, 3)"),
+        ([[0.1, 0.0]] * 3, InputError, "`switch_on_rate` must be a float32 or float64 array of shape (3, 3)"),
+        (
+            [[0.1, 0.004, 0.0], [0.1, 0.004, 0.0], [0.1, -0.001, 0.0]],
+            TableError,
+            "invalid tables: axes[2].switch_on_rate: must not be negative",
+        ),
+        (
+            [[float("nan"), 0.004, 0.0], [0.1, 0.004, 0.0], [0.1, 0.004, 0.0]],
+            TableError,
+            "invalid tables: axes[0].switch_on_rate: value is NaN or infinite",
+        ),
+    ],
+)
+def test_a_bad_switch_on_rate_is_named(
+    modified: ModifiedTables, rate: Any, error: type[Exception], message: str
+) -> None:
+    with pytest.raises(error, match=re.escape(message)):
+        modified.with_extension(terms(), rate)
 
 
 def test_with_extension_accepts_a_tuple_and_replaces_the_terms(extended: ModifiedTables) -> None:

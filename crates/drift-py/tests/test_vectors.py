@@ -52,21 +52,21 @@ def test_extended_cases_exercise_the_extension(cases: list[Case], models: dict[s
 
 def test_history_cases_start_with_what_was_kept(cases: list[Case], models: dict[str, Model]) -> None:
     """Guards the tests below against passing vacuously: cases with a kept previous activation
-    exist (history-keyed and not), `powered_corrector` starts them with `power_on_after`, and they
-    exercise both history flags."""
+    exist (history-keyed and not, and the extended model's rate at switch-on), `powered_corrector`
+    starts them with `power_on_after`, and they exercise both history flags."""
     with_previous = [c for c in cases if c.previous is not None]
-    assert {c.model for c in with_previous} == {"by_history", "modified", "warm_started"}
+    assert {c.model for c in with_previous} == {"by_history", "extended", "modified", "warm_started"}
     assert all(c.previous is not None and c.previous.shape == (3, 2) for c in with_previous)
     flags = np.concatenate([c.flags for c in cases if c.model == "by_history"])
     for flag in (gyrodrift.Flags.HISTORY_UNKNOWN, gyrodrift.Flags.HISTORY_OUT_OF_SPAN):
         assert (flags & flag).any(), flag
     # The same samples started with `power_on` instead differ: the kept values are read (stage 3
-    # keyed by history; the warm starts' initial bias).
-    for model in ("by_history", "warm_started"):
+    # keyed by history; the warm starts' initial bias; the rate filter's start).
+    for model in ("by_history", "warm_started", "extended"):
         case = next(c for c in with_previous if c.model == model and c.switch_on_raw is not None)
         cold = gyrodrift.Corrector(models[case.model])
         cold.power_on(case.switch_on_raw)
-        corrected, _, _ = cold.correct_batch(case.times, case.rate, case.temperature)
+        corrected, _, _ = cold.correct_batch(case.times, case.rate, case.temperature, aux=case.aux)
         assert not same_bits(case.corrected, corrected).all(), model
 
 

@@ -273,6 +273,17 @@ fn scenarios() -> Vec<Scenario> {
             previous: None,
         },
         Scenario {
+            name: "extended-warm-start",
+            description: "the extended model switched on with power_on_after at 33 °C after a short off-time (ambient 31 °C, switched off at 36 / 35.5 °C; Z switched off at 32.5 °C, below its switch-on: the ambient rose, a cold start): the rate filters of X and Y start at the heating less the cooling the kept history implies (X: 2 °C of residual heat, 0.4 of the switch-off heat left, 0.15 − 0.0148 °C/s), Z's at the heating alone",
+            model: "extended",
+            switch_on_celsius: Some([33.0, 33.0, 33.0]),
+            final_rise: [3.0, 2.5, 3.5],
+            times: every(1000, 120_000),
+            tamper: untouched,
+            aux: Some(supply_and_gravity),
+            previous: Some([[31.0, 36.0], [31.0, 35.5], [30.5, 32.5]]),
+        },
+        Scenario {
             name: "history-warm-start",
             description: "tables keyed by heating history: switched on at 33 °C after a short off-time at a 31 °C ambient (X, Y) and 30.5 °C (Z): stage 2 at the ambient, stage 3 at 2.0 / 2.2 / 2.5 °C of residual heat, between stored histories",
             model: "by_history",

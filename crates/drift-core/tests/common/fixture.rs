@@ -8,7 +8,7 @@
 
 use drift_core::{
     AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, PolynomialAxis, PolynomialTables,
-    Settings, WarmStart,
+    Settings, SwitchOnRate, WarmStart,
 };
 
 /// Reference times, ms.
@@ -162,6 +162,14 @@ pub fn extended() -> FixtureTables {
     ];
     let extension = Extension {
         terms: heapless::Vec::from_slice(&terms).unwrap(),
+        // A unit that heats at 0.15 °C/s at switch-on and cools at 1/250 s per °C of residual heat
+        // once its fast heat has gone, up to 1/80 s right after switch-off (X; Y and Z a little
+        // slower).
+        switch_on_rate: [0.004, 0.0035, 0.003].map(|cooling_per_second| SwitchOnRate {
+            heating_celsius_per_s: 0.15,
+            cooling_per_second,
+            cooling_per_second_per_remaining: 0.0085,
+        }),
     };
     modified().with_extension(extension).unwrap()
 }

@@ -71,6 +71,7 @@ _Path: TypeAlias = str | os.PathLike[str]
 _Floats3: TypeAlias = Sequence[float] | NDArray[np.floating]
 _Model: TypeAlias = ModifiedTables | PolynomialTables
 _Previous: TypeAlias = NDArray[np.floating] | Sequence[Sequence[float]]
+_FloatRows: TypeAlias = NDArray[np.floating] | Sequence[Sequence[float]]
 _Floats: TypeAlias = NDArray[np.float32] | NDArray[np.float64]
 _Floats4: TypeAlias = Sequence[float] | NDArray[np.floating]
 _TermKind: TypeAlias = Literal["temperature_rate", "aux", "axis_rise", "rise_squared"]
@@ -228,13 +229,26 @@ class ModifiedTables:
     @property
     def extension(self) -> tuple[ExtraTerm, ...]:
         """The extended model's extra terms, in model order; empty for the paper's model."""
-    def with_extension(self, terms: Sequence[ExtraTerm]) -> ModifiedTables:
-        """The same tables with `terms` as the extra terms (replacing any; `[]` removes them).
+    @property
+    def switch_on_rate(self) -> NDArray[np.float32]:
+        """Per axis X, Y, Z (rows), the rate at switch-on the temperature-rate term's filter starts
+        from: `[heating °C/s, cooling_per_second, cooling_per_second_per_remaining]`, float32
+        `(3, 3)`. The rate is `heating − residual_heat · (cooling_per_second +
+        cooling_per_second_per_remaining · remaining)` for the history `Corrector.power_on_after`
+        was given (`power_on`: a cold start, the heating alone). Zeros: the filter starts at rest,
+        as every model before image format 6 did."""
+    def with_extension(
+        self, terms: Sequence[ExtraTerm], switch_on_rate: _FloatRows | None = None
+    ) -> ModifiedTables:
+        """The same tables with `terms` as the extra terms (replacing any; `[]` removes them) and,
+        if given, `switch_on_rate` (`(3, 3)`, as the property; `None` keeps the current one).
 
-        At most `MAX_EXTRA_TERMS` terms (`InputError` otherwise, or for anything not an
-        `ExtraTerm`). drift-core validates the whole model: an unknown input or axis index, a
-        time constant of 0, rate terms with different time constants or a NaN/inf centre or
-        coefficient raise `TableError` naming the term's index. `self` is unchanged.
+        At most `MAX_EXTRA_TERMS` terms (`InputError` otherwise, for anything not an `ExtraTerm`,
+        or a `switch_on_rate` not of shape (3, 3)). drift-core validates the whole model: an
+        unknown input or axis index, a time constant of 0, rate terms with different time
+        constants, a NaN/inf centre or coefficient, or a switch-on rate that is not finite or
+        whose cooling would warm the unit raise `TableError` naming the term's index or the
+        axis. `self` is unchanged.
         """
     def __eq__(self, other: object, /) -> bool: ...
 
