@@ -274,15 +274,13 @@ mod tests {
     }
 
     /// The diagnosis scores the rate the firmware's term computes: drift-core's filter, fed the
-    /// same rise, gives the same values.
+    /// same rise, gives the same values, started at rest or at a rate.
     #[test]
     fn the_filtered_rate_is_drift_cores_rate_term() {
         let (tau_s, step_ms) = (8_u32, 10_u32);
         let rise: Vec<f64> = (0..6000)
             .map(|i| 5.0 * (1.0 - (-f64::from(i * step_ms) / 60_000.0).exp()))
             .collect();
-        let ours = filtered_rate(&rise, f64::from(tau_s), f64::from(step_ms) / 1000.0, 0.0);
-
         let mut extension = Extension::NONE;
         let term = ExtraTerm {
             term: Term::TemperatureRate {
@@ -292,19 +290,35 @@ mod tests {
             coefficient: [1.0; 3],
         };
         extension.terms.push(term).unwrap();
-        let mut state = ExtensionState::power_on();
-        for (i, (&r, &mine)) in rise.iter().zip(&ours).enumerate() {
-            let inputs = TermInputs {
-                since_power_on_ms: u32::try_from(i).unwrap() * step_ms,
-                rise_celsius: [r as f32; 3],
-                ..TermInputs::default()
-            };
-            let firmware = state.values(&extension, &inputs)[0][0];
-            assert!(
-                (firmware - mine).abs() < 2e-5,
-                "sample {i}: {firmware} vs {mine}"
+        // Ours against drift-core's, started as a cold start heating at `heating` °C/s.
+        let mut compare = |heating: f32| -> Vec<f32> {
+            let ours = filtered_rate(
+                &rise,
+                f64::from(tau_s),
+                f64::from(step_ms) / 1000.0,
+                f64::from(heating),
             );
-        }
+            extension.switch_on_rate = [drift_core::SwitchOnRate {
+                heating_celsius_per_s: heating,
+                ..drift_core::SwitchOnRate::AT_REST
+            }; 3];
+            let cold = [drift_core::SwitchOn::estimate(30.0, None); 3];
+            let mut state = ExtensionState::power_on_after(&extension, &cold);
+            for (i, (&r, &mine)) in rise.iter().zip(&ours).enumerate() {
+                let inputs = TermInputs {
+                    since_power_on_ms: u32::try_from(i).unwrap() * step_ms,
+                    rise_celsius: [r as f32; 3],
+                    ..TermInputs::default()
+                };
+                let firmware = state.values(&extension, &inputs)[0][0];
+                assert!(
+                    (firmware - mine).abs() < 2e-5,
+                    "start {heating}, sample {i}: {firmware} vs {mine}"
+                );
+            }
+            ours
+        };
+        let ours = compare(0.0);
         // The rate through the low-pass: a first-order low-pass of time constant τ turns the
         // decaying rate (5/T)·e^(−t/T) into the same exponential times T/(T − τ) once its own
         // start (e^(−t/τ)) has died away; at t = 60 s that is e^(−7.5) ≈ 6e-4 of it.
@@ -316,27 +330,7 @@ mod tests {
             "{at} vs {expected}"
         );
         assert_eq!(ours[0], 0.0);
-
-        // Started at a rate, as drift-core starts it for a cold start heating at 0.12 °C/s.
-        let started = filtered_rate(&rise, f64::from(tau_s), f64::from(step_ms) / 1000.0, 0.12);
-        extension.switch_on_rate = [drift_core::SwitchOnRate {
-            heating_celsius_per_s: 0.12,
-            ..drift_core::SwitchOnRate::AT_REST
-        }; 3];
-        let cold = [drift_core::SwitchOn::estimate(30.0, None); 3];
-        let mut state = ExtensionState::power_on_after(&extension, &cold);
-        for (i, (&r, &mine)) in rise.iter().zip(&started).enumerate() {
-            let inputs = TermInputs {
-                since_power_on_ms: u32::try_from(i).unwrap() * step_ms,
-                rise_celsius: [r as f32; 3],
-                ..TermInputs::default()
-            };
-            let firmware = state.values(&extension, &inputs)[0][0];
-            assert!(
-                (firmware - mine).abs() < 2e-5,
-                "sample {i}: {firmware} vs {mine}"
-            );
-        }
+        let started = compare(0.12);
         assert!((started[0] - 0.12).abs() < 1e-6, "{}", started[0]);
     }
 }
