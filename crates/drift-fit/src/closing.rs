@@ -18,6 +18,7 @@ use crate::fit::FittedUnit;
 use crate::keying::Keying;
 use crate::roles::Roles;
 use crate::settings::FitSettings;
+use crate::switch_on_rate::fit_switch_on_rate;
 use crate::warm_start::{self, WarmStartChoice};
 
 /// One unit's loop, closed as far as its data allow.
@@ -273,8 +274,22 @@ pub fn close<'a>(
     );
     let warm_start = warm_start::choose(fitted, &keying, &roles.training, settings);
     let keying = keying.with_warm_start(std::array::from_fn(|a| warm_start[a].chosen));
+    // Where a rate filter starts at switch-on, measured once on the calibration: the diagnosis
+    // starts its rate candidates there and the extended model its rate term.
+    let switch_on_rate = fit_switch_on_rate(
+        &roles.calibration,
+        &keying,
+        &fitted.modified.settings,
+        settings,
+    );
     let diagnosed = |keying: &Keying| -> Result<Vec<ActivationSeries>, FitError> {
-        let diagnoser = Diagnoser::new(fitted, &roles.calibration, settings, keying.clone())?;
+        let diagnoser = Diagnoser::new(
+            fitted,
+            &roles.calibration,
+            settings,
+            keying.clone(),
+            switch_on_rate.clone().map(|fit| fit.rate),
+        )?;
         Ok(roles
             .diagnosed()
             .iter()
@@ -298,6 +313,7 @@ pub fn close<'a>(
             fitted,
             &keying,
             &proposed,
+            &switch_on_rate,
             &roles.calibration,
             &roles.training,
             settings,

@@ -40,7 +40,7 @@ use crate::fit::FittedUnit;
 use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
-use crate::switch_on_rate::{fit_switch_on_rate, start_rates};
+use crate::switch_on_rate::start_rates;
 
 /// Spacing of the diagnosis grid, ms: the residual is low-passed at 1 s, so 10 Hz keeps it whole.
 pub const GRID_MS: u32 = 100;
@@ -92,12 +92,15 @@ impl Diagnoser {
     /// fitted on. Candidates are the auxiliary channels every calibration activation has and the
     /// derived quantities.
     ///
-    /// The model diagnosed is the paper's with stage 3 keyed as `keying` says per axis.
+    /// The model diagnosed is the paper's with stage 3 keyed as `keying` says per axis; a rate
+    /// candidate's filter starts at `switch_on_rate` (measured on the same calibration,
+    /// [`crate::switch_on_rate::fit_switch_on_rate`]), as the firmware's term would.
     pub fn new(
         fitted: &FittedUnit,
         calibration: &[&Segment],
         settings: &FitSettings,
         keying: Keying,
+        switch_on_rate: [SwitchOnRate; 3],
     ) -> Result<Self, FitError> {
         let mut channels: Vec<String> = calibration
             .first()
@@ -106,8 +109,6 @@ impl Diagnoser {
         channels.retain(|c| calibration.iter().all(|s| s.aux.contains_key(c)));
         let has_set_point = channels.iter().any(|c| c == SET_POINT_CHANNEL);
         let core = fitted.modified.settings;
-        let switch_on_rate =
-            fit_switch_on_rate(calibration, &keying, &core, settings).map(|fit| fit.rate);
         let kinds = Kind::all(channels, has_set_point)
             .into_iter()
             .map(|kind| {

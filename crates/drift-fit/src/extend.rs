@@ -31,7 +31,7 @@ use crate::fit::{fit_unit, FittedUnit};
 use crate::keying::Keying;
 use crate::lowpass::centred_moving_average;
 use crate::settings::FitSettings;
-use crate::switch_on_rate::{fit_switch_on_rate, switch_ons, without_heating, SwitchOnRateFit};
+use crate::switch_on_rate::{switch_ons, without_heating, SwitchOnRateFit};
 
 /// Time constant of an auxiliary term's low-pass, ms: the diagnosis scores a channel through the
 /// fit's 1-s window, and a recorded channel's sample noise (2 mV on a 5 V supply at 100 Hz) passed
@@ -654,17 +654,19 @@ pub struct Extended {
 /// terms' coefficients are fitted on all `training` activations against what the tables leave of
 /// each term ([`Absorber`]), and the tables are refitted once on `calibration` with the terms'
 /// contribution removed. With nothing admitted the paper's tables come back unchanged. Stage 3 is
-/// keyed per axis as `keying` says, throughout: the base model, the absorbers and the refits.
+/// keyed per axis as `keying` says, throughout: the base model, the absorbers and the refits. A
+/// rate term's filter starts at `switch_on_rate` (without the heating for the element's rate).
 pub fn extend(
     base: &FittedUnit,
     keying: &Keying,
     plan: &TermPlan,
+    switch_on_rate: &[SwitchOnRateFit; 3],
     calibration: &[&Segment],
     training: &[&Segment],
     settings: &FitSettings,
 ) -> Result<Extended, FitError> {
     let core_settings = *base.modified.settings();
-    let mut switch_on_rate = fit_switch_on_rate(calibration, keying, &core_settings, settings);
+    let mut switch_on_rate = switch_on_rate.clone();
     if plan.element_rate == Some(true) {
         for fit in &mut switch_on_rate {
             fit.rate = without_heating(fit.rate);
