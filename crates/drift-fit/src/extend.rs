@@ -465,22 +465,62 @@ fn training_series(
     }
 }
 
-/// Least squares of the residual on an intercept and the `chosen` terms' left-over values over the
-/// `groups` activations of `axis`; returns the coefficients (intercept first).
-fn joint_fit(series: &[&TrainingSeries], axis: usize, chosen: &[usize]) -> Vec<f64> {
+/// Least squares over `series` of `axis`'s residual, less `known` (per activation and grid point,
+/// what terms already fitted explain), on the `chosen` terms' left-over values. `within`: on each
+/// activation's variation about its own mean (an intercept per activation), the shape within
+/// activations; otherwise on one intercept for all, offsets between activations included. Returns
+/// the coefficients of `chosen`, in order.
+fn joint_fit(
+    series: &[&TrainingSeries],
+    axis: usize,
+    chosen: &[usize],
+    known: &[Vec<f64>],
+    within: bool,
+) -> Vec<f64> {
     let mut rows = Vec::new();
     let mut ys = Vec::new();
-    for s in series {
-        for (i, &y) in s.residual[axis].iter().enumerate() {
+    let mean = |values: &mut dyn Iterator<Item = f64>| {
+        let (sum, n) = values
+            .filter(|v| v.is_finite())
+            .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+        if within && n > 0 {
+            sum / n as f64
+        } else {
+            0.0
+        }
+    };
+    for (s, known) in series.iter().zip(known) {
+        let y = |i: usize| s.residual[axis][i] - known.get(i).copied().unwrap_or(0.0);
+        let y_mean = mean(&mut (0..s.residual[axis].len()).map(y));
+        let term_means: Vec<f64> = chosen
+            .iter()
+            .map(|&t| mean(&mut s.terms[t][axis].iter().copied()))
+            .collect();
+        for i in 0..s.residual[axis].len() {
+            // Within activations each one's own mean is its intercept, already taken out.
+            let intercept = (!within).then_some(1.0);
             rows.push(
-                std::iter::once(1.0)
-                    .chain(chosen.iter().map(|&t| s.terms[t][axis][i]))
+                intercept
+                    .into_iter()
+                    .chain(
+                        chosen
+                            .iter()
+                            .zip(&term_means)
+                            .map(|(&t, m)| s.terms[t][axis][i] - m),
+                    )
                     .collect::<Vec<f64>>(),
             );
-            ys.push(y);
+            ys.push(y(i) - y_mean);
         }
     }
-    crate::diagnose::least_squares(&rows, &ys)
+    if chosen.is_empty() {
+        return Vec::new();
+    }
+    let beta = crate::diagnose::least_squares(&rows, &ys);
+    let first = usize::from(!within);
+    (0..chosen.len())
+        .map(|k| beta.get(first + k).copied().unwrap_or(0.0))
+        .collect()
 }
 
 /// The paper's tables refitted on `calibration` with `extension`'s contribution removed, carrying
@@ -538,18 +578,49 @@ fn errors(
     std::array::from_fn(|a| (rms[a] * rms[a], drift[a]))
 }
 
-/// Coefficients per term and axis: least squares over `series` of each axis's residual on the
-/// left-over values of the terms `admitted[axis]` (all other coefficients zero).
+/// Coefficients per term and axis over `series`, against the left-over values of the terms
+/// `admitted[axis]` (all other coefficients zero), each kind on what it is for, as the guard
+/// judges it: the terms that change the shape within activations by least squares on each
+/// activation's variation about its own mean; then the auxiliary inputs, which move offsets
+/// between activations, on what the shape terms leave, with one intercept.
+///
+/// Why not one pooled fit: the offsets between activations dominate the squared residual, and a
+/// shape term whose left-over values also differ in mean from one activation to the next took its
+/// coefficient from those offsets, which the warm starts' initial bias already answers. Fitted on
+/// the shape alone the element's rate cut the held-out drift excess ≥ 2× on 6 of 9 axes instead
+/// of 4 (thermal lag at 5×, seeds 2–4, docs/closed-loop.md, session 14).
 fn coefficients(
+    plan: &TermPlan,
     series: &[&TrainingSeries],
     admitted: &[Vec<usize>; 3],
-    terms: usize,
 ) -> Vec<[f32; 3]> {
-    let mut coefficient = vec![[0.0f32; 3]; terms];
+    let mut coefficient = vec![[0.0f32; 3]; plan.terms.len()];
+    let shapes = |t: &usize| plan.terms.get(*t).is_some_and(|c| changes_shape(c.term));
     for (axis, chosen) in admitted.iter().enumerate() {
-        let beta = joint_fit(series, axis, chosen);
-        for (k, &t) in chosen.iter().enumerate() {
-            coefficient[t][axis] = beta.get(k + 1).copied().unwrap_or(0.0) as f32;
+        let (shape, offset): (Vec<usize>, Vec<usize>) = chosen.iter().copied().partition(shapes);
+        let none: Vec<Vec<f64>> = vec![Vec::new(); series.len()];
+        let shape_beta = joint_fit(series, axis, &shape, &none, true);
+        let explained: Vec<Vec<f64>> = series
+            .iter()
+            .map(|s| {
+                (0..s.residual[axis].len())
+                    .map(|i| {
+                        shape
+                            .iter()
+                            .zip(&shape_beta)
+                            .map(|(&t, b)| b * s.terms[t][axis][i])
+                            .sum()
+                    })
+                    .collect()
+            })
+            .collect();
+        let offset_beta = joint_fit(series, axis, &offset, &explained, false);
+        for (&t, &b) in shape
+            .iter()
+            .zip(&shape_beta)
+            .chain(offset.iter().zip(&offset_beta))
+        {
+            coefficient[t][axis] = b as f32;
         }
     }
     coefficient
@@ -609,7 +680,7 @@ fn held_out_gains(
             .map(|(_, s)| *s)
             .collect();
         let held_out_errors = |chosen: &[Vec<usize>; 3]| -> Result<Vec<[(f64, f64); 3]>, FitError> {
-            let extension = plan.extension(centre, &coefficients(&train, chosen, plan.terms.len()));
+            let extension = plan.extension(centre, &coefficients(plan, &train, chosen));
             let (_, tables) = refit(base, keying, plan, &extension, calibration, settings)?;
             Ok(held_out
                 .par_iter()
@@ -766,7 +837,7 @@ pub fn extend(
         }
     }
     let all: Vec<&TrainingSeries> = series.iter().collect();
-    let coefficient = coefficients(&all, &admitted, plan.terms.len());
+    let coefficient = coefficients(plan, &all, &admitted);
     // Terms no axis admitted are dropped (the firmware computes nothing for them), and so are
     // auxiliary inputs no kept term reads: the inputs are renumbered in order.
     let keep: Vec<usize> = (0..plan.terms.len())
@@ -938,6 +1009,44 @@ mod tests {
         );
         assert_eq!(kept.aux_inputs, ["b"]);
         assert!(plan.keeping(&[]).terms.is_empty() && plan.keeping(&[]).aux_inputs.is_empty());
+    }
+
+    #[test]
+    fn a_shape_term_is_fitted_within_activations_and_an_offset_term_on_what_it_leaves() {
+        // Ten activations: a rate whose mean differs from one activation to the next (m) and
+        // whose shape within each is a ramp, and an auxiliary input constant per activation (v).
+        // The residual is 0.5 × the rate's shape, 2 × the input, and −3 × m: an offset per
+        // activation that goes with the rate's mean but is not the rate's (the initial bias's to
+        // answer). A pooled fit would take the rate's coefficient from that offset.
+        let plan = TermPlan::choose(&[axis(
+            "X",
+            &[("element rate X (τ 30 s)", true), ("aux:supply", true)],
+        )]);
+        assert!(changes_shape(plan.terms[0].term) && !changes_shape(plan.terms[1].term));
+        let series: Vec<TrainingSeries> = (0..10)
+            .map(|a| {
+                let m = if a % 2 == 0 { 1.0 } else { -1.0 };
+                let v = if a % 4 < 2 { 1.0 } else { -1.0 };
+                let shape: Vec<f64> = (0..50).map(|i| f64::from(i) / 50.0 - 0.49).collect();
+                let rate: Vec<f64> = shape.iter().map(|s| m + s).collect();
+                let residual: Vec<f64> =
+                    shape.iter().map(|s| 0.5 * s + 2.0 * v - 3.0 * m).collect();
+                let same = |values: Vec<f64>| [values.clone(), values.clone(), values];
+                TrainingSeries {
+                    residual: same(residual),
+                    terms: vec![same(rate), same(vec![v; 50])],
+                    raw_sum: Vec::new(),
+                }
+            })
+            .collect();
+        let all: Vec<&TrainingSeries> = series.iter().collect();
+        let admitted = [vec![0, 1], vec![0], vec![1]];
+        let c = coefficients(&plan, &all, &admitted);
+        assert!((c[0][0] - 0.5).abs() < 1e-4, "{c:?}");
+        assert!((c[1][0] - 2.0).abs() < 1e-3, "{c:?}");
+        // Alone, each kind gets the same; a term not admitted on an axis stays 0.
+        assert!((c[0][1] - 0.5).abs() < 1e-4 && c[1][1] == 0.0, "{c:?}");
+        assert!(c[0][2] == 0.0 && (c[1][2] - 2.0).abs() < 1e-3, "{c:?}");
     }
 
     #[test]
