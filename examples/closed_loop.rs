@@ -34,7 +34,7 @@ const EFFECTS: [&str; 8] = [
 
 fn print(r: &Row) {
     println!(
-        "| {} | {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} |",
+        "| {} | {} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {} |",
         r.effect,
         r.seed,
         r.axis,
@@ -49,6 +49,7 @@ fn print(r: &Row) {
         r.before.0,
         r.after.0,
         r.floor.0,
+        cut(r.before.0, r.after.0, r.floor.0, r.drift_cut()),
         r.by_history.0,
         cut(r.before.0, r.by_history.0, r.floor.0, r.history_drift_cut()),
     );
@@ -170,8 +171,8 @@ fn main() -> anyhow::Result<()> {
     let work = tempfile::tempdir()?;
     let settings = drift_fit::FitSettings::default();
     let mut rows: Vec<Row> = Vec::new();
-    println!("| effect | seed | axis | top candidate behind the paper's model | top candidate left behind the loop's model | significant | terms admitted | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift | drift keyed by history | drift excess cut by history |");
-    println!("|---|---:|---|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| effect | seed | axis | top candidate behind the paper's model | top candidate left behind the loop's model | significant | terms admitted | RMS before | RMS after | noise floor RMS | excess cut | drift before | drift after | noise floor drift | drift excess cut | drift keyed by history | drift excess cut by history |");
+    println!("|---|---:|---|---|---|:---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for effect in &effects {
         for seed in first_seed..first_seed + seeds {
             eprintln!("{effect}, seed {seed} …");

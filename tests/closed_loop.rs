@@ -4,7 +4,8 @@
 //! nothing was fitted or chosen on; without a hidden effect nothing is significant, and the loop
 //! changes the paper's model only by reading the heating history (stage 3, the initial bias) and
 //! by the element's heating rate (offered on every unit) where the training activations chose
-//! them; a hidden thermal lag is closed by the warm starts' initial bias; and a unit the paper's
+//! them; a hidden thermal lag is closed by the warm starts' initial bias, and its rate, started
+//! where the unit is at switch-on, is what the paper's model lacks most; and a unit the paper's
 //! model represents exactly leaves the loop nothing to find or add.
 //! (`docs/closed-loop.md` has the full table over every effect and many seeds.)
 
@@ -132,4 +133,13 @@ fn a_hidden_thermal_lag_is_closed_by_the_warm_starts_initial_bias() {
     for r in rows.iter().filter(|r| !r.admitted.is_empty()) {
         assert!(r.after.0 < r.before.0, "{r:#?}");
     }
+    // Started where the unit is at switch-on, the rate is what the paper's model lacks most.
+    let rate_first = rows
+        .iter()
+        .filter(|r| {
+            let top = r.paper_top.trim_end_matches(", significant");
+            drift_fit::candidates::Kind::rate_time_constant_s(top).is_some()
+        })
+        .count();
+    assert!(rate_first >= 2, "{rows:#?}");
 }
