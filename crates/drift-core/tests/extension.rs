@@ -210,6 +210,50 @@ proptest! {
             }
         }
     }
+
+    /// Any kept history and any valid switch-on rate: `power_on_after` starts the rate filter
+    /// without a panic, the corrected rates stay finite, and a start with nothing finite kept is
+    /// the heating alone, as after `power_on`.
+    #[test]
+    fn any_kept_history_starts_the_rate_filter_finitely(
+        kept_bits in prop::array::uniform3(prop::array::uniform2(any::<u32>())),
+        switch_on in prop::array::uniform3(5000.0f32..8000.0),
+        heating in -1.0f32..1.0,
+        cooling in 0.0f32..0.1,
+        faster in -0.1f32..0.1,
+    ) {
+        let mut model = fixture::extended();
+        let rate = drift_core::SwitchOnRate {
+            heating_celsius_per_s: heating,
+            cooling_per_second: cooling,
+            cooling_per_second_per_remaining: faster.max(-cooling),
+        };
+        let mut extension = model.extension.clone();
+        extension.switch_on_rate = [rate; AXES];
+        model = model.with_extension(extension).unwrap();
+        let kept = kept_bits.map(|[ambient, off]| Previous {
+            ambient_celsius: f32::from_bits(ambient),
+            switch_off_celsius: f32::from_bits(off),
+        });
+        let mut after = Corrector::new(&model).unwrap();
+        after.power_on_after(switch_on, &mut kept.clone()).unwrap();
+        let mut plain = Corrector::new(&model).unwrap();
+        plain.power_on(switch_on).unwrap();
+        for i in 0..20u32 {
+            let raw = switch_on.map(|r| r + i as f32);
+            let s = sample(1 + 500 * i, raw);
+            let aux = [5.0; 4];
+            let (a, p) = (after.correct_with_aux(&s, &aux), plain.correct_with_aux(&s, &aux));
+            for axis in 0..AXES {
+                prop_assert!(a.corrected_dps[axis].is_finite() && a.bias_dps[axis].is_finite());
+                let nothing_kept = !(kept[axis].ambient_celsius.is_finite()
+                    && kept[axis].switch_off_celsius.is_finite());
+                if nothing_kept {
+                    prop_assert_eq!(a.corrected_dps[axis].to_bits(), p.corrected_dps[axis].to_bits());
+                }
+            }
+        }
+    }
 }
 
 fn aux_only(time_constant_ms: u32) -> Extension {

@@ -10,6 +10,13 @@
 //! (`drift_core::SwitchOn`), never a clock and never the simulator's truth.
 
 use drift_core::{Previous, Settings, SwitchOn, SwitchOnRate};
+use drift_recording::Segment;
+use serde::Serialize;
+
+use crate::candidates::StartRates;
+use crate::evaluate::{sample_at, switch_on_raw};
+use crate::keying::Keying;
+use crate::settings::FitSettings;
 
 /// Each axis's switch-on estimate, as `power_on_after` makes it from the raw switch-on readings
 /// `switch_on_raw` and what was kept before (`previous`; `None`: as `power_on`, nothing known).
@@ -46,13 +53,6 @@ pub fn without_heating(rate: SwitchOnRate) -> SwitchOnRate {
         ..rate
     }
 }
-use drift_recording::Segment;
-use serde::Serialize;
-
-use crate::candidates::StartRates;
-use crate::evaluate::{sample_at, switch_on_raw};
-use crate::keying::Keying;
-use crate::settings::FitSettings;
 
 /// The first seconds whose slope measures the cooling, ms. Short against the cooling (its fastest
 /// part leaves over ~90 s, so a 10-s mean slope is within ~5 % of the rate at switch-on), long
