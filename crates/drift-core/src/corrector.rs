@@ -222,7 +222,8 @@ impl<S: Copy + Default> CorrectorState<S> {
             state.activation_flags = activation;
             *flags = activation;
         }
-        // Without a history every start is unknown and the rate filters start at rest.
+        // Without a history every start is taken as cold: the rate filters start at the heating
+        // alone (at rest for images before format 6).
         self.extension = ExtensionState::power_on_after(model.extension(), &switch_ons);
         Ok(flags)
     }
