@@ -176,22 +176,20 @@ impl Kind {
                         .collect(),
                 )
             }
-            Self::TemperatureRate { time_constant_s } => per_axis(&|axis| {
-                filtered_rate(
-                    &rise(axis),
-                    f64::from(*time_constant_s),
-                    1.0 / rate_hz,
-                    f64::from(start.sensor[axis]),
-                )
-            }),
-            Self::ElementRate { time_constant_s } => per_axis(&|axis| {
-                filtered_rate(
-                    &rise(axis),
-                    f64::from(*time_constant_s),
-                    1.0 / rate_hz,
-                    f64::from(start.element[axis]),
-                )
-            }),
+            Self::TemperatureRate { time_constant_s } | Self::ElementRate { time_constant_s } => {
+                let from = match self {
+                    Self::ElementRate { .. } => &start.element,
+                    _ => &start.sensor,
+                };
+                per_axis(&|axis| {
+                    filtered_rate(
+                        &rise(axis),
+                        f64::from(*time_constant_s),
+                        1.0 / rate_hz,
+                        f64::from(from[axis]),
+                    )
+                })
+            }
             Self::RiseSquared => {
                 per_axis(&|axis| rise(axis).into_iter().map(|r| (r * r) as f32).collect())
             }
