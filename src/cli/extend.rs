@@ -156,7 +156,7 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
             md,
             "\nThe rate filter starts at the rate the unit has at switch-on ({}), measured on the calibration activations: heating − residual heat · (cooling + faster · remaining), where remaining is the fraction of the previous switch-off's heat still there (firmware: `power_on_after`; `power_on` starts a cold start's).\n\n| axis | heating, °C/s (cold starts) | cooling, 1/s | faster, 1/s (warm starts) | warm starts' RMS about the fit, °C/s |\n|---|---:|---:|---:|---:|",
             if element {
-                "the element's: it has not started heating, so only the cooling"
+                "the element's: it has not started heating, so only the cooling, and the heating below is not used"
             } else {
                 "the sensor's: its heating less its cooling"
             }

@@ -714,7 +714,8 @@ pub struct Extended {
     pub admissions: Vec<Admission>,
     /// The unit refitted with the terms' contribution removed (its baselines are unchanged).
     pub refitted: FittedUnit,
-    /// Per axis, the rate at switch-on measured on the calibration, where the rate filter starts.
+    /// Per axis, the rate at switch-on as measured on the calibration (the tables' extension holds
+    /// where the filter starts: without the heating for the element's rate).
     pub switch_on_rate: [SwitchOnRateFit; 3],
 }
 
@@ -737,14 +738,13 @@ pub fn extend(
     settings: &FitSettings,
 ) -> Result<Extended, FitError> {
     let core_settings = *base.modified.settings();
-    let mut switch_on_rate = switch_on_rate.clone();
-    if plan.element_rate == Some(true) {
-        for fit in &mut switch_on_rate {
-            fit.rate = without_heating(fit.rate);
-        }
-    }
+    // The element has not started heating at switch-on: its rate starts at the cooling alone.
+    let start = |fit: &SwitchOnRateFit| match plan.element_rate {
+        Some(true) => without_heating(fit.rate),
+        _ => fit.rate,
+    };
     let plan = &TermPlan {
-        switch_on_rate: switch_on_rate.clone().map(|fit| fit.rate),
+        switch_on_rate: std::array::from_fn(|a| start(&switch_on_rate[a])),
         ..plan.clone()
     };
     let absorbers = (0..plan.terms.len())
@@ -854,7 +854,7 @@ pub fn extend(
         plan: kept,
         admissions,
         refitted,
-        switch_on_rate,
+        switch_on_rate: switch_on_rate.clone(),
     })
 }
 
