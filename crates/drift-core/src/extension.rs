@@ -248,9 +248,11 @@ impl Extension {
 #[derive(Clone, Copy, Debug)]
 pub struct ExtensionState {
     /// Per axis, the rise since switch-on through the rate filter's first-order low-pass, °C (for
-    /// [`Term::TemperatureRate`]). The rise rather than the temperature: the filter needs no
-    /// previous reading, and f32 resolves a rise (~5 °C: 5e-7 °C) six times finer than a
-    /// temperature (~30 °C: 2e-6 °C), so the rate's rounding stays below 1e-5 °C/s at 1 kHz.
+    /// [`Term::TemperatureRate`]); at switch-on `−rate · τ` for the [`SwitchOnRate`] it starts
+    /// from, so that its first estimate is that rate. The rise rather than the temperature: the
+    /// filter needs no previous reading, and f32 resolves a rise (~5 °C: 5e-7 °C) six times finer
+    /// than a temperature (~30 °C: 2e-6 °C), so the rate's rounding stays below 1e-5 °C/s at
+    /// 1 kHz.
     filtered_rise: [f32; AXES],
     /// Per term, the low-passed auxiliary input ([`Term::Aux`]; unused by other kinds): NaN until
     /// the first finite input, then held through non-finite ones.
