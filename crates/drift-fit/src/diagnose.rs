@@ -83,8 +83,6 @@ pub struct Diagnoser {
     /// Each axis's rate at switch-on measured on the calibration, where a rate candidate's filter
     /// starts, as the firmware's term would.
     switch_on_rate: [SwitchOnRate; 3],
-    /// The tables' sensor settings.
-    core: drift_core::Settings,
 }
 
 impl Diagnoser {
@@ -131,7 +129,6 @@ impl Diagnoser {
             keying,
             kinds,
             switch_on_rate,
-            core,
         })
     }
 
@@ -143,7 +140,7 @@ impl Diagnoser {
         let (corrected, _) = self.keying.correct(&self.tables, segment, switch_on);
         let start = start_rates(
             &self.switch_on_rate,
-            &self.core,
+            &self.tables.settings,
             switch_on,
             self.keying.previous(segment),
         );

@@ -96,40 +96,55 @@ struct Start {
 }
 
 fn start(segment: &Segment, kept: [Previous; 3], core: &Settings, settings: &FitSettings) -> Start {
+    let (heating_slope, cooling_slope) = slopes(segment, core);
     Start {
         switch_on: switch_ons(core, switch_on_raw(segment, settings), Some(kept)),
-        heating_slope: slopes(segment, core, HEATING_WINDOW_MS),
-        cooling_slope: slopes(segment, core, COOLING_WINDOW_MS),
+        heating_slope,
+        cooling_slope,
     }
 }
 
-/// Per axis, the least-squares slope of the temperature over the first `window_ms`, °C/s (NaN
-/// with fewer than three readings).
-fn slopes(segment: &Segment, core: &Settings, window_ms: u32) -> [f64; 3] {
-    let mut sums = [[0.0f64; 5]; 3];
+/// Per axis, the least-squares slope of the temperature over the heating's and the cooling's
+/// first seconds, °C/s (NaN with fewer than three readings): one pass over the samples, the
+/// shorter window's sums taken on the way.
+fn slopes(segment: &Segment, core: &Settings) -> ([f64; 3], [f64; 3]) {
+    let mut heating = [[0.0f64; 5]; 3];
+    let mut cooling = [[0.0f64; 5]; 3];
     for i in 0..segment.len() {
         let sample = sample_at(segment, i);
-        if sample.since_power_on_ms > window_ms {
+        if sample.since_power_on_ms > COOLING_WINDOW_MS {
             break;
         }
+        let in_heating = sample.since_power_on_ms <= HEATING_WINDOW_MS;
         let t = f64::from(sample.since_power_on_ms) / 1000.0;
-        for (sum, raw) in sums.iter_mut().zip(sample.temperature_raw) {
+        for ((heating, cooling), raw) in heating
+            .iter_mut()
+            .zip(&mut cooling)
+            .zip(sample.temperature_raw)
+        {
             let celsius = f64::from(core.celsius(raw));
             if celsius.is_finite() {
-                for (s, v) in sum.iter_mut().zip([1.0, t, celsius, t * t, t * celsius]) {
-                    *s += v;
+                for (k, v) in [1.0, t, celsius, t * t, t * celsius]
+                    .into_iter()
+                    .enumerate()
+                {
+                    cooling[k] += v;
+                    if in_heating {
+                        heating[k] += v;
+                    }
                 }
             }
         }
     }
-    sums.map(|[n, t, y, tt, ty]| {
+    let slope = |[n, t, y, tt, ty]: [f64; 5]| {
         let spread = n * tt - t * t;
         if n < 3.0 || spread <= 0.0 {
             f64::NAN
         } else {
             (n * ty - t * y) / spread
         }
-    })
+    };
+    (heating.map(slope), cooling.map(slope))
 }
 
 /// Fits each axis's switch-on rate on the `calibration` activations, with what firmware kept
