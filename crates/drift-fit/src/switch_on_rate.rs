@@ -11,6 +11,7 @@
 
 use drift_core::{Previous, Settings, SwitchOn, SwitchOnRate};
 use drift_recording::Segment;
+use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
 use crate::candidates::StartRates;
@@ -54,14 +55,14 @@ pub fn without_heating(rate: SwitchOnRate) -> SwitchOnRate {
     }
 }
 
-/// The first seconds whose slope measures the cooling, ms. Short against the cooling (its fastest
-/// part leaves over ~90 s, so a 10-s mean slope is within ~5 % of the rate at switch-on), long
-/// against the sensor's noise (10⁴ samples at 1 kHz: a slope to ~1e-5 °C/s). The heating within it
-/// cancels against the cold start's.
+/// The first seconds whose curve measures the cooling, ms: long against the sensor's noise (10⁴
+/// samples at 1 kHz), short enough that a parabola follows the cooling's bend (its fastest part
+/// leaves over ~90 s). The heating within it cancels against the cold start's.
 const COOLING_WINDOW_MS: u32 = 10_000;
-/// The first seconds whose slope measures the heating, ms. The heating rate falls as the heat
-/// spreads from the ASIC (in the simulator 0.152 °C/s at 0.5 s, 0.142 at 2 s, 0.110 at 8 s): a
-/// 2-s mean slope is the rate at 1 s, within ~3 % of the one at switch-on, to ~1e-3 °C/s at 100 Hz.
+/// The first seconds whose curve measures the heating, ms. The heating rate falls steadily as the
+/// heat spreads from the ASIC (in the simulator 0.156 °C/s at switch-on, 0.152 at 0.5 s, 0.142 at
+/// 2 s), so a parabola over 2 s gives the rate at switch-on, where a mean slope over 2 s is the
+/// rate at 1 s (4–7 % lower).
 const HEATING_WINDOW_MS: u32 = 2_000;
 /// Residual heat below which a start is cold: the reference for the warm starts, °C.
 const COLD_BELOW_CELSIUS: f32 = 0.05;
@@ -88,7 +89,8 @@ pub struct SwitchOnRateFit {
     pub cooling_rms_error_celsius_per_s: f64,
 }
 
-/// One activation's start: per axis the switch-on estimate and the slopes of its first seconds.
+/// One activation's start: per axis the switch-on estimate and the temperature's rate at switch-on
+/// over the heating's and the cooling's first seconds.
 struct Start {
     switch_on: [SwitchOn; 3],
     heating_slope: [f64; 3],
@@ -104,12 +106,42 @@ fn start(segment: &Segment, kept: [Previous; 3], core: &Settings, settings: &Fit
     }
 }
 
-/// Per axis, the least-squares slope of the temperature over the heating's and the cooling's
-/// first seconds, °C/s (NaN with fewer than three readings): one pass over the samples, the
-/// shorter window's sums taken on the way.
+/// A least-squares parabola through (time since switch-on, temperature), kept as its normal
+/// equations so that one pass over the samples can feed two windows.
+#[derive(Clone, Copy)]
+struct Parabola {
+    normal: Matrix3<f64>,
+    rhs: Vector3<f64>,
+}
+
+impl Parabola {
+    const EMPTY: Self = Self {
+        normal: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        rhs: Vector3::new(0.0, 0.0, 0.0),
+    };
+
+    fn add(&mut self, t: f64, celsius: f64) {
+        let row = Vector3::new(1.0, t, t * t);
+        self.normal += row * row.transpose();
+        self.rhs += row * celsius;
+    }
+
+    /// The parabola's slope at switch-on, °C/s: the rate at t = 0, where a mean slope over the
+    /// window would be the rate at its middle (NaN with fewer than four readings or no spread).
+    fn slope_at_switch_on(&self) -> f64 {
+        if self.normal[(0, 0)] < 4.0 {
+            return f64::NAN;
+        }
+        self.normal.lu().solve(&self.rhs).map_or(f64::NAN, |c| c[1])
+    }
+}
+
+/// Per axis, the temperature's rate at switch-on from its least-squares parabola over the
+/// heating's and the cooling's first seconds, °C/s: one pass over the samples, the shorter
+/// window's sums taken on the way.
 fn slopes(segment: &Segment, core: &Settings) -> ([f64; 3], [f64; 3]) {
-    let mut heating = [[0.0f64; 5]; 3];
-    let mut cooling = [[0.0f64; 5]; 3];
+    let mut heating = [Parabola::EMPTY; 3];
+    let mut cooling = [Parabola::EMPTY; 3];
     for i in 0..segment.len() {
         let sample = sample_at(segment, i);
         if sample.since_power_on_ms > COOLING_WINDOW_MS {
@@ -124,31 +156,21 @@ fn slopes(segment: &Segment, core: &Settings) -> ([f64; 3], [f64; 3]) {
         {
             let celsius = f64::from(core.celsius(raw));
             if celsius.is_finite() {
-                for (k, v) in [1.0, t, celsius, t * t, t * celsius]
-                    .into_iter()
-                    .enumerate()
-                {
-                    cooling[k] += v;
-                    if in_heating {
-                        heating[k] += v;
-                    }
+                cooling.add(t, celsius);
+                if in_heating {
+                    heating.add(t, celsius);
                 }
             }
         }
     }
-    let slope = |[n, t, y, tt, ty]: [f64; 5]| {
-        let spread = n * tt - t * t;
-        if n < 3.0 || spread <= 0.0 {
-            f64::NAN
-        } else {
-            (n * ty - t * y) / spread
-        }
-    };
-    (heating.map(slope), cooling.map(slope))
+    (
+        heating.map(|p| p.slope_at_switch_on()),
+        cooling.map(|p| p.slope_at_switch_on()),
+    )
 }
 
 /// Fits each axis's switch-on rate on the `calibration` activations, with what firmware kept
-/// before each (`keying`): the heating is the cold starts' mean first-seconds slope; the cooling,
+/// before each (`keying`): the heating is the cold starts' mean rate at switch-on; the cooling,
 /// `residual_heat · (a + b · remaining)`, is least squares over the warm starts, each measured
 /// against the cold start nearest in ambient. Without cold starts the filter starts at rest. An
 /// axis with fewer than three warm starts, or whose fit would have the unit warm itself while
@@ -262,6 +284,23 @@ fn fit_cooling(axis: usize, warm: &[(f64, f64, f64)]) -> SwitchOnRateFit {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_rate_at_switch_on_is_the_parabola_s_slope_at_zero_not_the_window_s_mean() {
+        // A heating rate falling from 0.156 °C/s as the heat spreads, sampled at 100 Hz for 2 s:
+        // the mean slope would be the rate at 1 s (0.148).
+        let mut parabola = Parabola::EMPTY;
+        for i in 0..=200 {
+            let t = f64::from(i) / 100.0;
+            parabola.add(t, 25.0 + 0.156 * t - 0.004 * t * t);
+        }
+        assert!((parabola.slope_at_switch_on() - 0.156).abs() < 1e-9);
+        let mut three = Parabola::EMPTY;
+        for t in [0.0, 0.01, 0.02] {
+            three.add(t, 25.0);
+        }
+        assert!(three.slope_at_switch_on().is_nan());
+    }
 
     #[test]
     fn a_two_speed_cooling_is_recovered_from_its_warm_starts() {
