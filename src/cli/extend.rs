@@ -11,6 +11,7 @@ use drift_core::blob;
 use drift_fit::closing::{BeforeAfter, Closed};
 use drift_fit::evaluate;
 use drift_fit::pipeline;
+use drift_fit::switch_on_rate::SwitchOnRateFit;
 use drift_fit::FittedUnit;
 use drift_recording::{read_recording, Segment};
 
@@ -152,28 +153,36 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
         );
     }
     if let Some(element) = extended.plan.element_rate {
+        md += &switch_on_rate_markdown(element, &extended.switch_on_rate);
+    }
+    md
+}
+
+/// The switch-on rate section: where the rate filter starts, as measured on the calibration, for
+/// the element's rate (`element`: the cooling alone) or the sensor's.
+fn switch_on_rate_markdown(element: bool, fits: &[SwitchOnRateFit; 3]) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "\nThe rate filter starts at the rate the unit has at switch-on ({}), measured on the calibration activations: heating − residual heat · (cooling + faster · remaining), where remaining is the fraction of the previous switch-off's heat still there (firmware: `power_on_after`; `power_on` starts a cold start's).\n\n| axis | heating, °C/s (cold starts) | cooling, 1/s | faster, 1/s (warm starts) | warm starts' RMS about the fit, °C/s |\n|---|---:|---:|---:|---:|",
+        if element {
+            "the element's: it has not started heating, so only the cooling, and the heating below is not used"
+        } else {
+            "the sensor's: its heating less its cooling"
+        }
+    );
+    for fit in fits {
         let _ = writeln!(
             md,
-            "\nThe rate filter starts at the rate the unit has at switch-on ({}), measured on the calibration activations: heating − residual heat · (cooling + faster · remaining), where remaining is the fraction of the previous switch-off's heat still there (firmware: `power_on_after`; `power_on` starts a cold start's).\n\n| axis | heating, °C/s (cold starts) | cooling, 1/s | faster, 1/s (warm starts) | warm starts' RMS about the fit, °C/s |\n|---|---:|---:|---:|---:|",
-            if element {
-                "the element's: it has not started heating, so only the cooling, and the heating below is not used"
-            } else {
-                "the sensor's: its heating less its cooling"
-            }
+            "| {} | {:.4} ({}) | {:.5} | {:.5} ({}) | {:.1e} |",
+            fit.axis,
+            fit.rate.heating_celsius_per_s,
+            fit.cold_starts,
+            fit.rate.cooling_per_second,
+            fit.rate.cooling_per_second_per_remaining,
+            fit.warm_starts,
+            fit.cooling_rms_error_celsius_per_s
         );
-        for fit in &extended.switch_on_rate {
-            let _ = writeln!(
-                md,
-                "| {} | {:.4} ({}) | {:.5} | {:.5} ({}) | {:.1e} |",
-                fit.axis,
-                fit.rate.heating_celsius_per_s,
-                fit.cold_starts,
-                fit.rate.cooling_per_second,
-                fit.rate.cooling_per_second_per_remaining,
-                fit.warm_starts,
-                fit.cooling_rms_error_celsius_per_s
-            );
-        }
     }
     md
 }
@@ -273,4 +282,54 @@ fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String 
         "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). No noise floor given: record a zero-drift twin (`gyrodrift simulate --zero-drift`) and pass it as `--noise-floor`.\n\n"
     });
     md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use drift_core::SwitchOnRate;
+
+    fn fit(axis: &'static str, heating: f32, cooling: f32) -> SwitchOnRateFit {
+        SwitchOnRateFit {
+            axis,
+            cold_starts: 36,
+            warm_starts: 48,
+            rate: SwitchOnRate {
+                heating_celsius_per_s: heating,
+                cooling_per_second: cooling,
+                cooling_per_second_per_remaining: 0.0162,
+            },
+            cooling_rms_error_celsius_per_s: 0.0021,
+        }
+    }
+
+    #[test]
+    fn the_switch_on_rate_section_has_one_row_per_axis_and_says_which_rate_starts_there() {
+        let fits = [
+            fit("X", 0.1559, 0.0028),
+            fit("Y", 0.1166, 0.0023),
+            fit("Z", 0.1703, 0.0007),
+        ];
+        let element = switch_on_rate_markdown(true, &fits);
+        let rows: Vec<&str> = element.lines().filter(|l| l.starts_with("| ")).collect();
+        assert_eq!(rows.len(), 4, "{element}"); // the header and one row per axis
+        assert_eq!(
+            rows[1],
+            "| X | 0.1559 (36) | 0.00280 | 0.01620 (48) | 2.1e-3 |"
+        );
+        assert!(
+            rows[3].starts_with("| Z | 0.1703 (36) | 0.00070 |"),
+            "{element}"
+        );
+        assert!(
+            element.contains("the element's: it has not started heating"),
+            "{element}"
+        );
+        let sensor = switch_on_rate_markdown(false, &fits);
+        assert!(
+            sensor.contains("the sensor's: its heating less its cooling")
+                && !sensor.contains("the element's"),
+            "{sensor}"
+        );
+    }
 }
