@@ -93,16 +93,16 @@ pub struct SwitchOnRateFit {
 /// over the heating's and the cooling's first seconds.
 struct Start {
     switch_on: [SwitchOn; 3],
-    heating_slope: [f64; 3],
-    cooling_slope: [f64; 3],
+    heating_rate: [f64; 3],
+    cooling_rate: [f64; 3],
 }
 
 fn start(segment: &Segment, kept: [Previous; 3], core: &Settings, settings: &FitSettings) -> Start {
-    let (heating_slope, cooling_slope) = slopes(segment, core);
+    let (heating_rate, cooling_rate) = rates_at_switch_on(segment, core);
     Start {
         switch_on: switch_ons(core, switch_on_raw(segment, settings), Some(kept)),
-        heating_slope,
-        cooling_slope,
+        heating_rate,
+        cooling_rate,
     }
 }
 
@@ -139,7 +139,7 @@ impl Parabola {
 /// Per axis, the temperature's rate at switch-on from its least-squares parabola over the
 /// heating's and the cooling's first seconds, °C/s: one pass over the samples, the shorter
 /// window's sums taken on the way.
-fn slopes(segment: &Segment, core: &Settings) -> ([f64; 3], [f64; 3]) {
+fn rates_at_switch_on(segment: &Segment, core: &Settings) -> ([f64; 3], [f64; 3]) {
     let mut heating = [Parabola::EMPTY; 3];
     let mut cooling = [Parabola::EMPTY; 3];
     for i in 0..segment.len() {
@@ -192,13 +192,13 @@ pub fn fit_switch_on_rate(
             .collect();
         let heating: Vec<f64> = cold_starts
             .iter()
-            .map(|s| s.heating_slope[a])
-            .filter(|slope| slope.is_finite())
+            .map(|s| s.heating_rate[a])
+            .filter(|rate| rate.is_finite())
             .collect();
         let colds: Vec<(f32, f64)> = cold_starts
             .iter()
-            .map(|s| (s.switch_on[a].ambient_celsius, s.cooling_slope[a]))
-            .filter(|(ambient, slope)| ambient.is_finite() && slope.is_finite())
+            .map(|s| (s.switch_on[a].ambient_celsius, s.cooling_rate[a]))
+            .filter(|(ambient, rate)| ambient.is_finite() && rate.is_finite())
             .collect();
         // (residual heat, remaining, measured cooling rate)
         let warm: Vec<(f64, f64, f64)> = starts
@@ -207,11 +207,11 @@ pub fn fit_switch_on_rate(
             .filter(|s| s.switch_on[a].residual_heat_celsius >= WARM_FROM_CELSIUS)
             .filter_map(|s| {
                 let on = &s.switch_on[a];
-                let (distance, cold_slope) = colds
+                let (distance, cold_rate) = colds
                     .iter()
                     .map(|(ambient, slope)| ((ambient - on.ambient_celsius).abs(), *slope))
                     .min_by(|x, y| x.0.total_cmp(&y.0))?;
-                let rate = s.cooling_slope[a] - cold_slope;
+                let rate = s.cooling_rate[a] - cold_rate;
                 (distance <= SAME_AMBIENT_CELSIUS && rate.is_finite()).then_some((
                     f64::from(on.residual_heat_celsius),
                     f64::from(on.remaining),
