@@ -1,11 +1,11 @@
 //! Each axis's temperature rate at switch-on, measured on the calibration activations: where the
 //! extended model's temperature-rate filter starts (`drift_core::SwitchOnRate`).
 //!
-//! The heating is a cold start's slope in its first seconds. The cooling is never recorded
+//! The heating is a cold start's rate at switch-on, read from its first seconds. The cooling is never recorded
 //! directly (the unit is off), but it shows after switch-on: the unit's thermal network is linear,
 //! so a warm start's temperature is a cold start's heating (at the same ambient) plus the cooling
-//! of the heat it switched on with, and the slope of a warm start's first seconds less a cold
-//! start's is the cooling rate at switch-on, whatever the heating does. Only what firmware has at
+//! of the heat it switched on with, and a warm start's rate at switch-on less a cold start's is
+//! the cooling rate, whatever the heating does. Only what firmware has at
 //! switch-on goes in: the residual heat and the fraction of the switch-off heat left
 //! (`drift_core::SwitchOn`), never a clock and never the simulator's truth.
 
@@ -209,7 +209,7 @@ pub fn fit_switch_on_rate(
                 let on = &s.switch_on[a];
                 let (distance, cold_rate) = colds
                     .iter()
-                    .map(|(ambient, slope)| ((ambient - on.ambient_celsius).abs(), *slope))
+                    .map(|(ambient, rate)| ((ambient - on.ambient_celsius).abs(), *rate))
                     .min_by(|x, y| x.0.total_cmp(&y.0))?;
                 let rate = s.cooling_rate[a] - cold_rate;
                 (distance <= SAME_AMBIENT_CELSIUS && rate.is_finite()).then_some((
