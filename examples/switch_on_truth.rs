@@ -7,21 +7,21 @@
 //!     [--effect thermal_lag] [--unit physical|paper_exact]
 //! ```
 //!
-//! One unit's campaign is simulated as the closed-loop experiment simulates it, its switch-on
-//! rate fitted on the calibration activations (`drift_fit::switch_on_rate`), and every
-//! activation's predicted start compared with the true rate at switch-on, °C/s: the sensor
-//! site's (where a sensor-rate filter starts: heating less cooling) and the element's (where an
-//! element-rate filter starts: its cooling, the element not heating yet), each over the first
-//! 10-ms step of the simulator's thermal grid. Grouped by protocol or field and by the off-time
-//! before: the calibration's shortest off-time is 1 min, the field's 30 s. A paper-exact unit's
-//! bias follows the sensor's site, so its element columns are left empty.
+//! One unit's campaign is simulated as the closed-loop experiment simulates it and its loop closed
+//! (which fits the switch-on rate on the calibration activations, `drift_fit::switch_on_rate`);
+//! every activation's predicted start is then compared with the true rate at switch-on, °C/s:
+//! the sensor site's (where a sensor-rate filter starts: heating less cooling) and the element's
+//! (where an element-rate filter starts: its cooling, the element not heating yet), each over the
+//! first 10-ms step of the simulator's thermal grid. Grouped by protocol or field and by the
+//! off-time before: the calibration's shortest off-time is 1 min, the field's 30 s. A paper-exact
+//! unit's bias follows the sensor's site, so its element columns are left empty.
 
 use anyhow::Context;
 use drift_fit::analyse::analyse;
 use drift_fit::closing::close;
 use drift_fit::evaluate::switch_on_raw;
 use drift_fit::roles::Roles;
-use drift_fit::switch_on_rate::{fit_switch_on_rate, start_rates, switch_ons};
+use drift_fit::switch_on_rate::{start_rates, switch_ons};
 use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{read_recording, SeriesKind, AUX_RATE_HZ, TRUTH_DIR, TRUTH_EXTENSION};
 use drift_sim::truth::read_truth;
@@ -141,8 +141,8 @@ fn main() -> anyhow::Result<()> {
         plan.clock,
     )?;
     let core = &fitted.modified.settings;
-    let fits = fit_switch_on_rate(&closed.roles.calibration, &closed.keying, core, &settings);
-    for fit in &fits {
+    let fits = &closed.switch_on_rate;
+    for fit in fits {
         println!(
             "{}: heating {:.4} °C/s ({} cold starts) less residual heat × ({:.5} + {:.5} · remaining)/s ({} warm starts)",
             fit.axis,
@@ -153,7 +153,7 @@ fn main() -> anyhow::Result<()> {
             fit.warm_starts
         );
     }
-    let rates = fits.map(|fit| fit.rate);
+    let rates = fits.clone().map(|fit| fit.rate);
 
     // Afterwards, the truth.
     let grid_s = 1.0 / f64::from(AUX_RATE_HZ);

@@ -423,7 +423,7 @@ pub fn run(
             }
         }
     }
-    for fit in closed.extended.iter().flat_map(|e| &e.switch_on_rate) {
+    for fit in closed.extended.iter().flat_map(|_| &closed.switch_on_rate) {
         let rate = &fit.rate;
         eprintln!(
             "  rate at switch-on on {}: heating {:.4} °C/s ({} cold starts) less {:.5}/s + {:.5}/s · remaining per °C of residual heat ({} warm starts, RMS off the fit {:.1e} °C/s)",

@@ -153,7 +153,7 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
         );
     }
     if let Some(element) = extended.plan.element_rate {
-        md += &switch_on_rate_markdown(element, &extended.switch_on_rate);
+        md += &switch_on_rate_markdown(element, &closed.switch_on_rate);
     }
     md
 }

@@ -18,7 +18,7 @@ use crate::fit::FittedUnit;
 use crate::keying::Keying;
 use crate::roles::Roles;
 use crate::settings::FitSettings;
-use crate::switch_on_rate::fit_switch_on_rate;
+use crate::switch_on_rate::{fit_switch_on_rate, SwitchOnRateFit};
 use crate::warm_start::{self, WarmStartChoice};
 
 /// One unit's loop, closed as far as its data allow.
@@ -42,6 +42,10 @@ pub struct Closed<'a> {
     pub paper_axes: [AxisDiagnosis; 3],
     /// The terms the diagnosis proposes (significant winners the firmware can compute).
     pub proposed: TermPlan,
+    /// Per axis, the rate at switch-on as measured on the calibration: where the diagnosis starts
+    /// its rate candidates and the extended model its rate term (whose extension holds where the
+    /// filter starts: without the heating for the element's rate).
+    pub switch_on_rate: [SwitchOnRateFit; 3],
     /// The extended model, when asked for, when something was proposed and there are training
     /// activations to fit it on.
     pub extended: Option<Extended>,
@@ -330,6 +334,7 @@ pub fn close<'a>(
         axes,
         paper_axes,
         proposed,
+        switch_on_rate,
         extended,
     })
 }

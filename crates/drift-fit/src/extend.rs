@@ -714,9 +714,6 @@ pub struct Extended {
     pub admissions: Vec<Admission>,
     /// The unit refitted with the terms' contribution removed (its baselines are unchanged).
     pub refitted: FittedUnit,
-    /// Per axis, the rate at switch-on as measured on the calibration (the tables' extension holds
-    /// where the filter starts: without the heating for the element's rate).
-    pub switch_on_rate: [SwitchOnRateFit; 3],
 }
 
 /// Fits the extended model of one unit: `plan`'s terms (from the diagnosis) are admitted on an
@@ -854,7 +851,6 @@ pub fn extend(
         plan: kept,
         admissions,
         refitted,
-        switch_on_rate: switch_on_rate.clone(),
     })
 }
 
