@@ -16,6 +16,7 @@ use anyhow::Context;
 use drift_fit::analyse::analyse;
 use drift_fit::closing::{close, mean_profiles, profile_bin_labels, BeforeAfter, Profile};
 use drift_fit::evaluate;
+use drift_fit::excess::{excess_cut, excess_ratio, ExcessCut};
 use drift_fit::roles::Roles;
 use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{read_recording, Segment, SeriesKind};
@@ -175,6 +176,9 @@ pub struct Row {
     pub by_history: (f64, f64),
     /// The zero-drift twin, uncorrected, less its constant bias.
     pub floor: (f64, f64),
+    /// The loop's drift excess cut ([`Row::drift_cut`]) with its 95 % interval, resampling the
+    /// held-out activations and the twin's.
+    pub drift_cut_interval: ExcessCut,
     /// Field activations measured (+33 °C).
     pub field_activations: usize,
     /// Field activations diagnosed and trained on (+30/+40 °C, inside the ambient range).
@@ -215,12 +219,6 @@ impl Row {
     pub fn history_drift_cut(&self) -> f64 {
         excess_ratio(self.before.0, self.by_history.0, self.floor.0)
     }
-}
-
-/// `(before − floor) / (after − floor)`: how many times a model cuts the excess over the noise
-/// floor (an `after` at the floor counts as 1e-9 above it, not a division by zero).
-fn excess_ratio(before: f64, after: f64, floor: f64) -> f64 {
-    (before - floor) / (after - floor).max(1e-9)
 }
 
 /// One line per activation, in order of off-time: the mean (the activation's offset) and the drift
@@ -529,6 +527,11 @@ pub fn run(
         })
         .collect();
     let floor = evaluate::noise_floor(&twin_field, settings.lowpass_window_samples);
+    let twin_drift: [Vec<f64>; 3] = {
+        let per_activation =
+            evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_samples);
+        std::array::from_fn(|a| per_activation.iter().map(|p| p[a].0).collect())
+    };
     // Per axis: the terms the guard admitted there, and those proposed but left out.
     let terms = |axis: &str, admitted: bool| -> Vec<String> {
         closed
@@ -575,6 +578,11 @@ pub fn run(
                 after: avg(&after[a]),
                 by_history: avg(&by_history[a]),
                 floor: floor[a],
+                drift_cut_interval: excess_cut(
+                    &before[a].iter().map(|p| p.0).collect::<Vec<_>>(),
+                    &after[a].iter().map(|p| p.0).collect::<Vec<_>>(),
+                    &twin_drift[a],
+                ),
                 field_activations: measured.len(),
                 training_activations: closed.roles.training.len(),
             }

@@ -33,7 +33,17 @@ fn rows_of(effect: &str, seed: u64, unit: UnitModel) -> Vec<Row> {
         unit,
         ..Plan::default()
     };
-    run(effect, seed, work.path(), &FitSettings::default(), &plan).unwrap()
+    let rows = run(effect, seed, work.path(), &FitSettings::default(), &plan).unwrap();
+    for r in &rows {
+        // The interval resamples the very activations the table's figure is the mean of.
+        let cut = r.drift_cut_interval;
+        assert!(
+            (cut.ratio - r.drift_cut()).abs() <= 1e-9 * r.drift_cut().abs().max(1.0),
+            "{r:#?}"
+        );
+        assert!(cut.low <= cut.ratio && cut.ratio <= cut.high, "{r:#?}");
+    }
+    rows
 }
 
 #[test]

@@ -136,6 +136,20 @@ pub fn profile(
 /// leave: white noise and bias instability through the 1-s window.
 pub fn noise_floor(activations: &[&Segment], window: usize) -> [(f64, f64); 3] {
     let n = activations.len().max(1) as f64;
+    let mut sums = [(0.0, 0.0); 3];
+    for per_axis in noise_floor_per_activation(activations, window) {
+        for (sum, (drift, rms)) in sums.iter_mut().zip(per_axis) {
+            sum.0 += drift;
+            sum.1 += rms;
+        }
+    }
+    sums.map(|(drift, rms)| (drift / n, rms / n))
+}
+
+/// [`noise_floor`] activation by activation: per activation and axis, the drift and RMS (what an
+/// interval over the activations resamples, [`crate::excess`]).
+pub fn noise_floor_per_activation(activations: &[&Segment], window: usize) -> Vec<[(f64, f64); 3]> {
+    let n = activations.len().max(1) as f64;
     let offset: [f64; 3] = std::array::from_fn(|a| {
         activations
             .iter()
@@ -145,21 +159,19 @@ pub fn noise_floor(activations: &[&Segment], window: usize) -> [(f64, f64); 3] {
             .sum::<f64>()
             / n
     });
-    let mut sums = [(0.0, 0.0); 3];
-    for s in activations {
-        let centred: [Vec<f32>; 3] = std::array::from_fn(|a| {
-            s.rate_dps[a]
-                .iter()
-                .map(|&v| (f64::from(v) - offset[a]) as f32)
-                .collect()
-        });
-        let (drift, rms) = metric(&centred, window);
-        for a in 0..3 {
-            sums[a].0 += drift[a];
-            sums[a].1 += rms[a];
-        }
-    }
-    sums.map(|(drift, rms)| (drift / n, rms / n))
+    activations
+        .iter()
+        .map(|s| {
+            let centred: [Vec<f32>; 3] = std::array::from_fn(|a| {
+                s.rate_dps[a]
+                    .iter()
+                    .map(|&v| (f64::from(v) - offset[a]) as f32)
+                    .collect()
+            });
+            let (drift, rms) = metric(&centred, window);
+            std::array::from_fn(|a| (drift[a], rms[a]))
+        })
+        .collect()
 }
 
 /// The switch-on reading firmware passes to `power_on`: the mean raw temperature over the first

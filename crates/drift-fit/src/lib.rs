@@ -17,6 +17,7 @@ pub mod curves;
 pub mod diagnose;
 pub mod error;
 pub mod evaluate;
+pub mod excess;
 pub mod extend;
 pub mod fit;
 pub mod history_order;
