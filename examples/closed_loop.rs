@@ -18,7 +18,6 @@
 //! the null case for the diagnosis's false-alarm rate, which the physical unit's element lag is not.
 
 use anyhow::Context;
-use drift_fit::excess::ExcessCut;
 use drift_sim::UnitModel;
 use gyrodrift::closed_loop::{run, Plan, Row};
 
@@ -53,25 +52,8 @@ fn print(r: &Row) {
         cut(r.before.0, r.after.0, r.floor.0, r.drift_cut()),
         r.by_history.0,
         cut(r.before.0, r.by_history.0, r.floor.0, r.history_drift_cut()),
-        interval(r),
+        r.drift_cut_interval.interval_text(),
     );
-}
-
-/// The drift excess cut's 95 % interval (`drift_fit::excess`), where the cut has a figure.
-fn interval(r: &Row) -> String {
-    let ExcessCut { low, high, .. } = r.drift_cut_interval;
-    let ratio = |v: f64| {
-        if v > 99.0 {
-            "> 99×".to_owned()
-        } else {
-            format!("{v:.1}×")
-        }
-    };
-    if r.before.0 <= r.floor.0 || !(low.is_finite() && high.is_finite()) {
-        "–".to_owned()
-    } else {
-        format!("{} – {}", ratio(low), ratio(high))
-    }
 }
 
 /// An excess cut for the table: a model that ends within the table's last digit (0.00005 °/s) of

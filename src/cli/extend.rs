@@ -10,6 +10,7 @@ use anyhow::Context as _;
 use drift_core::blob;
 use drift_fit::closing::{BeforeAfter, Closed};
 use drift_fit::evaluate;
+use drift_fit::excess::excess_cut;
 use drift_fit::pipeline;
 use drift_fit::switch_on_rate::SwitchOnRateFit;
 use drift_fit::FittedUnit;
@@ -187,9 +188,19 @@ fn switch_on_rate_markdown(element: bool, fits: &[SwitchOnRateFit; 3]) -> String
     md
 }
 
-/// The noise floor per held-out group (`+33.0 °C field`, as [`by_set_point_and_kind`] names it)
-/// and axis: (drift, RMS) of the 1-s mean, °/s.
-pub type Floor = BTreeMap<String, [(f64, f64); 3]>;
+/// The noise floor per held-out group (`+33.0 °C field`, as [`by_set_point_and_kind`] names it).
+pub type Floor = BTreeMap<String, FloorGroup>;
+
+/// The noise floor of one held-out group.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FloorGroup {
+    /// Per axis, (drift, RMS) of the 1-s mean, °/s: the mean over the twin's units of each unit's
+    /// mean over its activations.
+    pub mean: [(f64, f64); 3],
+    /// Per axis, the drift of every twin activation in the group, °/s: what the interval of an
+    /// excess cut resamples ([`drift_fit::excess`]).
+    pub drift: [Vec<f64>; 3],
+}
 
 /// The group an activation's result goes in.
 fn group(set_point_celsius: f64, series_kind: &str) -> String {
@@ -216,14 +227,19 @@ pub fn noise_floor(dir: &Path, window: usize) -> anyhow::Result<Floor> {
                 .push(segment);
         }
     }
-    let mut sums: BTreeMap<String, ([(f64, f64); 3], usize)> = BTreeMap::new();
+    let mut sums: BTreeMap<String, (FloorGroup, usize)> = BTreeMap::new();
     for ((key, _unit), segments) in &groups {
         let refs: Vec<&Segment> = segments.iter().collect();
         let floor = evaluate::noise_floor(&refs, window);
         let entry = sums.entry(key.clone()).or_default();
-        for (sum, (drift, rms)) in entry.0.iter_mut().zip(floor) {
+        for (sum, (drift, rms)) in entry.0.mean.iter_mut().zip(floor) {
             sum.0 += drift;
             sum.1 += rms;
+        }
+        for per_axis in evaluate::noise_floor_per_activation(&refs, window) {
+            for (all, (drift, _)) in entry.0.drift.iter_mut().zip(per_axis) {
+                all.push(drift);
+            }
         }
         entry.1 += 1;
     }
@@ -234,7 +250,10 @@ pub fn noise_floor(dir: &Path, window: usize) -> anyhow::Result<Floor> {
     );
     Ok(sums
         .into_iter()
-        .map(|(key, (axes, n))| (key, axes.map(|(d, r)| (d / n as f64, r / n as f64))))
+        .map(|(key, (mut group, n))| {
+            group.mean = group.mean.map(|(d, r)| (d / n as f64, r / n as f64));
+            (key, group)
+        })
         .collect())
 }
 
@@ -251,21 +270,29 @@ pub fn by_set_point_and_kind(results: &[BeforeAfter]) -> BTreeMap<String, Vec<&B
 }
 
 /// Means per set point, series kind and axis of the held-out activations' errors, with the noise
-/// floor of their set point when measured.
+/// floor of their set point when measured, and then how many times the model cuts the drift in
+/// excess of it, with a 95 % interval.
 fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String {
     let groups = by_set_point_and_kind(results);
-    let mut md = String::from("\nError on the held-out activations (nothing was fitted or chosen on them):\n\n| set point | axis | activations | RMS before | RMS after | noise floor RMS | drift before | drift after | noise floor drift |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    let mut md = String::from("\nError on the held-out activations (nothing was fitted or chosen on them):\n\n| set point | axis | activations | RMS before | RMS after | noise floor RMS | drift before | drift after | noise floor drift | drift excess cut (95 %) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (key, rows) in &groups {
         let n = rows.len() as f64;
         let at = floor.and_then(|f| f.get(key));
         for (a, axis) in ["X", "Y", "Z"].iter().enumerate() {
             let mean = |f: &dyn Fn(&BeforeAfter) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
             let floor = |pick: fn(&(f64, f64)) -> f64| {
-                at.map_or_else(|| "–".to_owned(), |f| format!("{:.4}", pick(&f[a])))
+                at.map_or_else(|| "–".to_owned(), |f| format!("{:.4}", pick(&f.mean[a])))
             };
+            let drift = |pick: fn(&(f64, f64)) -> f64| -> Vec<f64> {
+                rows.iter().map(|r| pick(&r.drift_dps[a])).collect()
+            };
+            let cut = at.map_or_else(
+                || "–".to_owned(),
+                |f| excess_cut(&drift(|d| d.0), &drift(|d| d.1), &f.drift[a]).to_string(),
+            );
             let _ = writeln!(
                 md,
-                "| {key} | {axis} | {} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {} |",
+                "| {key} | {axis} | {} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {} | {cut} |",
                 rows.len(),
                 mean(&|r| r.rms_dps[a].0),
                 mean(&|r| r.rms_dps[a].1),
@@ -277,7 +304,7 @@ fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String 
         }
     }
     md.push_str(if floor.is_some() {
-        "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). Noise floor: the zero-drift units of `--noise-floor`, the same set point and series kind, uncorrected, less each unit's constant bias — the physical limit beside each figure; – where the twin has no such activations.\n\n"
+        "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). Noise floor: the zero-drift units of `--noise-floor`, the same set point and series kind, uncorrected, less each unit's constant bias — the physical limit beside each figure; – where the twin has no such activations. Drift excess cut: (drift before − floor) / (drift after − floor) over the activations pooled, with the 2.5–97.5 % range of a bootstrap over the held-out activations and the twin's; – where the drift before is at the floor, or below it.\n\n"
     } else {
         "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). No noise floor given: record a zero-drift twin (`gyrodrift simulate --zero-drift`) and pass it as `--noise-floor`.\n\n"
     });
@@ -330,6 +357,58 @@ mod tests {
             sensor.contains("the sensor's: its heating less its cooling")
                 && !sensor.contains("the element's"),
             "{sensor}"
+        );
+    }
+
+    fn held_out(drift_before: f64, drift_after: f64) -> BeforeAfter {
+        BeforeAfter {
+            set_point_celsius: 33.0,
+            series_kind: "field",
+            drift_dps: [(drift_before, drift_after); 3],
+            rms_dps: [(0.004, 0.003); 3],
+            by_history_drift_dps: [drift_before; 3],
+            by_history_rms_dps: [0.004; 3],
+            mean_dps: [(0.0, 0.0); 3],
+            residual_heat_celsius: [0.0; 3],
+            off_before_s: Some(600.0),
+        }
+    }
+
+    #[test]
+    fn the_before_after_table_cuts_the_drift_excess_over_the_twins_floor_with_its_interval() {
+        // Drift 0.0040 → 0.0025 over a 0.0010 floor: the excess 0.0030 → 0.0015, cut 2.0×.
+        let results: Vec<BeforeAfter> = (0..12)
+            .map(|i| {
+                let wiggle = if i % 2 == 0 { 0.0004 } else { -0.0004 };
+                held_out(0.0040 + wiggle, 0.0025 + wiggle / 2.0)
+            })
+            .collect();
+        let floor: Floor = [(
+            "+33.0 °C field".to_owned(),
+            FloorGroup {
+                mean: [(0.0010, 0.0030); 3],
+                drift: std::array::from_fn(|_| vec![0.0009, 0.0011, 0.0010, 0.0010]),
+            },
+        )]
+        .into_iter()
+        .collect();
+        let with = before_after_table(&results, Some(&floor));
+        let row = with
+            .lines()
+            .find(|l| l.starts_with("| +33.0 °C field | Y |"))
+            .unwrap_or_default();
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        assert_eq!(cells[9], "0.0010", "{with}");
+        assert!(cells[10].starts_with("2.0× ("), "{with}");
+        assert!(with.contains("| drift excess cut (95 %) |"), "{with}");
+        // Without a twin there is no floor to cut to.
+        let without = before_after_table(&results, None);
+        assert!(
+            without
+                .lines()
+                .filter(|l| l.starts_with("| +33.0 °C field"))
+                .all(|l| l.ends_with("| – | – |")),
+            "{without}"
         );
     }
 }

@@ -39,6 +39,36 @@ impl ExcessCut {
     pub fn surely_below(&self, floor: f64) -> bool {
         self.high < floor
     }
+
+    /// The interval for a table, "1.8–2.9×" ("> 99×" past 99); "–" when there was no excess to
+    /// cut (before at or below the floor: the ratio is not positive) or no activations.
+    pub fn interval_text(&self) -> String {
+        if !(self.ratio > 0.0 && self.low.is_finite() && self.high.is_finite()) {
+            return "–".to_owned();
+        }
+        let bound = |v: f64| {
+            if v > 99.0 {
+                "> 99".to_owned()
+            } else {
+                format!("{v:.1}")
+            }
+        };
+        format!("{}–{}×", bound(self.low), bound(self.high))
+    }
+}
+
+/// "2.3× (1.8–2.9×)"; "–" as [`ExcessCut::interval_text`].
+impl std::fmt::Display for ExcessCut {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let interval = self.interval_text();
+        if interval == "–" {
+            f.write_str("–")
+        } else if self.ratio > 99.0 {
+            write!(f, "> 99× ({interval})")
+        } else {
+            write!(f, "{:.1}× ({interval})", self.ratio)
+        }
+    }
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
@@ -137,6 +167,20 @@ mod tests {
         assert!(!cut(1.0).surely_below(2.0), "{:?}", cut(1.0));
         assert!(cut(0.05).surely_below(2.0), "{:?}", cut(0.05));
         assert_eq!(cut(1.0), cut(1.0), "the resampling is seeded");
+    }
+
+    #[test]
+    fn a_table_cell_shows_the_ratio_and_its_interval_or_a_dash() {
+        let cut = ExcessCut {
+            ratio: 2.34,
+            low: 1.81,
+            high: 140.0,
+        };
+        assert_eq!(cut.to_string(), "2.3× (1.8–> 99×)");
+        assert_eq!(cut.interval_text(), "1.8–> 99×");
+        let nothing_to_cut = excess_cut(&[1.0; 4], &[1.0; 4], &[1.5; 4]);
+        assert_eq!(nothing_to_cut.to_string(), "–");
+        assert_eq!(excess_cut(&[], &[], &[1.0]).interval_text(), "–");
     }
 
     #[test]
