@@ -13,6 +13,7 @@ mod corrector;
 mod diagnosis;
 mod errors;
 mod evaluation;
+mod excess;
 mod extension;
 mod fit;
 mod fit_settings;
@@ -58,5 +59,6 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<evaluation::PyEvaluation>()?;
     module.add_function(wrap_pyfunction!(evaluation::evaluate, module)?)?;
     module.add_function(wrap_pyfunction!(evaluation::summarise, module)?)?;
+    module.add_function(wrap_pyfunction!(excess::excess_cut, module)?)?;
     Ok(())
 }

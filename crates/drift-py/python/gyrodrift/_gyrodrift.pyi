@@ -60,6 +60,7 @@ __all__ = [
     "__version__",
     "analyse",
     "evaluate",
+    "excess_cut",
     "fit",
     "load_campaign",
     "resolve_campaign",
@@ -986,3 +987,13 @@ def evaluate(
 
 def summarise(results: Sequence[ActivationResult]) -> list[_Record]:
     """Averages activation results into the report's records (as `Evaluation.records`)."""
+
+def excess_cut(before: _Floats, after: _Floats, floor: _Floats) -> tuple[float, float, float]:
+    """How many times a model cuts the metric's excess over the noise floor, with its 95 %
+    interval: `(ratio, low, high)`, ratio = (mean(before) − mean(floor)) / (mean(after) −
+    mean(floor)), as the closed-loop experiment and `gyrodrift diagnose --extend` report it.
+    `before[i]` and `after[i]` are activation i's metric (e.g. its drift, °/s) under the two
+    models, resampled together; `floor` the zero-drift twin's activations, resampled apart (a
+    seeded bootstrap of 2000 draws, so the same data give the same interval). Raises `InputError`
+    for an array that is empty, not finite (naming the index), or `after` not as long as
+    `before`."""
