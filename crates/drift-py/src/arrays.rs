@@ -362,6 +362,29 @@ pub fn finite_values(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f32>, E
     Ok(values)
 }
 
+/// A 1-D float64 or float32 array of finite values, as f64 (may be empty): for statistics over
+/// results, which need not be rounded to the corrector's f32.
+pub fn finite_values_f64(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
+    let values: Vec<f64> = if let Ok(array) = value.cast::<PyArray1<f64>>() {
+        array.to_vec().map_err(|e| borrow_error(name, e))?
+    } else if let Ok(array) = value.cast::<PyArray1<f32>>() {
+        let values = array.to_vec().map_err(|e| borrow_error(name, e))?;
+        values.into_iter().map(f64::from).collect()
+    } else {
+        return Err(Error::Input(format!(
+            "`{name}` must be a float64 or float32 array of shape (n,), got {}",
+            describe(value)
+        )));
+    };
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Input(format!(
+            "`{name}` must be finite, got {} at index {i}",
+            values.get(i).copied().unwrap_or(f64::NAN)
+        )));
+    }
+    Ok(values)
+}
+
 fn borrow_error(name: &str, error: impl std::fmt::Display) -> Error {
     Error::Input(format!("`{name}` cannot be read: {error}"))
 }

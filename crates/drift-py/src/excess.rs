@@ -2,35 +2,16 @@
 //! its 95 % bootstrap interval — the figure the closed-loop experiment and `gyrodrift diagnose
 //! --extend` give beside each before/after pair ([`drift_fit::excess`]).
 
-use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 
-use crate::arrays::describe;
+use crate::arrays::finite_values_f64;
 use crate::errors::Error;
 
-/// A 1-D float64 or float32 array of finite values, as f64, not empty.
+/// [`finite_values_f64`], not empty: a ratio of means needs a mean.
 fn values(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
-    let values: Vec<f64> = if let Ok(array) = value.cast::<PyArray1<f64>>() {
-        array.to_vec()
-    } else if let Ok(array) = value.cast::<PyArray1<f32>>() {
-        array
-            .to_vec()
-            .map(|v| v.into_iter().map(f64::from).collect())
-    } else {
-        return Err(Error::Input(format!(
-            "`{name}` must be a float64 or float32 array of shape (n,), got {}",
-            describe(value)
-        )));
-    }
-    .map_err(|e| Error::Input(format!("`{name}` cannot be read: {e}")))?;
+    let values = finite_values_f64(name, value)?;
     if values.is_empty() {
         return Err(Error::Input(format!("`{name}` has no values")));
-    }
-    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::Input(format!(
-            "`{name}` must be finite, got {} at index {i}",
-            values[i]
-        )));
     }
     Ok(values)
 }
