@@ -526,12 +526,11 @@ pub fn run(
                 && is(VALIDATION, s.labels.nominal_set_point_celsius())
         })
         .collect();
-    let floor = evaluate::noise_floor(&twin_field, settings.lowpass_window_samples);
-    let twin_drift: [Vec<f64>; 3] = {
-        let per_activation =
-            evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_samples);
-        std::array::from_fn(|a| per_activation.iter().map(|p| p[a].0).collect())
-    };
+    let twin_floor =
+        evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_samples);
+    let floor = evaluate::mean_floor(&twin_floor);
+    let twin_drift: [Vec<f64>; 3] =
+        std::array::from_fn(|a| twin_floor.iter().map(|p| p[a].0).collect());
     // Per axis: the terms the guard admitted there, and those proposed but left out.
     let terms = |axis: &str, admitted: bool| -> Vec<String> {
         closed

@@ -230,13 +230,18 @@ pub fn noise_floor(dir: &Path, window: usize) -> anyhow::Result<Floor> {
     let mut sums: BTreeMap<String, (FloorGroup, usize)> = BTreeMap::new();
     for ((key, _unit), segments) in &groups {
         let refs: Vec<&Segment> = segments.iter().collect();
-        let floor = evaluate::noise_floor(&refs, window);
+        let per_activation = evaluate::noise_floor_per_activation(&refs, window);
         let entry = sums.entry(key.clone()).or_default();
-        for (sum, (drift, rms)) in entry.0.mean.iter_mut().zip(floor) {
+        for (sum, (drift, rms)) in entry
+            .0
+            .mean
+            .iter_mut()
+            .zip(evaluate::mean_floor(&per_activation))
+        {
             sum.0 += drift;
             sum.1 += rms;
         }
-        for per_axis in evaluate::noise_floor_per_activation(&refs, window) {
+        for per_axis in per_activation {
             for (all, (drift, _)) in entry.0.drift.iter_mut().zip(per_axis) {
                 all.push(drift);
             }

@@ -135,9 +135,15 @@ pub fn profile(
 /// less the unit's constant bias (its mean over every one of them). What a perfect model would
 /// leave: white noise and bias instability through the 1-s window.
 pub fn noise_floor(activations: &[&Segment], window: usize) -> [(f64, f64); 3] {
-    let n = activations.len().max(1) as f64;
+    mean_floor(&noise_floor_per_activation(activations, window))
+}
+
+/// The mean over activations of [`noise_floor_per_activation`]'s figures: [`noise_floor`] for a
+/// caller that keeps the activations' figures too.
+pub fn mean_floor(per_activation: &[[(f64, f64); 3]]) -> [(f64, f64); 3] {
+    let n = per_activation.len().max(1) as f64;
     let mut sums = [(0.0, 0.0); 3];
-    for per_axis in noise_floor_per_activation(activations, window) {
+    for per_axis in per_activation {
         for (sum, (drift, rms)) in sums.iter_mut().zip(per_axis) {
             sum.0 += drift;
             sum.1 += rms;
