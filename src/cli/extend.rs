@@ -279,6 +279,7 @@ pub fn by_set_point_and_kind(results: &[BeforeAfter]) -> BTreeMap<String, Vec<&B
 /// excess of it, with a 95 % interval.
 fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String {
     let groups = by_set_point_and_kind(results);
+    let mut worse = Vec::new();
     let mut md = String::from("\nError on the held-out activations (nothing was fitted or chosen on them):\n\n| set point | axis | activations | RMS before | RMS after | noise floor RMS | drift before | drift after | noise floor drift | drift excess cut (95 %) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (key, rows) in &groups {
         let n = rows.len() as f64;
@@ -291,10 +292,11 @@ fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String 
             let drift = |pick: fn(&(f64, f64)) -> f64| -> Vec<f64> {
                 rows.iter().map(|r| pick(&r.drift_dps[a])).collect()
             };
-            let cut = at.map_or_else(
-                || "–".to_owned(),
-                |f| excess_cut(&drift(|d| d.0), &drift(|d| d.1), &f.drift[a]).to_string(),
-            );
+            let cut = at.map(|f| excess_cut(&drift(|d| d.0), &drift(|d| d.1), &f.drift[a]));
+            if cut.is_some_and(|c| c.ratio > 0.0 && c.surely_below(1.0)) {
+                worse.push(format!("{key} {axis}"));
+            }
+            let cut = cut.map_or_else(|| "–".to_owned(), |c| c.to_string());
             let _ = writeln!(
                 md,
                 "| {key} | {axis} | {} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {} | {cut} |",
@@ -313,6 +315,13 @@ fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String 
     } else {
         "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). No noise floor given: record a zero-drift twin (`gyrodrift simulate --zero-drift`) and pass it as `--noise-floor`.\n\n"
     });
+    if !worse.is_empty() {
+        let _ = writeln!(
+            md,
+            "**The extended model drifts more than the paper's, with 95 % confidence, on: {}.** Where the unit is used like those activations, keep the paper's model.\n",
+            worse.join(", ")
+        );
+    }
     md
 }
 
@@ -398,6 +407,7 @@ mod tests {
         .into_iter()
         .collect();
         let with = before_after_table(&results, Some(&floor));
+        assert!(!with.contains("drifts more than the paper's"), "{with}");
         let row = with
             .lines()
             .find(|l| l.starts_with("| +33.0 °C field | Y |"))
@@ -406,6 +416,27 @@ mod tests {
         assert_eq!(cells[9], "0.0010", "{with}");
         assert!(cells[10].starts_with("2.0× ("), "{with}");
         assert!(with.contains("| drift excess cut (95 %) |"), "{with}");
+        // A group the model makes worse, with confidence, is named below the table.
+        let mut worse = results.clone();
+        worse.extend((0..12).map(|i| {
+            let wiggle = if i % 2 == 0 { 0.0002 } else { -0.0002 };
+            BeforeAfter {
+                set_point_celsius: 40.0,
+                ..held_out(0.0030 + wiggle, 0.0060 + wiggle)
+            }
+        }));
+        let mut floors = floor.clone();
+        floors.insert("+40.0 °C field".to_owned(), floor["+33.0 °C field"].clone());
+        let warned = before_after_table(&worse, Some(&floors));
+        let warning = warned
+            .lines()
+            .find(|l| l.contains("drifts more than the paper's"))
+            .unwrap_or_default();
+        assert!(
+            warning.contains("+40.0 °C field X, +40.0 °C field Y, +40.0 °C field Z")
+                && !warning.contains("+33.0"),
+            "{warned}"
+        );
         // Without a twin there is no floor to cut to.
         let without = before_after_table(&results, None);
         assert!(
