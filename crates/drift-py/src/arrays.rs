@@ -342,44 +342,42 @@ pub fn raw_rows<'py>(
 
 /// A 1-D float32 or float64 array of finite values, as f32 (may be empty).
 pub fn finite_values(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f32>, Error> {
-    let values: Vec<f32> = if let Ok(array) = value.cast::<PyArray1<f32>>() {
-        array.to_vec().map_err(|e| borrow_error(name, e))?
+    finite_1d(name, value, |v| v, AsF32::as_f32)
+}
+
+/// A 1-D float32 or float64 array of finite values, as f64 (may be empty): for statistics over
+/// results, which need not be rounded to the corrector's f32.
+pub fn finite_values_f64(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
+    finite_1d(name, value, f64::from, |v| v)
+}
+
+/// A 1-D float32 or float64 array, each value converted by `from_f32` or `from_f64`, then checked
+/// finite (after the conversion: a float64 beyond f32's range is not finite as f32).
+fn finite_1d<T: Copy + Into<f64> + std::fmt::Display>(
+    name: &str,
+    value: &Bound<'_, PyAny>,
+    from_f32: impl Fn(f32) -> T,
+    from_f64: impl Fn(f64) -> T,
+) -> Result<Vec<T>, Error> {
+    let values: Vec<T> = if let Ok(array) = value.cast::<PyArray1<f32>>() {
+        let values = array.to_vec().map_err(|e| borrow_error(name, e))?;
+        values.into_iter().map(from_f32).collect()
     } else if let Ok(array) = value.cast::<PyArray1<f64>>() {
         let values = array.to_vec().map_err(|e| borrow_error(name, e))?;
-        values.into_iter().map(AsF32::as_f32).collect()
+        values.into_iter().map(from_f64).collect()
     } else {
         return Err(Error::Input(format!(
             "`{name}` must be a float32 or float64 array of shape (n,), got {}",
             describe(value)
         )));
     };
-    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+    if let Some((i, v)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(**v).into().is_finite())
+    {
         return Err(Error::Input(format!(
-            "`{name}` must be finite, got {} at index {i}",
-            values.get(i).copied().unwrap_or(f32::NAN)
-        )));
-    }
-    Ok(values)
-}
-
-/// A 1-D float64 or float32 array of finite values, as f64 (may be empty): for statistics over
-/// results, which need not be rounded to the corrector's f32.
-pub fn finite_values_f64(name: &str, value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
-    let values: Vec<f64> = if let Ok(array) = value.cast::<PyArray1<f64>>() {
-        array.to_vec().map_err(|e| borrow_error(name, e))?
-    } else if let Ok(array) = value.cast::<PyArray1<f32>>() {
-        let values = array.to_vec().map_err(|e| borrow_error(name, e))?;
-        values.into_iter().map(f64::from).collect()
-    } else {
-        return Err(Error::Input(format!(
-            "`{name}` must be a float64 or float32 array of shape (n,), got {}",
-            describe(value)
-        )));
-    };
-    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-        return Err(Error::Input(format!(
-            "`{name}` must be finite, got {} at index {i}",
-            values.get(i).copied().unwrap_or(f64::NAN)
+            "`{name}` must be finite, got {v} at index {i}"
         )));
     }
     Ok(values)

@@ -49,7 +49,7 @@ def test_a_larger_sample_narrows_the_interval() -> None:
         ),
         (np.array([1.0, np.nan]), np.ones(2), np.ones(3), "`before` must be finite, got NaN at index 1"),
         (np.ones(2), np.ones(2), np.array([], dtype=np.float64), "`floor` has no values"),
-        (np.ones(2), [1.0, 1.0], np.ones(3), "`after` must be a float64 or float32 array of shape (n,)"),
+        (np.ones(2), [1.0, 1.0], np.ones(3), "`after` must be a float32 or float64 array of shape (n,)"),
     ],
 )
 def test_bad_input_names_the_argument(before: object, after: object, floor: object, message: str) -> None:
