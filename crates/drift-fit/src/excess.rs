@@ -10,8 +10,9 @@ use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 use serde::Serialize;
 
-/// Bootstrap resamples per interval: enough that the 2.5 and 97.5 percentiles move by less than
-/// the tables' rounding from one seed of the resampling to another.
+/// Bootstrap resamples per interval. From one seed of the resampling to another the bounds move by
+/// 0.01 (low) to 0.03 (high) on a 1.7–2.9× interval over 48 activations (sd over 50 seeds, a
+/// numpy restatement at thermal lag's spreads): within the tables' one decimal.
 const DRAWS: usize = 2000;
 
 /// The resampling's seed: fixed, so that a table is the same on every run.
