@@ -421,7 +421,9 @@ pub fn run(
             }
         }
     }
-    for fit in closed.extended.iter().flat_map(|_| &closed.switch_on_rate) {
+    // The start is reported where the extended model uses it.
+    let starts = closed.extended.is_some().then_some(&closed.switch_on_rate);
+    for fit in starts.into_iter().flatten() {
         let rate = &fit.rate;
         eprintln!(
             "  rate at switch-on on {}: heating {:.4} °C/s ({} cold starts) less {:.5}/s + {:.5}/s · remaining per °C of residual heat ({} warm starts, RMS off the fit {:.1e} °C/s)",

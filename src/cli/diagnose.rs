@@ -526,7 +526,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "paper_axes": &closed.paper_axes,
             "proposed_terms": closed.proposed.terms.iter().map(|t| &t.candidate).collect::<Vec<_>>(),
             "admissions": closed.extended.as_ref().map(|e| &e.admissions),
-            "switch_on_rate": closed.extended.as_ref().map(|_| &closed.switch_on_rate),
+            "switch_on_rate": closed.extended.is_some().then_some(&closed.switch_on_rate),
             "crossings": fitted.crossings,
             "stage3": stage3,
             "warm_start": warm_start,

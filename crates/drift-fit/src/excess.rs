@@ -41,10 +41,16 @@ impl ExcessCut {
         self.high < floor
     }
 
+    /// Whether there is a cut to show: an excess before (a positive ratio) and activations behind
+    /// the interval.
+    fn shown(&self) -> bool {
+        self.ratio > 0.0 && self.low.is_finite() && self.high.is_finite()
+    }
+
     /// The interval for a table, "1.8–2.9×" ("> 99×" past 99); "–" when there was no excess to
     /// cut (before at or below the floor: the ratio is not positive) or no activations.
     pub fn interval_text(&self) -> String {
-        if !(self.ratio > 0.0 && self.low.is_finite() && self.high.is_finite()) {
+        if !self.shown() {
             return "–".to_owned();
         }
         let bound = |v: f64| {
@@ -61,13 +67,12 @@ impl ExcessCut {
 /// "2.3× (1.8–2.9×)"; "–" as [`ExcessCut::interval_text`].
 impl std::fmt::Display for ExcessCut {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let interval = self.interval_text();
-        if interval == "–" {
+        if !self.shown() {
             f.write_str("–")
         } else if self.ratio > 99.0 {
-            write!(f, "> 99× ({interval})")
+            write!(f, "> 99× ({})", self.interval_text())
         } else {
-            write!(f, "{:.1}× ({interval})", self.ratio)
+            write!(f, "{:.1}× ({})", self.ratio, self.interval_text())
         }
     }
 }

@@ -1,12 +1,12 @@
 //! Each axis's temperature rate at switch-on, measured on the calibration activations: where the
 //! extended model's temperature-rate filter starts (`drift_core::SwitchOnRate`).
 //!
-//! The heating is a cold start's rate at switch-on, read from its first seconds. The cooling is never recorded
-//! directly (the unit is off), but it shows after switch-on: the unit's thermal network is linear,
-//! so a warm start's temperature is a cold start's heating (at the same ambient) plus the cooling
-//! of the heat it switched on with, and a warm start's rate at switch-on less a cold start's is
-//! the cooling rate, whatever the heating does. Only what firmware has at
-//! switch-on goes in: the residual heat and the fraction of the switch-off heat left
+//! The heating is a cold start's rate at switch-on, read from its first seconds. The cooling is
+//! never recorded directly (the unit is off), but it shows after switch-on: the unit's thermal
+//! network is linear, so a warm start's temperature is a cold start's heating (at the same ambient)
+//! plus the cooling of the heat it switched on with, and a warm start's rate at switch-on less a
+//! cold start's is the cooling rate, whatever the heating does. Only what firmware has at switch-on
+//! goes in: the residual heat and the fraction of the switch-off heat left
 //! (`drift_core::SwitchOn`), never a clock and never the simulator's truth.
 
 use drift_core::{Previous, Settings, SwitchOn, SwitchOnRate};
