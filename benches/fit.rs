@@ -19,8 +19,8 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use drift_evaluate::pipeline::{self, Options};
 use drift_fit::analyse::Analysed;
-use drift_fit::pipeline::{self, Options};
 use drift_fit::{fit_unit, FitSettings};
 use drift_recording::read_recording;
 

@@ -1,6 +1,5 @@
 //! The `gyrodrift` command line as a library, so integration tests drive the same code.
 
 pub mod cli;
-pub mod closed_loop;
 pub mod output;
 pub mod report;

@@ -1,7 +1,7 @@
 //! Stage 3's premise on simulated physics: the fit says when the rise no longer tells heating
 //! histories apart (heating power that grows with temperature), and says nothing when it does.
 
-use drift_fit::pipeline::{self, Options};
+use drift_evaluate::pipeline::{self, Options};
 use drift_fit::FitSettings;
 use drift_sim::hidden::RiseNonlinearity;
 use drift_sim::{simulate_campaign, Campaign, HiddenEffects, Protocol};
@@ -70,7 +70,7 @@ fn a_unit_without_the_effect_keeps_the_papers_order() {
 /// with the paper's tables and with the same curves keyed by history, each activation started from
 /// what the firmware kept of the one before in its recording.
 fn validation_drift(effects: HiddenEffects) -> [(f64, f64); 3] {
-    use drift_fit::evaluate::ModelKind;
+    use drift_evaluate::evaluate::ModelKind;
     let dir = tempfile::tempdir().unwrap();
     let campaign = Campaign {
         set_points_celsius: vec![30.0, 40.0, 33.0],

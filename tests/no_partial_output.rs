@@ -107,7 +107,7 @@ fn an_unwritable_table_folder_writes_nothing() {
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("GIU-01"), b"not a folder").unwrap();
     let fitted = drift_fit_unit();
-    let error = gyrodrift::cli::fit::write_tables(&out, &[fitted]).unwrap_err();
+    let error = drift_evaluate::tables_folder::write(&out, &[fitted]).unwrap_err();
     assert!(format!("{error:#}").contains("GIU-01"), "{error:#}");
     assert_eq!(
         snapshot(&out).len(),
@@ -134,15 +134,15 @@ fn drift_fit_unit() -> drift_fit::FittedUnit {
         ..Campaign::default()
     };
     simulate_campaign(&c, dir.path(), |_| {}).unwrap();
-    let files = drift_fit::pipeline::recording_files(dir.path()).unwrap();
-    let options = drift_fit::pipeline::Options {
+    let files = drift_evaluate::pipeline::recording_files(dir.path()).unwrap();
+    let options = drift_evaluate::pipeline::Options {
         calibration_set_points: vec![30.0, 40.0],
         validation_set_points: vec![],
         fit: drift_fit::FitSettings::default(),
         held_out_repeats: false,
         evaluate: false,
     };
-    drift_fit::pipeline::run(&files, &options, false, &|_, _, _| {})
+    drift_evaluate::pipeline::run(&files, &options, false, &|_, _, _| {})
         .unwrap()
         .fitted
         .remove(0)

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use drift_fit::evaluate::ModelKind;
-use drift_fit::pipeline::{self, Options, Outcome};
-use drift_fit::summary::{summarise, Split};
+use drift_evaluate::evaluate::ModelKind;
+use drift_evaluate::pipeline::{self, Options, Outcome};
+use drift_evaluate::summary::{summarise, Split};
 use drift_fit::FitSettings;
 use drift_sim::{simulate_campaign, Campaign, Field, Protocol, UnitModel};
 

@@ -6,8 +6,8 @@
 //! The fitter refuses calibration data with a dropout, naming where.
 
 use drift_core::{Corrector, Flags, Model, Sample};
-use drift_fit::evaluate::switch_on_raw;
-use drift_fit::pipeline::{self, Options};
+use drift_evaluate::evaluate::switch_on_raw;
+use drift_evaluate::pipeline::{self, Options};
 use drift_fit::{FitSettings, FittedUnit};
 use drift_recording::{read_recording, temperature_reading, Segment};
 use drift_sim::faults::{FaultEvent, FaultKind, FaultWindow, SensorFaults, Spikes};

@@ -73,6 +73,6 @@ pub struct Simulated {
 pub fn simulate(campaign: &Campaign) -> Simulated {
     let dir = tempfile::tempdir().expect("temp dir");
     simulate_campaign(campaign, dir.path(), |_| {}).expect("simulate");
-    let files = drift_fit::pipeline::recording_files(dir.path()).expect("recordings");
+    let files = drift_evaluate::pipeline::recording_files(dir.path()).expect("recordings");
     Simulated { dir, files }
 }

@@ -1,11 +1,13 @@
 //! The arguments every fitting command shares: which recordings, which set points to fit, which
 //! fit settings, and whether to show progress.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use drift_fit::pipeline::Options;
+use anyhow::Context;
 
-use super::fit::load_settings;
+use drift_evaluate::pipeline::Options;
+use drift_fit::FitSettings;
+use drift_recording::paper;
 
 /// Recordings and fit settings.
 #[derive(Debug, clap::Args)]
@@ -16,7 +18,7 @@ pub struct CampaignArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "30,40",
+        default_values_t = paper::CALIBRATION_SET_POINTS_CELSIUS,
         allow_hyphen_values = true
     )]
     pub calibration: Vec<f64>,
@@ -38,5 +40,18 @@ impl CampaignArgs {
             held_out_repeats: evaluate,
             evaluate,
         })
+    }
+}
+
+/// Reads fit settings from a JSON file, or the defaults.
+pub fn load_settings(path: Option<&Path>) -> anyhow::Result<FitSettings> {
+    match path {
+        None => Ok(FitSettings::default()),
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading {}", path.display()))?;
+            serde_json::from_str(&text)
+                .with_context(|| format!("{}: not valid fit settings", path.display()))
+        }
     }
 }

@@ -7,13 +7,15 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
-use drift_core::blob::{decode, Image};
+use drift_core::blob::Image;
 use drift_core::{Model, ModifiedTables, PolynomialTables};
-use drift_fit::check::{AxisVerdict, CheckedActivation, Limits, UnitCheck};
-use drift_fit::{pipeline, FitSettings};
+use drift_evaluate::check::{AxisVerdict, CheckedActivation, Limits, UnitCheck};
+use drift_evaluate::pipeline;
+use drift_evaluate::tables_folder::{self, StoredModel, TablesError};
+use drift_fit::FitSettings;
 use drift_recording::read_recording;
 
-use super::fit::load_settings;
+use super::campaign_args::load_settings;
 use super::progress::Steps;
 use crate::output::write_atomic;
 
@@ -33,12 +35,12 @@ pub enum Stored {
 }
 
 impl Stored {
-    fn file_name(self) -> &'static str {
+    fn model(self) -> StoredModel {
         match self {
-            Self::Modified => "modified.bin",
-            Self::ByHistory => "by_history.bin",
-            Self::Standard => "standard.bin",
-            Self::ThirdOrder => "third_order.bin",
+            Self::Modified => StoredModel::Modified,
+            Self::ByHistory => StoredModel::ByHistory,
+            Self::Standard => StoredModel::Standard,
+            Self::ThirdOrder => StoredModel::ThirdOrder,
         }
     }
 }
@@ -87,13 +89,12 @@ struct UnitResult {
 
 /// The image a unit carries, decoded; errors name the file.
 fn load<M: Image>(path: &Path) -> anyhow::Result<M> {
-    let bytes = std::fs::read(path).with_context(|| {
-        format!(
-            "reading {} (no stored tables for this unit? `gyrodrift fit` writes them)",
-            path.display()
-        )
-    })?;
-    decode(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    tables_folder::read_image(path).map_err(|error| match error {
+        TablesError::Io { .. } => {
+            anyhow::anyhow!("{error} (no stored tables for this unit? `gyrodrift fit` writes them)")
+        }
+        other => other.into(),
+    })
 }
 
 /// Checks every activation of every recording against the unit's stored `M`.
@@ -116,7 +117,7 @@ fn check_all<M: Model + Image>(
         let (_, check) = match units.entry(unit.clone()) {
             Entry::Occupied(entry) => entry.into_mut(),
             Entry::Vacant(entry) => {
-                let image = args.tables.join(unit).join(args.model.file_name());
+                let image = args.model.model().image_path(&args.tables, unit);
                 let model: M = load(&image)?;
                 let check = UnitCheck::new(unit, model, settings)
                     .with_context(|| image.display().to_string())?;

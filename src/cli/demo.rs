@@ -12,7 +12,7 @@ use drift_sim::{Campaign, Field, Protocol, UnitModel};
 
 use super::progress::Steps;
 use super::report::{make, print_headline};
-use drift_fit::pipeline::Options;
+use drift_evaluate::pipeline::Options;
 
 /// Options of `gyrodrift demo`.
 #[derive(Debug, clap::Args)]
@@ -70,13 +70,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         simulated.push((campaign.name.clone(), dir, summary));
     }
     steps.finish();
-    let options = Options {
-        calibration_set_points: vec![30.0, 40.0],
-        validation_set_points: vec![33.0],
-        fit: drift_fit::FitSettings::default(),
-        held_out_repeats: true,
-        evaluate: true,
-    };
+    let options = Options::default();
     let mut provenance = vec![format!(
         "Made by `gyrodrift demo --seed {}`: simulated campaigns (drift-sim), fit on +30/+40 °C protocol activations, evaluated with drift-core's f32 corrector (the firmware's code) on data the fit did not see.",
         args.seed

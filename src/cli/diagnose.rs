@@ -4,12 +4,12 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use drift_fit::closing::{
+use drift_diagnose::closing::{
     close, mean_profiles, profile_bin_labels, BeforeAfter, Closed, Profile, Stage3Choice,
 };
-use drift_fit::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
-use drift_fit::pipeline;
-use drift_fit::warm_start::WarmStartChoice;
+use drift_diagnose::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
+use drift_diagnose::warm_start::WarmStartChoice;
+use drift_evaluate::pipeline;
 use drift_fit::FittedUnit;
 use drift_recording::{read_recording, Segment};
 
@@ -396,7 +396,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let floor = match &args.noise_floor {
         Some(dir) => {
             steps.update("measuring the noise floor", 0, 1);
-            Some(super::extend::noise_floor(
+            Some(drift_evaluate::noise_floor::measure(
                 dir,
                 options.fit.lowpass_window_samples,
             )?)

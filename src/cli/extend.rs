@@ -1,22 +1,18 @@
 //! `gyrodrift diagnose --extend`: the report section of the extended model
-//! ([`drift_fit::closing`]): the guard's decisions, the admitted terms, the error before and after
+//! ([`drift_diagnose::closing`]): the guard's decisions, the admitted terms, the error before and after
 //! on the held-out activations, and the firmware image.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::Context as _;
 use drift_core::blob;
-use drift_fit::closing::{BeforeAfter, Closed};
-use drift_fit::evaluate;
-use drift_fit::excess::excess_cut;
-use drift_fit::pipeline;
-use drift_fit::switch_on_rate::SwitchOnRateFit;
+use drift_diagnose::closing::{BeforeAfter, Closed};
+use drift_diagnose::switch_on_rate::SwitchOnRateFit;
+use drift_evaluate::excess::excess_cut;
+use drift_evaluate::noise_floor::{group_name, Floor};
+use drift_evaluate::tables_folder;
 use drift_fit::FittedUnit;
-use drift_recording::{read_recording, Segment};
-
-use crate::output::write_atomic;
 
 /// Writes the extended model of one unit (image and JSON) and returns its Markdown section.
 pub fn run(
@@ -60,17 +56,13 @@ pub fn run(
         }
     }
     md.push_str(&before_after_table(before_after, floor));
-    let mut image = vec![0; blob::encoded_len(&*tables)?];
-    blob::encode(&*tables, &mut image)?;
-    write_atomic(&out.join(format!("extended-{unit}.bin")), &image)?;
-    write_atomic(
-        &out.join(format!("extended-{unit}.json")),
-        serde_json::to_string_pretty(&*tables)?.as_bytes(),
-    )?;
+    let files = tables_folder::model_files(out, &format!("extended-{unit}"), &*tables)?;
+    let image_len = files[1].1.len();
+    tables_folder::write_files(&files)?;
     let _ = writeln!(
         md,
         "Firmware image of the loop's model: `extended-{unit}.bin` ({} bytes, format version {}); tables as JSON: `extended-{unit}.json`.\n",
-        image.len(),
+        image_len,
         blob::FORMAT_VERSION
     );
     Ok(md)
@@ -188,86 +180,12 @@ fn switch_on_rate_markdown(element: bool, fits: &[SwitchOnRateFit; 3]) -> String
     md
 }
 
-/// The noise floor per held-out group (`+33.0 °C field`, as [`by_set_point_and_kind`] names it).
-pub type Floor = BTreeMap<String, FloorGroup>;
-
-/// The noise floor of one held-out group.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FloorGroup {
-    /// Per axis, (drift, RMS) of the 1-s mean, °/s: the mean over the twin's units of each unit's
-    /// mean over its activations.
-    pub mean: [(f64, f64); 3],
-    /// Per axis, the drift of every twin activation in the group, °/s: what the interval of an
-    /// excess cut resamples ([`drift_fit::excess`]).
-    pub drift: [Vec<f64>; 3],
-}
-
-/// The group an activation's result goes in.
-fn group(set_point_celsius: f64, series_kind: &str) -> String {
-    format!("{set_point_celsius:+.1} °C {series_kind}")
-}
-
-/// Measures the noise floor on the zero-drift campaign in `dir`, recorded like the diagnosed one:
-/// per unit, set point and series kind, its activations uncorrected, less the unit's constant bias
-/// ([`drift_fit::evaluate::noise_floor`], as the closed-loop experiment measures it); the mean
-/// over its units.
-pub fn noise_floor(dir: &Path, window: usize) -> anyhow::Result<Floor> {
-    let mut groups: BTreeMap<(String, String), Vec<Segment>> = BTreeMap::new();
-    for path in pipeline::recording_files(dir)? {
-        let recording = read_recording(&path)
-            .with_context(|| format!("noise floor: reading {}", path.display()))?;
-        for segment in recording.segments {
-            let key = group(
-                segment.labels.nominal_set_point_celsius(),
-                segment.labels.series_kind.as_str(),
-            );
-            groups
-                .entry((key, recording.unit_id.clone()))
-                .or_default()
-                .push(segment);
-        }
-    }
-    let mut sums: BTreeMap<String, (FloorGroup, usize)> = BTreeMap::new();
-    for ((key, _unit), segments) in &groups {
-        let refs: Vec<&Segment> = segments.iter().collect();
-        let per_activation = evaluate::noise_floor_per_activation(&refs, window);
-        let entry = sums.entry(key.clone()).or_default();
-        for (sum, (drift, rms)) in entry
-            .0
-            .mean
-            .iter_mut()
-            .zip(evaluate::mean_floor(&per_activation))
-        {
-            sum.0 += drift;
-            sum.1 += rms;
-        }
-        for per_axis in per_activation {
-            for (all, (drift, _)) in entry.0.drift.iter_mut().zip(per_axis) {
-                all.push(drift);
-            }
-        }
-        entry.1 += 1;
-    }
-    anyhow::ensure!(
-        !sums.is_empty(),
-        "noise floor: {} has no activations",
-        dir.display()
-    );
-    Ok(sums
-        .into_iter()
-        .map(|(key, (mut group, n))| {
-            group.mean = group.mean.map(|(d, r)| (d / n as f64, r / n as f64));
-            (key, group)
-        })
-        .collect())
-}
-
 /// The held-out activations' results by set point and series kind (`+33.0 °C field`), in order.
 pub fn by_set_point_and_kind(results: &[BeforeAfter]) -> BTreeMap<String, Vec<&BeforeAfter>> {
     let mut groups: BTreeMap<String, Vec<&BeforeAfter>> = BTreeMap::new();
     for r in results {
         groups
-            .entry(group(r.set_point_celsius, r.series_kind))
+            .entry(group_name(r.set_point_celsius, r.series_kind))
             .or_default()
             .push(r);
     }
@@ -399,7 +317,7 @@ mod tests {
             .collect();
         let floor: Floor = [(
             "+33.0 °C field".to_owned(),
-            FloorGroup {
+            drift_evaluate::noise_floor::FloorGroup {
                 mean: [(0.0010, 0.0030); 3],
                 drift: std::array::from_fn(|_| vec![0.0009, 0.0011, 0.0010, 0.0010]),
             },

@@ -5,10 +5,10 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use drift_fit::measured::{
+use drift_evaluate::measured::{
     characterise, obstacles_of, switch_on, Characterisation, MeasuredSettings, NotFittable,
 };
-use drift_fit::pipeline::PipelineError;
+use drift_evaluate::pipeline::PipelineError;
 use drift_recording::{read_recording, Segment};
 
 /// The units of `files` the paper's method cannot be fitted on, with what each lacks. Reads one

@@ -2,16 +2,17 @@
 
 use std::path::{Path, PathBuf};
 
-use drift_fit::summary::Split;
+use drift_evaluate::summary::Split;
 
 use super::campaign_args::CampaignArgs;
-use super::fit::write_tables;
 use super::measured;
 use super::progress::Steps;
 use crate::report::measured::write_measured_report;
 use crate::report::{write_report, ReportInput};
-use drift_fit::pipeline::PipelineError;
-use drift_fit::pipeline::{self, Options, Outcome};
+use drift_evaluate::pipeline::PipelineError;
+use drift_evaluate::pipeline::{self, Options, Outcome};
+use drift_evaluate::tables_folder;
+use drift_recording::paper;
 
 /// Options of `gyrodrift report`.
 #[derive(Debug, clap::Args)]
@@ -23,7 +24,7 @@ pub struct Args {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "33",
+        default_values_t = [paper::VALIDATION_SET_POINT_CELSIUS],
         allow_hyphen_values = true
     )]
     pub validation: Vec<f64>,
@@ -47,31 +48,11 @@ pub fn make(
     let steps = Steps::new(quiet);
     let progress = |s: &str, d, t| steps.update(s, d, t);
     let files = pipeline::recording_files(campaign)?;
-    let mut outcome = pipeline::run(&files, options, false, &progress)?;
-    let mut noise_units = Vec::new();
-    if let Some(dir) = noise_floor {
-        let noise = pipeline::run(&pipeline::recording_files(dir)?, options, true, &progress)?;
-        for (_, result) in &noise.results {
-            let id = format!("noise:{}", result.labels.unit_id);
-            if !noise_units.contains(&id) {
-                noise_units.push(id);
-            }
-        }
-        outcome
-            .results
-            .extend(noise.results.into_iter().map(|(split, mut r)| {
-                r.labels.unit_id = format!("noise:{}", r.labels.unit_id);
-                (split, r)
-            }));
-        outcome.timings.extend(
-            noise
-                .timings
-                .into_iter()
-                .map(|(step, s)| (format!("noise floor: {step}"), s)),
-        );
-    }
+    let noise_files = noise_floor.map(pipeline::recording_files).transpose()?;
+    let (outcome, noise_units) =
+        pipeline::run_with_noise_floor(&files, noise_files.as_deref(), options, &progress)?;
     steps.finish();
-    write_tables(&out.join("tables"), &outcome.fitted)?;
+    tables_folder::write(&out.join("tables"), &outcome.fitted)?;
     let input = ReportInput {
         title: "gyrodrift report: temperature-drift correction on data the fit did not see",
         provenance,
@@ -87,7 +68,7 @@ pub fn make(
 
 /// Prints the headline table of a finished report.
 pub fn print_headline(outcome: &Outcome) {
-    let records = drift_fit::summary::summarise(&outcome.results);
+    let records = drift_evaluate::summary::summarise(&outcome.results);
     print!(
         "{}",
         crate::report::headline_text(&records, &outcome.fitted, &noise_ids(outcome))

@@ -1,8 +1,8 @@
 //! `gyrodrift simulate`: record a simulated calibration campaign as a folder of MCAP files.
 
 use anyhow::Context;
-use drift_sim::campaign::set_point_range;
-use drift_sim::{Campaign, Field, UnitModel};
+use drift_sim::overrides::{parse_set_points, Overrides};
+use drift_sim::Campaign;
 use std::path::PathBuf;
 
 /// Options of `gyrodrift simulate`. Flags override the campaign file; without a file the
@@ -58,72 +58,34 @@ pub struct Args {
     pub quiet: bool,
 }
 
-fn parse_set_points(text: &str) -> anyhow::Result<Vec<f64>> {
-    let number = |s: &str| {
-        s.trim()
-            .parse::<f64>()
-            .with_context(|| format!("--set-points: `{s}` is not a number"))
-    };
-    if text.contains(':') {
-        let parts: Vec<&str> = text.split(':').collect();
-        anyhow::ensure!(
-            parts.len() == 3,
-            "--set-points range must be from:to:step, got `{text}`"
-        );
-        let points = set_point_range(number(parts[0])?, number(parts[1])?, number(parts[2])?);
-        anyhow::ensure!(!points.is_empty(), "--set-points range `{text}` is empty");
-        return Ok(points);
-    }
-    text.split(',').map(number).collect()
-}
-
-/// Builds the campaign from the file (if any) and the flags.
+/// The campaign these flags describe: the file's (or the built-in paper campaign) with the flags
+/// applied as [`Overrides`].
 pub fn campaign_from(args: &Args) -> anyhow::Result<Campaign> {
-    let mut c = match &args.campaign {
+    let base = match &args.campaign {
         Some(path) => Campaign::from_file(path)?,
         None => Campaign::default(),
     };
-    if let Some(seed) = args.seed {
-        c.seed = seed;
-    }
-    if let Some(units) = args.units {
-        c.units = units;
-    }
-    if let Some(text) = &args.set_points {
-        c.set_points_celsius = parse_set_points(text)?;
-    }
-    if args.intervals.is_some() || args.repeats.is_some() {
-        let p = c.protocol.get_or_insert_with(Default::default);
-        if let Some(intervals) = &args.intervals {
-            p.intervals_min.clone_from(intervals);
+    let set_points = match &args.set_points {
+        Some(text) => {
+            Some(parse_set_points(text).map_err(|e| anyhow::anyhow!("--set-points: {e}"))?)
         }
-        if let Some(repeats) = args.repeats {
-            p.repeats = repeats;
-        }
-    }
-    if args.field || args.field_only {
-        c.field.get_or_insert_with(Field::default);
-    }
-    if args.field_only {
-        c.protocol = None;
-    }
-    if args.zero_drift {
-        c.unit_model = UnitModel::ZeroSystematicDrift;
-    }
-    if args.paper_exact {
-        c.unit_model = UnitModel::PaperExact;
-    }
-    for name in &args.effects {
-        c.effects.enable(name.trim()).map_err(anyhow::Error::msg)?;
-    }
-    if args.truth_at_aux_rate {
-        c.truth_bias = drift_sim::campaign::TruthBias::AuxRate;
-    }
-    if let Some(scale) = args.noise_scale {
-        c.noise_scale = scale;
-    }
-    c.validate()?;
-    Ok(c)
+        None => None,
+    };
+    let overrides = Overrides {
+        seed: args.seed,
+        units: args.units,
+        set_points,
+        intervals: args.intervals.clone(),
+        repeats: args.repeats,
+        field: args.field,
+        field_only: args.field_only,
+        zero_drift: args.zero_drift,
+        paper_exact: args.paper_exact,
+        effects: args.effects.clone(),
+        noise_scale: args.noise_scale,
+        truth_at_aux_rate: args.truth_at_aux_rate,
+    };
+    Ok(overrides.apply(base)?)
 }
 
 /// Runs `gyrodrift simulate`.

@@ -4,13 +4,13 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use drift_evaluate::evaluate::ModelKind;
+use drift_evaluate::summary::Split;
 use drift_fit::analyse::Analysed;
-use drift_fit::evaluate::ModelKind;
-use drift_fit::summary::Split;
 use drift_recording::SeriesKind;
 
+use super::input::ReportInput;
 use super::plots::{draw, Chart, Series};
-use super::ReportInput;
 use crate::output::write_atomic;
 
 const AXIS: usize = 0;

@@ -1,11 +1,11 @@
 //! The report for recordings the paper's method cannot be fitted on: why not, and what the data
 //! does tell (noise floor, bias per activation, slow drift, a 1-D temperature slope, the residual
-//! after a linear temperature correction), from [`drift_fit::measured::characterise`].
+//! after a linear temperature correction), from [`drift_evaluate::measured::characterise`].
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use drift_fit::measured::{Characterisation, Estimate, Obstacle};
+use drift_evaluate::measured::{Characterisation, Estimate, Obstacle};
 
 use super::plots;
 use crate::output::write_atomic;

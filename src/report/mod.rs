@@ -2,37 +2,19 @@
 //! results.
 
 mod figures;
+mod input;
 pub mod measured;
 pub mod plots;
-pub(crate) mod tables;
+pub mod tables;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use drift_fit::analyse::Analysed;
-use drift_fit::evaluate::ActivationResult;
-use drift_fit::summary::{summarise, Record, Split};
+use drift_evaluate::summary::{summarise, Record};
 use drift_fit::FittedUnit;
 
 use crate::output::write_atomic;
-
-/// Everything a report is made from.
-pub struct ReportInput<'a> {
-    /// Title line.
-    pub title: &'a str,
-    /// How the data and the report were made (commands, seeds), as Markdown lines.
-    pub provenance: Vec<String>,
-    /// Units the tables were fitted for, in column order.
-    pub fitted: &'a [FittedUnit],
-    /// Ids of units whose systematic drift is zero (the noise floor), if any.
-    pub noise_floor_units: &'a [String],
-    /// The calibration activations, analysed (for the figures of the paper's kind).
-    pub calibration: &'a [Analysed],
-    /// Evaluation results with the data split each was measured on.
-    pub results: &'a [(Split, ActivationResult)],
-    /// Measured durations of the pipeline's steps, seconds.
-    pub timings: Vec<(String, f64)>,
-}
+pub use input::ReportInput;
 
 /// Writes `report.md`, `report.json` (the table as data) and the figures into `dir`; returns the
 /// report's path.
@@ -100,11 +82,6 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
         serde_json::to_string_pretty(&records)?.as_bytes(),
     )?;
     Ok(path)
-}
-
-/// Records of one split, for convenience.
-pub(crate) fn of_split(records: &[Record], split: Split) -> impl Iterator<Item = &Record> {
-    records.iter().filter(move |r| r.split == split)
 }
 
 /// The headline table (Markdown), for printing.

@@ -3,10 +3,8 @@
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
-use drift_fit::summary::{Record, Split};
+use drift_evaluate::summary::{Record, Split};
 use drift_fit::FittedUnit;
-
-use super::of_split;
 
 const AXES: [&str; 3] = ["X", "Y", "Z"];
 const MODELS: [&str; 5] = [
@@ -32,6 +30,11 @@ fn find<'a>(
             && r.model == model
             && r.axis == axis
     })
+}
+
+/// Records of one split, for convenience.
+fn of_split(records: &[Record], split: Split) -> impl Iterator<Item = &Record> {
+    records.iter().filter(move |r| r.split == split)
 }
 
 /// Set points present in a split, ascending.

@@ -135,10 +135,7 @@ impl NormalEquations {
         let columns = self.columns;
         let normal = DMatrix::<f64>::from_fn(columns, columns, |r, c| self.power_sums[r + c]);
         let rhs = DVector::<f64>::from_column_slice(&self.rhs[..columns]);
-        normal
-            .lu()
-            .solve(&rhs)
-            .map(|v| v.iter().copied().collect())
+        crate::regression::solve(normal, &rhs)
             .unwrap_or_else(|| vec![self.y_sum / self.count.max(1) as f64])
     }
 }
@@ -185,7 +182,7 @@ pub fn standard(by_set_point: &[Vec<&Analysed>], settings: Settings) -> Polynomi
 
 /// The PX4/ArduPilot practice: a least-squares polynomial of the given degree per axis over every
 /// calibration grid point.
-pub fn least_squares(
+pub fn least_squares_polynomial(
     activations: &[&Analysed],
     degree: usize,
     settings: Settings,

@@ -428,7 +428,13 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
         || {
             rayon::join(
                 || baselines::standard(&by_set_point, core_settings),
-                || baselines::least_squares(&protocol, settings.polynomial_degree, core_settings),
+                || {
+                    baselines::least_squares_polynomial(
+                        &protocol,
+                        settings.polynomial_degree,
+                        core_settings,
+                    )
+                },
             )
         },
     );

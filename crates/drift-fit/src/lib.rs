@@ -1,38 +1,27 @@
-//! Fitting and evaluation, the std/f64 half of gyrodrift: segments → fitted tables → corrector →
-//! residual.
+//! Fitting, the std/f64 half of gyrodrift's calibration: one activation's recording → its drift and
+//! temperature-rise curves → the paper's tables and the polynomial baselines.
 //!
 //! - [`analyse`] turns one activation into its low-frequency drift and temperature-rise curves;
-//! - [`fit`] groups activations into the paper's curves, picks reference times, and builds the
-//!   paper's tables ([`drift_core::ModifiedTables`]) and the two polynomial baselines;
-//! - [`evaluate`] runs the fitted models through drift-core's f32 corrector (exactly what firmware
-//!   runs) on activations the fit did not see, and measures the paper's drift metric.
+//! - [`fit`] groups activations into the paper's curves ([`curves`]), picks reference times
+//!   ([`knots`]) and builds the paper's tables ([`drift_core::ModifiedTables`]), the same curves
+//!   keyed by heating history ([`history_order`]) and the two polynomial baselines;
+//! - [`regression`] is the one least-squares solver the fitting and the closed loop share.
+//!
+//! Evaluation lives in `drift-evaluate`, the closed loop in `drift-diagnose`; both build on this
+//! crate, never the other way round.
 
-pub mod absorb;
 pub mod analyse;
 pub mod baselines;
-pub mod candidates;
-pub mod check;
-pub mod closing;
 pub mod curves;
-pub mod diagnose;
 pub mod error;
-pub mod evaluate;
-pub mod excess;
-pub mod extend;
 pub mod fit;
 pub mod history_order;
-pub mod keying;
 pub mod knots;
 pub mod lowpass;
-pub mod measured;
-pub mod parallel;
-pub mod pipeline;
-pub mod roles;
+mod parallel;
+pub mod regression;
 pub mod settings;
-pub mod summary;
-pub mod switch_on_rate;
-pub mod warm_start;
-pub mod windows;
+mod windows;
 
 pub use error::FitError;
 pub use fit::{fit_unit, FittedUnit};

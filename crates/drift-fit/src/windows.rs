@@ -82,16 +82,6 @@ impl Windows {
         }
     }
 
-    /// Number of windows.
-    pub fn len(&self) -> usize {
-        self.queries
-    }
-
-    /// Whether there are no windows.
-    pub fn is_empty(&self) -> bool {
-        self.queries == 0
-    }
-
     /// Where the running sums are to be recorded, ascending (none without windows): record `r` is
     /// the sum of the samples before the `r`-th position. Sample 0 first, the lattice points, then
     /// the last window's end, which is where the pass may stop.

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use drift_core::Model;
-use drift_fit::check::{Limits, UnitCheck};
+use drift_evaluate::check::{Limits, UnitCheck};
 use drift_fit::FitSettings;
 use drift_recording::{read_recording, Segment};
 use pyo3::prelude::*;

@@ -4,11 +4,11 @@
 
 use std::sync::Arc;
 
-use drift_fit::closing::close;
-use drift_fit::closing::{BeforeAfter, Profile, Stage3Choice, PROFILE_EDGES_S};
-use drift_fit::diagnose::AxisDiagnosis;
-use drift_fit::extend::Admission;
-use drift_fit::warm_start::WarmStartChoice;
+use drift_diagnose::closing::close;
+use drift_diagnose::closing::{BeforeAfter, Profile, Stage3Choice, PROFILE_EDGES_S};
+use drift_diagnose::diagnose::AxisDiagnosis;
+use drift_diagnose::extend::Admission;
+use drift_diagnose::warm_start::WarmStartChoice;
 use drift_fit::{FitSettings, FittedUnit};
 use drift_recording::{read_recording, Segment};
 use numpy::ndarray::Array3;

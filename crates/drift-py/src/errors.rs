@@ -17,7 +17,8 @@
 use std::path::PathBuf;
 
 use drift_core::blob::BlobError;
-use drift_fit::pipeline::PipelineError;
+use drift_evaluate::pipeline::PipelineError;
+use drift_evaluate::tables_folder::TablesError;
 use drift_fit::FitError as RustFitError;
 use drift_recording::{ReadError, WriteError};
 use drift_sim::SimError;
@@ -198,6 +199,29 @@ impl From<SimError> for Error {
             },
             SimError::Write(error) => error.into(),
             other => Self::Simulate(other),
+        }
+    }
+}
+
+impl From<TablesError> for Error {
+    fn from(error: TablesError) -> Self {
+        match error {
+            TablesError::Io {
+                action,
+                path,
+                problem,
+            } => Self::File {
+                action,
+                path,
+                source: problem,
+            },
+            TablesError::Encode { problem, .. } | TablesError::Decode { problem, .. } => {
+                Self::Image(problem)
+            }
+            TablesError::Json { problem, .. } => Self::Json {
+                model: "tables",
+                source: problem,
+            },
         }
     }
 }

@@ -2,12 +2,12 @@
 //! correct everything the fit did not see), `gyrodrift.Evaluation`, `gyrodrift.ActivationResult`
 //! and `gyrodrift.summarise` (the report's table as data, the records of `report.json`).
 
-use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use drift_fit::evaluate::ActivationResult;
-use drift_fit::pipeline::{self, Options};
-use drift_fit::summary::{summarise as summarise_results, Split};
+use drift_evaluate::evaluate::ActivationResult;
+use drift_evaluate::pipeline::{self, Options};
+use drift_evaluate::summary::{summarise as summarise_results, Split};
+use drift_recording::paper;
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
@@ -17,114 +17,8 @@ use crate::arrays::describe;
 use crate::errors::Error;
 use crate::fit::PyFittedUnit;
 use crate::fit_settings;
-use crate::labels::PyLabels;
+use crate::results::PyActivationResult;
 use crate::sources::{self, Source};
-
-const SPLITS: [(Split, &str); 4] = [
-    (Split::Validation, "validation"),
-    (Split::HeldOutRepeat, "held_out_repeat"),
-    (Split::Field, "field"),
-    (Split::NoiseFloor, "noise_floor"),
-];
-
-/// A split's name as in `report.json`.
-fn split_name(split: Split) -> &'static str {
-    SPLITS
-        .iter()
-        .find(|(s, _)| *s == split)
-        .map_or("validation", |(_, name)| name)
-}
-
-/// A split from its `report.json` name.
-pub fn split_from(value: &Bound<'_, PyAny>) -> Result<Split, Error> {
-    let names: Vec<&str> = SPLITS.iter().map(|(_, n)| *n).collect();
-    let text: Option<String> = value.extract().ok();
-    SPLITS
-        .iter()
-        .find(|(_, name)| text.as_deref() == Some(*name))
-        .map(|(split, _)| *split)
-        .ok_or_else(|| {
-            Error::Input(format!(
-                "`split` must be one of {}, got {}",
-                names.join(", "),
-                args::shown(value)
-            ))
-        })
-}
-
-/// Per model name, one value per axis.
-type PerModel<T> = BTreeMap<&'static str, (T, T, T)>;
-
-/// One activation corrected with every model, and the data it was measured on.
-#[pyclass(module = "gyrodrift", name = "ActivationResult", frozen)]
-#[derive(Debug, Clone)]
-pub struct PyActivationResult {
-    pub split: Split,
-    pub result: ActivationResult,
-}
-
-impl PyActivationResult {
-    fn per_model<T: Copy>(
-        &self,
-        value: impl Fn(&drift_fit::evaluate::ModelResult) -> [T; 3],
-    ) -> PerModel<T> {
-        self.result
-            .models
-            .iter()
-            .map(|m| {
-                let [x, y, z] = value(m);
-                (m.model.name(), (x, y, z))
-            })
-            .collect()
-    }
-}
-
-#[pymethods]
-impl PyActivationResult {
-    /// Which data: "validation", "held_out_repeat", "field" or "noise_floor".
-    #[getter]
-    fn split(&self) -> &'static str {
-        split_name(self.split)
-    }
-
-    /// The activation's labels.
-    #[getter]
-    fn labels(&self) -> PyLabels {
-        PyLabels(self.result.labels.clone())
-    }
-
-    /// Per model ("uncorrected", "standard", "3rd-order", "modified", "by-history"): drift per
-    /// axis, °/s (max − min of the 1-s low-frequency rate over the activation).
-    #[getter]
-    fn drift_dps(&self) -> PerModel<f64> {
-        self.per_model(|m| m.drift_dps)
-    }
-
-    /// Per model: RMS of the low-frequency rate per axis, °/s (includes the initial-bias error).
-    #[getter]
-    fn residual_rms_dps(&self) -> PerModel<f64> {
-        self.per_model(|m| m.residual_rms_dps)
-    }
-
-    /// Per model: union of the corrector's flags over the activation, per axis.
-    #[getter]
-    fn flags(&self) -> PerModel<u16> {
-        self.per_model(|m| m.flags)
-    }
-
-    fn __repr__(&self) -> String {
-        let l = &self.result.labels;
-        format!(
-            "<ActivationResult {} {} {:+} °C series {} repeat {} activation {}>",
-            split_name(self.split),
-            l.unit_id,
-            l.set_point_celsius,
-            l.series,
-            l.repeat,
-            l.activation
-        )
-    }
-}
 
 /// The records of `report.json` as Python dicts (same keys and values).
 fn records_of<'py>(
@@ -276,43 +170,21 @@ pub fn evaluate(
     let options = Options {
         calibration_set_points: match calibration {
             Some(v) => sources::set_points("calibration", v, false)?,
-            None => vec![30.0, 40.0],
+            None => paper::CALIBRATION_SET_POINTS_CELSIUS.to_vec(),
         },
         validation_set_points: match validation {
             Some(v) => sources::set_points("validation", v, true)?,
-            None => vec![33.0],
+            None => vec![paper::VALIDATION_SET_POINT_CELSIUS],
         },
         fit: fit_settings::or_default(settings)?,
         held_out_repeats,
         evaluate: true,
     };
-    let (mut outcome, noise) = py
+    let (outcome, noise_floor_units) = py
         .detach(|| {
-            let outcome = pipeline::run(&files, &options, false, &|_, _, _| {})?;
-            let noise = match &noise_files {
-                Some(files) => Some(pipeline::run(files, &options, true, &|_, _, _| {})?),
-                None => None,
-            };
-            Ok::<_, pipeline::PipelineError>((outcome, noise))
+            pipeline::run_with_noise_floor(&files, noise_files.as_deref(), &options, &|_, _, _| {})
         })
         .map_err(Error::from)?;
-    let mut noise_floor_units = Vec::new();
-    if let Some(noise) = noise {
-        // As `gyrodrift report`: noise-floor units are told apart by a "noise:" prefix.
-        for (split, mut result) in noise.results {
-            result.labels.unit_id = format!("noise:{}", result.labels.unit_id);
-            if !noise_floor_units.contains(&result.labels.unit_id) {
-                noise_floor_units.push(result.labels.unit_id.clone());
-            }
-            outcome.results.push((split, result));
-        }
-        outcome.timings.extend(
-            noise
-                .timings
-                .into_iter()
-                .map(|(step, s)| (format!("noise floor: {step}"), s)),
-        );
-    }
     let fitted = outcome
         .fitted
         .into_iter()

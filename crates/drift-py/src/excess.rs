@@ -1,6 +1,6 @@
 //! `gyrodrift.excess_cut`: how many times a model cuts the error in excess of the noise floor, with
 //! its 95 % bootstrap interval — the figure the closed-loop experiment and `gyrodrift diagnose
-//! --extend` give beside each before/after pair ([`drift_fit::excess`]).
+//! --extend` give beside each before/after pair ([`drift_evaluate::excess`]).
 
 use pyo3::prelude::*;
 
@@ -40,6 +40,6 @@ pub fn excess_cut(
         ))
         .into());
     }
-    let cut = drift_fit::excess::excess_cut(&before, &after, &floor);
+    let cut = drift_evaluate::excess::excess_cut(&before, &after, &floor);
     Ok((cut.ratio, cut.low, cut.high))
 }

@@ -5,10 +5,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use drift_evaluate::evaluate::{evaluate_after, kept_before};
+use drift_evaluate::pipeline::{self, Options};
+use drift_evaluate::summary::Split;
 use drift_fit::analyse::{analyse, Analysed};
-use drift_fit::evaluate::{evaluate_after, kept_before};
-use drift_fit::pipeline::{self, Options};
-use drift_fit::summary::Split;
 use drift_fit::{fit_unit, FitSettings, FittedUnit};
 use drift_recording::{Segment, SeriesKind};
 use pyo3::prelude::*;
@@ -17,12 +17,12 @@ use rayon::prelude::*;
 use crate::args;
 use crate::arrays::describe;
 use crate::errors::{Error, FitError};
-use crate::evaluation::{split_from, PyActivationResult};
 use crate::fit_settings::{self, PyFitSettings};
-use crate::model_io;
+use crate::results::{split_from, PyActivationResult};
 use crate::segment::PySegment;
 use crate::sources::{self, Source};
 use crate::tables::{PyModifiedTables, PyPolynomialTables};
+use drift_evaluate::tables_folder;
 
 /// Everything fitted for one unit, with the settings it was fitted with.
 #[pyclass(module = "gyrodrift", name = "FittedUnit", frozen)]
@@ -118,7 +118,7 @@ pub fn fit(
     let source = sources::source(py, "source", source)?;
     let set_points = match calibration {
         Some(v) => sources::set_points("calibration", v, false)?,
-        None => vec![30.0, 40.0],
+        None => drift_recording::paper::CALIBRATION_SET_POINTS_CELSIUS.to_vec(),
     };
     let settings = fit_settings::or_default(settings)?;
     fit_source(py, source, set_points, settings)
@@ -284,42 +284,13 @@ impl PyFittedUnit {
         )
     }
 
-    /// Writes `<folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin}` as
-    /// `gyrodrift fit` does; returns the unit's folder.
+    /// Writes `<folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin}`
+    /// (`drift_evaluate::tables_folder`, the command line's writer); returns the unit's folder.
     fn save(&self, folder: &Bound<'_, PyAny>) -> Result<PathBuf, Error> {
-        let dir = args::path("folder", folder)?.join(&self.unit.unit_id);
-        std::fs::create_dir_all(&dir).map_err(|source| Error::File {
-            action: "write",
-            path: dir.clone(),
-            source,
-        })?;
-        for (name, tables) in [
-            ("modified", &self.unit.modified),
-            ("by_history", &self.unit.by_history),
-        ] {
-            model_io::write(
-                &dir.join(format!("{name}.json")),
-                model_io::to_json("ModifiedTables", tables)?.as_bytes(),
-            )?;
-            model_io::write(
-                &dir.join(format!("{name}.bin")),
-                &model_io::to_image(tables)?,
-            )?;
-        }
-        for (name, model) in [
-            ("standard", &self.unit.standard),
-            ("third_order", &self.unit.third_order),
-        ] {
-            model_io::write(
-                &dir.join(format!("{name}.json")),
-                model_io::to_json("PolynomialTables", model)?.as_bytes(),
-            )?;
-            model_io::write(
-                &dir.join(format!("{name}.bin")),
-                &model_io::to_image(model)?,
-            )?;
-        }
-        Ok(dir)
+        let folder = args::path("folder", folder)?;
+        let files = tables_folder::unit_files(&folder, &self.unit)?;
+        tables_folder::write_files(&files)?;
+        Ok(folder.join(&self.unit.unit_id))
     }
 
     fn __repr__(&self) -> String {

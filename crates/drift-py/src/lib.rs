@@ -1,7 +1,7 @@
 //! Python bindings for gyrodrift: the extension module `gyrodrift._gyrodrift`.
 //!
-//! A thin layer: argument conversion and delegation to drift-core, drift-recording, drift-sim and
-//! drift-fit; the numeric work stays there. One file per Python-facing area; shared argument
+//! A thin layer: argument conversion and delegation to drift-core, drift-recording, drift-sim,
+//! drift-fit, drift-evaluate and drift-diagnose; the numeric work stays there. One file per Python-facing area; shared argument
 //! checks in `args` and `arrays`, numpy outputs in `outputs`; every error goes through `errors`.
 //! See `README.md`.
 
@@ -22,6 +22,7 @@ mod labels;
 mod model_io;
 mod outputs;
 mod recording;
+mod results;
 mod segment;
 mod settings;
 mod simulate;
@@ -55,7 +56,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(fit::fit, module)?)?;
     module.add_class::<analysed::PyAnalysed>()?;
     module.add_function(wrap_pyfunction!(analysed::analyse, module)?)?;
-    module.add_class::<evaluation::PyActivationResult>()?;
+    module.add_class::<results::PyActivationResult>()?;
     module.add_class::<evaluation::PyEvaluation>()?;
     module.add_function(wrap_pyfunction!(evaluation::evaluate, module)?)?;
     module.add_function(wrap_pyfunction!(evaluation::summarise, module)?)?;

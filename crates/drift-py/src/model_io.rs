@@ -2,10 +2,9 @@
 //! (`drift_core::blob`), and files. Pure Rust; the classes in `tables.rs` only delegate.
 
 use std::fs;
-use std::io::Write;
 use std::path::Path;
 
-use drift_core::blob::{self, BlobError, Image};
+use drift_core::blob::{self, Image};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
@@ -28,23 +27,9 @@ pub fn from_image<M: Image>(bytes: &[u8]) -> Result<M, Error> {
     blob::decode(bytes).map_err(Error::Image)
 }
 
-/// Encodes a firmware table image, growing the buffer until the image fits.
+/// Encodes a firmware table image.
 pub fn to_image<M: Image>(tables: &M) -> Result<Vec<u8>, Error> {
-    // The largest host model (16 × 12 × 32 capacities) takes about 150 KB; stop well beyond.
-    const LIMIT: usize = 16 << 20;
-    let mut buffer = vec![0_u8; 4096];
-    loop {
-        match blob::encode(tables, &mut buffer) {
-            Ok(length) => {
-                buffer.truncate(length);
-                return Ok(buffer);
-            }
-            Err(BlobError::BufferTooSmall) if buffer.len() < LIMIT => {
-                buffer.resize(buffer.len().saturating_mul(2), 0);
-            }
-            Err(error) => return Err(Error::Image(error)),
-        }
-    }
+    drift_evaluate::tables_folder::image_bytes(tables).map_err(Error::Image)
 }
 
 /// Reads a whole file.
@@ -65,26 +50,12 @@ pub fn read_text(path: &Path) -> Result<String, Error> {
     })
 }
 
-/// Writes a whole file atomically: a temporary file next to it, then a rename, so a failed write
-/// never leaves a half-written model behind.
+/// Writes a whole file atomically ([`drift_recording::write_atomic`]): a failed write never
+/// leaves a half-written model behind.
 pub fn write(path: &Path, contents: &[u8]) -> Result<(), Error> {
-    let error = |source| Error::File {
+    drift_recording::write_atomic(path, contents).map_err(|source| Error::File {
         action: "write",
         path: path.to_owned(),
         source,
-    };
-    let mut temporary = path.as_os_str().to_owned();
-    temporary.push(format!(".tmp-{}", std::process::id()));
-    let temporary = Path::new(&temporary);
-    let result = fs::File::create(temporary)
-        .and_then(|mut file| {
-            file.write_all(contents)?;
-            file.sync_all()
-        })
-        .and_then(|()| fs::rename(temporary, path));
-    if result.is_err() {
-        // Best effort: the temporary may not even exist (e.g. the folder is missing).
-        let _ = fs::remove_file(temporary);
-    }
-    result.map_err(error)
+    })
 }

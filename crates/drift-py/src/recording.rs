@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use drift_fit::pipeline::recording_files;
+use drift_evaluate::pipeline::recording_files;
 use drift_recording::{
     check_named_aux_channel, fixed_aux_unit, read_metadata, read_recording, write_recording,
     Recording, AUX_RATE_HZ,

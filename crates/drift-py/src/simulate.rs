@@ -4,31 +4,14 @@
 
 use std::path::{Path, PathBuf};
 
-use drift_sim::campaign::{set_point_range, TruthBias};
-use drift_sim::{Campaign, Field, Protocol, UnitModel};
+use drift_sim::overrides::{parse_set_points, OverrideError, Overrides, SetPointsError};
+use drift_sim::{Campaign, Protocol};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 use crate::args;
 use crate::arrays::describe;
 use crate::errors::Error;
-
-/// The keyword overrides, one per flag of `gyrodrift simulate`.
-#[derive(Debug, Default)]
-struct Overrides {
-    seed: Option<u64>,
-    units: Option<u32>,
-    set_points: Option<Vec<f64>>,
-    intervals: Option<Vec<f64>>,
-    repeats: Option<u32>,
-    field: bool,
-    field_only: bool,
-    zero_drift: bool,
-    paper_exact: bool,
-    effects: Vec<String>,
-    noise_scale: Option<f64>,
-    truth_at_aux_rate: bool,
-}
 
 /// `--set-points`: a list of floats, or the flag's text (`"30,40,33"` or `"-40:60:10"`).
 fn set_points(value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
@@ -41,83 +24,14 @@ fn set_points(value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
         ))
     };
     if let Ok(text) = value.cast::<PyString>() {
-        let text = text.to_string();
-        let number = |s: &str| s.trim().parse::<f64>().map_err(|_| bad());
-        if text.contains(':') {
-            let parts: Vec<&str> = text.split(':').collect();
-            let [from, to, step] = parts.as_slice() else {
-                return Err(bad());
-            };
-            let points = set_point_range(number(from)?, number(to)?, number(step)?);
-            if points.is_empty() {
-                return Err(Error::Input(format!(
-                    "`set_points` range {text:?} is empty"
-                )));
+        return parse_set_points(&text.to_string()).map_err(|error| match error {
+            SetPointsError::EmptyRange(text) => {
+                Error::Input(format!("`set_points` range {text:?} is empty"))
             }
-            return Ok(points);
-        }
-        return text.split(',').map(number).collect();
+            _ => bad(),
+        });
     }
     args::value("set_points", EXPECTED, value)
-}
-
-impl Overrides {
-    /// Applies the overrides as `gyrodrift simulate` applies its flags (src/cli/simulate.rs).
-    fn apply(&self, mut c: Campaign) -> Result<Campaign, Error> {
-        if let Some(seed) = self.seed {
-            c.seed = seed;
-        }
-        if let Some(units) = self.units {
-            c.units = units;
-        }
-        if let Some(points) = &self.set_points {
-            c.set_points_celsius.clone_from(points);
-        }
-        if self.intervals.is_some() || self.repeats.is_some() {
-            let p = c.protocol.get_or_insert_with(Protocol::default);
-            if let Some(intervals) = &self.intervals {
-                p.intervals_min.clone_from(intervals);
-            }
-            if let Some(repeats) = self.repeats {
-                p.repeats = repeats;
-            }
-        }
-        if self.field && self.field_only {
-            return Err(Error::Input(
-                "`field` and `field_only` cannot both be set".into(),
-            ));
-        }
-        if self.field || self.field_only {
-            c.field.get_or_insert_with(Field::default);
-        }
-        if self.field_only {
-            c.protocol = None;
-        }
-        if self.zero_drift && self.paper_exact {
-            return Err(Error::Input(
-                "`zero_drift` and `paper_exact` cannot both be set".into(),
-            ));
-        }
-        if self.zero_drift {
-            c.unit_model = UnitModel::ZeroSystematicDrift;
-        }
-        if self.paper_exact {
-            c.unit_model = UnitModel::PaperExact;
-        }
-        for name in &self.effects {
-            c.effects
-                .enable(name.trim())
-                .map_err(|reason| Error::Input(format!("`effects`: {reason}")))?;
-        }
-        if self.truth_at_aux_rate {
-            c.truth_bias = TruthBias::AuxRate;
-        }
-        if let Some(scale) = self.noise_scale {
-            c.noise_scale = scale;
-        }
-        c.validate()?;
-        Ok(c)
-    }
 }
 
 /// Text as TOML, or as JSON when it starts with `{`.
@@ -212,7 +126,12 @@ fn resolve(
             args::shown(effects)
         )));
     }
-    overrides.apply(base(py, campaign)?)
+    overrides
+        .apply(base(py, campaign)?)
+        .map_err(|error| match error {
+            OverrideError::Campaign(error) => error.into(),
+            other => Error::Input(other.to_string()),
+        })
 }
 
 /// A campaign as a dict (the JSON form drift-sim reads and writes to truth/campaign.json).

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use drift_fit::pipeline::recording_files;
+use drift_evaluate::pipeline::recording_files;
 use drift_recording::Segment;
 use pyo3::prelude::*;
 

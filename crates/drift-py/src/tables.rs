@@ -167,7 +167,7 @@ macro_rules! model_class {
             /// Is this stored calibration still valid? Corrects every activation of `source`
             /// (one unit's recordings or segments, held static) as the firmware would; one
             /// record per axis against the limits (`gyrodrift check` on the command line; the
-            /// defaults are `drift_fit::check::Limits::default()`, which a test compares).
+            /// defaults are `drift_evaluate::check::Limits::default()`, which a test compares).
             #[pyo3(signature = (source, *, max_drift = 0.005, max_rms = 0.02, min_removed = 0.5, settings = None))]
             fn check<'py>(
                 &self,

@@ -9,6 +9,7 @@
 //! [`write_recording`] writes the same format from a real test bench's data, and [`read_csv`] reads
 //! measured data from CSV into the same segments.
 
+pub mod atomic;
 mod aux;
 pub mod cdr;
 mod csv_aux;
@@ -16,6 +17,7 @@ mod csv_file;
 mod error;
 mod layout;
 mod messages;
+pub mod paper;
 mod read;
 pub mod schema;
 mod segment;
@@ -23,6 +25,7 @@ mod writable;
 mod write;
 pub mod writer;
 
+pub use atomic::write_atomic;
 pub use aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic, FIXED_AUX_CHANNELS};
 pub use csv_aux::CsvAuxColumn;
 pub use csv_file::{

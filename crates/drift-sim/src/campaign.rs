@@ -147,7 +147,7 @@ impl Default for Campaign {
             seed: 1,
             units: 2,
             sample_rate_hz: 1000,
-            set_points_celsius: vec![30.0, 40.0, 33.0],
+            set_points_celsius: drift_recording::paper::CAMPAIGN_SET_POINTS_CELSIUS.to_vec(),
             unit_model: UnitModel::Physical,
             noise_scale: 1.0,
             protocol: Some(Protocol::default()),

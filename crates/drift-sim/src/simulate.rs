@@ -91,9 +91,7 @@ fn write_json(path: &Path, value: &impl Serialize) -> Result<(), SimError> {
         path: path.to_path_buf(),
         source: e,
     })?;
-    let temp = path.with_extension("json.tmp");
-    std::fs::write(&temp, text).map_err(|e| SimError::io(&temp, e))?;
-    std::fs::rename(&temp, path).map_err(|e| SimError::io(path, e))
+    drift_recording::write_atomic(path, text.as_bytes()).map_err(|e| SimError::io(path, e))
 }
 
 /// Simulates and records a whole campaign into `out_dir` (created if missing).

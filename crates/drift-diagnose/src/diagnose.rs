@@ -1,0 +1,512 @@
+//! Diagnosis: after correction by the paper's model, is a systematic effect left in the residual,
+//! and which recorded or derived quantity explains it?
+//!
+//! For every diagnosed activation, the corrected rate's low-frequency residual is put on a coarse
+//! grid beside candidate explanations ([`crate::candidates`]): every auxiliary channel the
+//! recording has (whatever its name) and derived quantities (temperature rate per axis, rise², the
+//! other axes' rises, time since switch-on, switch-on temperature, residual heat at switch-on,
+//! campaign time). Before scoring, each candidate is stripped of what the paper's model already
+//! accounts for: the paper's tables are fitted to the candidate itself on the calibration
+//! activations ([`crate::absorb`]) and what they predict of it is taken out. A candidate the table
+//! explains is then left with nothing to explain, and what is left is exactly what a term in that
+//! candidate would add to the paper's model.
+//!
+//! Score: out-of-sample explained variance of the residual, cross-validated by activation
+//! (K folds of whole activations, never samples), for a one-coefficient linear term. Significance:
+//! per-activation reductions of squared error on held-out activations, one-sided t-test of their
+//! mean against zero, Bonferroni-corrected over every candidate of the axis. Activations are the
+//! independent samples; the noise inside one is strongly autocorrelated. A candidate is significant
+//! only if it also lowers the *whole* held-out residual (offsets and shape, no activation means
+//! taken out) at the same level: a firmware term changes both, and a candidate left over from
+//! what the tables almost wholly absorb (rise², the rises) can match the tables' own lookup error
+//! in shape while a term in it makes the whole error no smaller (measured in
+//! `docs/closed-loop.md`, *Session 8*).
+//!
+//! The model whose residual is diagnosed is the loop's: the paper's tables with stage 3 keyed by
+//! rise or by heating history per axis, as [`crate::closing`] chose ([`Keying`]).
+
+use std::collections::BTreeMap;
+
+use drift_core::SwitchOnRate;
+use drift_recording::{Segment, SegmentLabels};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::absorb::Absorber;
+use crate::candidates::{Kind, SET_POINT_CHANNEL};
+use crate::keying::Keying;
+use crate::statistics::one_sided_mean_test;
+use crate::switch_on_rate::start_rates;
+use drift_evaluate::evaluate::{spread, switch_on_raw};
+use drift_fit::error::FitError;
+use drift_fit::fit::FittedUnit;
+use drift_fit::lowpass::centred_moving_average;
+use drift_fit::settings::FitSettings;
+
+/// Spacing of the diagnosis grid, ms: the residual is low-passed at 1 s, so 10 Hz keeps it whole.
+pub const GRID_MS: u32 = 100;
+const AXES: [&str; 3] = ["X", "Y", "Z"];
+
+/// One activation on the diagnosis grid.
+#[derive(Debug, Clone)]
+pub struct ActivationSeries {
+    /// Labels.
+    pub labels: SegmentLabels,
+    /// Low-frequency residual after the paper's model, per axis, °/s.
+    pub residual_dps: [Vec<f64>; 3],
+    /// Candidates per axis, by name, as recorded or derived.
+    pub candidates: [BTreeMap<String, Vec<f64>>; 3],
+    /// The same candidates less what the paper's tables predict of them: what is scored.
+    pub left_over: [BTreeMap<String, Vec<f64>>; 3],
+}
+
+/// Low-pass at the fit's window and sample on the diagnosis grid.
+fn on_grid<T: Copy + Into<f64>>(values: &[T], window: usize, step: usize) -> Vec<f64> {
+    centred_moving_average(values, window)
+        .into_iter()
+        .step_by(step)
+        .collect()
+}
+
+/// Puts activations of one unit on the diagnosis grid, with the loop's model (the paper's tables
+/// fitted on its calibration activations, stage 3 keyed as chosen) and, for every candidate, what
+/// those tables absorb of it.
+pub struct Diagnoser {
+    settings: FitSettings,
+    /// How stage 3 reads each axis of the model diagnosed, and what firmware kept before each
+    /// activation.
+    keying: Keying,
+    /// The diagnosed model's tables (the paper's, with the history-keyed axes `keying` chose).
+    tables: Box<drift_core::ModifiedTables>,
+    /// Each candidate kind with the tables fitted to it; a kind the calibration activations cannot
+    /// carry (an auxiliary channel they lack) is not offered.
+    kinds: Vec<(Kind, Absorber)>,
+    /// Each axis's rate at switch-on measured on the calibration, where a rate candidate's filter
+    /// starts, as the firmware's term would.
+    switch_on_rate: [SwitchOnRate; 3],
+}
+
+impl Diagnoser {
+    /// Learns what the paper's tables absorb of every candidate, on the activations `fitted` was
+    /// fitted on. Candidates are the auxiliary channels every calibration activation has and the
+    /// derived quantities.
+    ///
+    /// The model diagnosed is the paper's with stage 3 keyed as `keying` says per axis; a rate
+    /// candidate's filter starts at `switch_on_rate` (measured on the same calibration,
+    /// [`crate::switch_on_rate::fit_switch_on_rate`]), as the firmware's term would.
+    pub fn new(
+        fitted: &FittedUnit,
+        calibration: &[&Segment],
+        settings: &FitSettings,
+        keying: Keying,
+        switch_on_rate: [SwitchOnRate; 3],
+    ) -> Result<Self, FitError> {
+        let mut channels: Vec<String> = calibration
+            .first()
+            .map(|s| s.aux.keys().cloned().collect())
+            .unwrap_or_default();
+        channels.retain(|c| calibration.iter().all(|s| s.aux.contains_key(c)));
+        let has_set_point = channels.iter().any(|c| c == SET_POINT_CHANNEL);
+        let core = fitted.modified.settings;
+        let kinds = Kind::all(channels, has_set_point)
+            .into_iter()
+            .map(|kind| {
+                let absorber = Absorber::fit(
+                    calibration,
+                    |s| {
+                        let on = switch_on_raw(s, settings);
+                        let start = start_rates(&switch_on_rate, &core, on, keying.previous(s));
+                        kind.values(s, on, &start)
+                    },
+                    settings,
+                    &keying,
+                )?;
+                Ok((kind, absorber))
+            })
+            .collect::<Result<Vec<_>, FitError>>()?;
+        Ok(Self {
+            settings: settings.clone(),
+            tables: keying.tables(&fitted.modified, &fitted.by_history),
+            keying,
+            kinds,
+            switch_on_rate,
+        })
+    }
+
+    /// Puts one activation, corrected by the paper's model, on the diagnosis grid.
+    pub fn series(&self, segment: &Segment) -> ActivationSeries {
+        let window = self.settings.lowpass_window_samples;
+        let step = (segment.sample_rate_hz as usize * GRID_MS as usize / 1000).max(1);
+        let switch_on = switch_on_raw(segment, &self.settings);
+        let (corrected, _) = self.keying.correct(&self.tables, segment, switch_on);
+        let start = start_rates(
+            &self.switch_on_rate,
+            &self.tables.settings,
+            switch_on,
+            self.keying.previous(segment),
+        );
+        let residual: [Vec<f64>; 3] = [0, 1, 2].map(|a| on_grid(&corrected[a], window, step));
+        let mut candidates: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
+        let mut left_over: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
+        let computed: Vec<_> = self
+            .kinds
+            .par_iter()
+            .filter_map(|(kind, absorber)| {
+                let values = kind.values(segment, switch_on, &start)?;
+                let left = absorber.left_over(segment, values.clone(), switch_on, &self.keying);
+                Some((kind, values, left))
+            })
+            .collect();
+        for (kind, values, left) in computed {
+            for axis in 0..3 {
+                let name = kind.name(axis);
+                candidates[axis].insert(name.clone(), on_grid(&values[axis], window, step));
+                left_over[axis].insert(name, on_grid(&left[axis], window, step));
+            }
+        }
+        ActivationSeries {
+            labels: segment.labels.clone(),
+            residual_dps: residual,
+            candidates,
+            left_over,
+        }
+    }
+}
+
+/// One candidate's score on one axis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CandidateScore {
+    /// Candidate name.
+    pub name: String,
+    /// Out-of-sample share of the residual's variance explained (cross-validated by activation).
+    pub explained: f64,
+    /// One-sided p-value of the mean held-out improvement (before multiple-comparison correction).
+    pub p_value: f64,
+    /// One-sided p-value of the mean held-out improvement of the whole residual (offsets and
+    /// shape together, no per-activation means taken out): what a firmware term changes.
+    pub whole_p_value: f64,
+    /// One-sided p-value of the mean held-out reduction of the drift (max − min of the 1-s
+    /// residual over each activation) when the candidate's within-activation fit is taken out:
+    /// the paper's metric, which a shape term changes and an offset cannot.
+    pub drift_p_value: f64,
+    /// Whether it passes the Bonferroni-corrected test at `alpha`, at its level and on the whole
+    /// residual.
+    pub significant: bool,
+    /// Fitted coefficient on all data ((°/s) per candidate unit, on what the tables leave of it).
+    pub coefficient: f64,
+    /// Share of the candidate's own variance that the paper's tables, fitted to it on the
+    /// calibration activations, predict. Near 1: the table accounts for this quantity, and it is
+    /// not scored.
+    pub absorbed_by_model: f64,
+    /// Where the effect shows: within activations (shape), between activations (offsets), or
+    /// absorbed by the model.
+    pub level: &'static str,
+}
+
+/// The ranking on one axis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisDiagnosis {
+    /// `X`, `Y` or `Z`.
+    pub axis: &'static str,
+    /// Activations used.
+    pub activations: usize,
+    /// RMS of the residual, °/s.
+    pub residual_rms_dps: f64,
+    /// Candidates, best first.
+    pub ranking: Vec<CandidateScore>,
+}
+
+impl AxisDiagnosis {
+    /// The winning candidate, if any is significant.
+    pub fn chosen(&self) -> Option<&CandidateScore> {
+        self.ranking.first().filter(|c| c.significant)
+    }
+}
+
+/// A candidate whose variance the paper's tables explain beyond this share is the table's already.
+const ABSORBED: f64 = 0.999;
+
+/// Share of the candidate's variance (about its mean, over every activation) that the paper's
+/// tables predict: 1 − var(left over) / var(candidate).
+fn absorbed_share(activations: &[ActivationSeries], axis: usize, name: &str) -> f64 {
+    let spread = |pick: &dyn Fn(&ActivationSeries) -> Option<&Vec<f64>>| {
+        let values: Vec<f64> = activations
+            .iter()
+            .filter_map(pick)
+            .flatten()
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect();
+        let m = mean(values.iter().copied());
+        values.iter().map(|v| (v - m).powi(2)).sum::<f64>()
+    };
+    let total = spread(&|a| a.candidates[axis].get(name));
+    if total <= 0.0 {
+        return 1.0; // a constant: nothing left once the intercept is taken out
+    }
+    (1.0 - spread(&|a| a.left_over[axis].get(name)) / total).max(0.0)
+}
+
+/// One point of the scoring data: residual and candidate (left over after the tables).
+type Point = (f64, f64);
+
+/// Slope and intercept of `y` on `x` over the finite points of `train`; `None` without spread.
+fn line(train: &[&Vec<Point>]) -> Option<(f64, f64)> {
+    let points = || {
+        train
+            .iter()
+            .flat_map(|g| g.iter())
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+    };
+    let n = points().count() as f64;
+    if n < 2.0 {
+        return None;
+    }
+    let (mx, my) = (
+        points().map(|p| p.1).sum::<f64>() / n,
+        points().map(|p| p.0).sum::<f64>() / n,
+    );
+    let sxx: f64 = points().map(|p| (p.1 - mx).powi(2)).sum();
+    let sxy: f64 = points().map(|p| (p.1 - mx) * (p.0 - my)).sum();
+    if sxx <= 0.0 {
+        return Some((0.0, my));
+    }
+    let slope = sxy / sxx;
+    Some((slope, my - slope * mx))
+}
+
+/// A candidate's cross-validated score at one level.
+struct Score {
+    explained: f64,
+    /// One-sided p-value of the mean held-out reduction of the squared residual.
+    p_value: f64,
+    /// One-sided p-value of the mean held-out reduction of the drift (max − min over the
+    /// activation): the paper's metric, which an offset cannot move.
+    drift_p_value: f64,
+    coefficient: f64,
+}
+
+/// Scores one candidate on groups of points (one group per activation), cross-validated by
+/// group: the explained share, the p-values of the held-out squared residual's and drift's
+/// reductions, and the coefficient on all data.
+fn score(groups: &[Vec<Point>], folds: usize) -> Score {
+    let finite = |p: &&Point| p.0.is_finite() && p.1.is_finite();
+    let all: Vec<&Point> = groups.iter().flatten().filter(finite).collect();
+    let mean_y = all.iter().map(|p| p.0).sum::<f64>() / all.len().max(1) as f64;
+    let total: f64 = all.iter().map(|p| (p.0 - mean_y).powi(2)).sum();
+    let folds = folds.clamp(2, groups.len().max(2));
+    let mut improvements = Vec::with_capacity(groups.len());
+    let mut drift_gains = Vec::with_capacity(groups.len());
+    let mut sse = 0.0;
+    for fold in 0..folds {
+        let train: Vec<&Vec<Point>> = groups
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % folds != fold)
+            .map(|(_, g)| g)
+            .collect();
+        let Some((slope, intercept)) = line(&train) else {
+            continue;
+        };
+        let intercept_only = mean(
+            train
+                .iter()
+                .flat_map(|g| g.iter())
+                .filter(finite)
+                .map(|p| p.0),
+        );
+        for group in groups
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % folds == fold)
+            .map(|(_, g)| g)
+        {
+            let (mut without, mut with, mut n) = (0.0, 0.0, 0usize);
+            for p in group.iter().filter(finite) {
+                without += (p.0 - intercept_only).powi(2);
+                with += (p.0 - intercept - slope * p.1).powi(2);
+                n += 1;
+            }
+            if n > 0 {
+                sse += with;
+                improvements.push((without - with) / n as f64);
+                let residual = || group.iter().filter(finite);
+                drift_gains.push(
+                    spread(residual().map(|p| p.0)) - spread(residual().map(|p| p.0 - slope * p.1)),
+                );
+            }
+        }
+    }
+    let (_, p_value) = one_sided_mean_test(&improvements);
+    let (_, drift_p_value) = one_sided_mean_test(&drift_gains);
+    let all_groups: Vec<&Vec<Point>> = groups.iter().collect();
+    let coefficient = line(&all_groups).map_or(0.0, |(slope, _)| slope);
+    let explained = if total > 0.0 { 1.0 - sse / total } else { 0.0 };
+    Score {
+        explained,
+        p_value,
+        drift_p_value,
+        coefficient,
+    }
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    sum / n.max(1) as f64
+}
+
+/// Scores every candidate on one axis of `activations` with `folds`-fold cross-validation by
+/// activation; `alpha` is the family-wise significance level for the axis.
+///
+/// Each candidate is scored at two levels, because effects show in two ways: **within**
+/// activations (residual and candidate less their activation means: the shape that the drift
+/// metric sees, e.g. a temperature-rate term) and **between** activations (one point per activation,
+/// the means: offsets that change from one switch-on to the next, e.g. supply voltage or
+/// orientation). The better level is reported; Bonferroni covers both levels of every candidate.
+pub fn diagnose_axis(
+    activations: &[ActivationSeries],
+    axis: usize,
+    folds: usize,
+    alpha: f64,
+) -> AxisDiagnosis {
+    let names: Vec<String> = activations
+        .first()
+        .map(|a| a.candidates[axis].keys().cloned().collect())
+        .unwrap_or_default();
+    let names: Vec<String> = names
+        .into_iter()
+        .filter(|n| {
+            activations
+                .iter()
+                .all(|a| a.candidates[axis].contains_key(n) && a.left_over[axis].contains_key(n))
+        })
+        .collect();
+    let rms = mean(
+        activations
+            .iter()
+            .flat_map(|a| a.residual_dps[axis].iter().map(|y| y * y)),
+    )
+    .sqrt();
+    let mut ranking: Vec<CandidateScore> = names
+        .iter()
+        .map(|name| {
+            let absorbed = absorbed_share(activations, axis, name);
+            let mut candidate = CandidateScore {
+                name: name.clone(),
+                explained: 0.0,
+                p_value: 1.0,
+                whole_p_value: 1.0,
+                drift_p_value: 1.0,
+                significant: false,
+                coefficient: 0.0,
+                absorbed_by_model: absorbed,
+                level: "",
+            };
+            if absorbed > ABSORBED {
+                candidate.level = "absorbed by the model";
+                return candidate;
+            }
+            let finite_mean = |v: &[f64]| mean(v.iter().copied().filter(|x| x.is_finite()));
+            let within: Vec<Vec<Point>> = activations
+                .iter()
+                .map(|a| {
+                    let (y, c) = (&a.residual_dps[axis], &a.left_over[axis][name]);
+                    let (my, mc) = (finite_mean(y), finite_mean(c));
+                    y.iter().zip(c).map(|(y, c)| (y - my, c - mc)).collect()
+                })
+                .collect();
+            let between: Vec<Vec<Point>> = activations
+                .iter()
+                .map(|a| {
+                    vec![(
+                        finite_mean(&a.residual_dps[axis]),
+                        finite_mean(&a.left_over[axis][name]),
+                    )]
+                })
+                .collect();
+            let whole: Vec<Vec<Point>> = activations
+                .iter()
+                .map(|a| {
+                    let (y, c) = (&a.residual_dps[axis], &a.left_over[axis][name]);
+                    y.iter().copied().zip(c.iter().copied()).collect()
+                })
+                .collect();
+            let within = score(&within, folds);
+            let between = score(&between, folds);
+            candidate.whole_p_value = score(&whole, folds).p_value;
+            // Only a shape has a drift; the between level's one point per activation has none.
+            candidate.drift_p_value = within.drift_p_value;
+            let (best, level) = if within.p_value <= between.p_value {
+                (within, "within activations")
+            } else {
+                (between, "between activations")
+            };
+            (
+                candidate.explained,
+                candidate.p_value,
+                candidate.coefficient,
+                candidate.level,
+            ) = (best.explained, best.p_value, best.coefficient, level);
+            candidate
+        })
+        .collect();
+    let bonferroni = alpha / (2 * ranking.len()).max(1) as f64;
+    for c in &mut ranking {
+        // The drift's p-value is reported, not tested: in the null case the paper's own gap (the
+        // element lagging the sensor) passes it on many axes (docs/closed-loop.md, session 12),
+        // and the element's heating rate is offered to the guard on every axis anyway
+        // (`TermPlan::choose`).
+        c.significant = c.p_value < bonferroni && c.whole_p_value < bonferroni && c.explained > 0.0;
+    }
+    // Significant first, then by explained share.
+    ranking.sort_by(|a, b| {
+        b.significant
+            .cmp(&a.significant)
+            .then(b.explained.total_cmp(&a.explained))
+    });
+    AxisDiagnosis {
+        axis: AXES[axis],
+        activations: activations.len(),
+        residual_rms_dps: rms,
+        ranking,
+    }
+}
+
+/// Diagnoses all three axes.
+pub fn diagnose(activations: &[ActivationSeries]) -> [AxisDiagnosis; 3] {
+    [0, 1, 2].map(|axis| diagnose_axis(activations, axis, 5, 0.05))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{score, spread, Point};
+
+    #[test]
+    fn the_drift_test_sees_a_shape_and_not_an_unrelated_candidate() {
+        // 20 activations whose residual is a ramp of its own size plus a wobble: the ramp as
+        // candidate takes the drift down on every held-out activation, the wobble's twin does not.
+        let activation = |k: u32, candidate: &dyn Fn(f64) -> f64| -> Vec<Point> {
+            let size = 1.0 + f64::from(k % 5);
+            (0..50)
+                .map(|i| {
+                    let t = f64::from(i) / 50.0;
+                    let wobble = 0.3 * (7.0 * t + f64::from(k)).sin();
+                    (size * t + wobble, candidate(size * t))
+                })
+                .collect()
+        };
+        let ramp: Vec<Vec<Point>> = (0..20).map(|k| activation(k, &|ramp| ramp)).collect();
+        let shape = score(&ramp, 5);
+        assert!(
+            shape.drift_p_value < 1e-3 && shape.p_value < 1e-3,
+            "{}",
+            shape.drift_p_value
+        );
+        let unrelated: Vec<Vec<Point>> = (0..20)
+            .map(|k| activation(k, &|ramp| (13.0 * ramp).cos()))
+            .collect();
+        assert!(score(&unrelated, 5).drift_p_value > 0.05);
+        assert_eq!(spread([1.0, f64::NAN, -2.0]), 3.0);
+        assert_eq!(spread([]), 0.0);
+    }
+}

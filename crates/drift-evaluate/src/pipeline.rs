@@ -1,0 +1,361 @@
+//! The main job, one way through: recordings → segments → fitted tables → corrector → residual →
+//! report data.
+//!
+//! Recordings are read twice, file by file, so memory holds one file's samples at a time: the first
+//! pass analyses the calibration activations (small curves) for the fits, the second corrects every
+//! activation the fits did not see. Validation set points, field sessions and the noise-floor unit
+//! never reach a fit; at calibration set points each repeat is evaluated with tables refitted
+//! without it.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use drift_recording::{
+    paper, read_metadata, read_recording, ReadError, Segment, SeriesKind, RECORDINGS_DIR,
+};
+use rayon::prelude::*;
+
+use crate::evaluate::{evaluate_after, kept_before, ActivationResult};
+use crate::summary::Split;
+use drift_fit::analyse::{analyse, Analysed};
+use drift_fit::error::FitError;
+use drift_fit::fit::{fit_unit, FittedUnit};
+use drift_fit::settings::FitSettings;
+
+/// Why the pipeline stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// A folder could not be listed.
+    #[error("listing recordings in {path}: {source}")]
+    List {
+        /// The folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// A folder holds no recordings.
+    #[error("no .mcap recordings in {path}")]
+    NoRecordings {
+        /// The folder.
+        path: PathBuf,
+    },
+    /// A recording failed to read or validate (the error names file, topic and message).
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    /// Analysing or fitting failed (the error names the unit and activation).
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    /// None of the recordings has protocol activations at the calibration set points.
+    #[error("no protocol activations at the calibration set points {set_points:?} °C in {files} recordings")]
+    NoCalibration {
+        /// The calibration set points asked for.
+        set_points: Vec<f64>,
+        /// How many recordings were looked at.
+        files: usize,
+    },
+}
+
+/// What to fit on and what to evaluate on.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Chamber set points whose protocol activations are fitted, °C.
+    pub calibration_set_points: Vec<f64>,
+    /// Chamber set points evaluated only, °C (never fitted).
+    pub validation_set_points: Vec<f64>,
+    /// Fitting settings.
+    pub fit: FitSettings,
+    /// Evaluate each repeat at the calibration set points with tables refitted without it.
+    pub held_out_repeats: bool,
+    /// Run the evaluation pass at all (`false`: fit only; nothing else is read).
+    pub evaluate: bool,
+}
+
+impl Default for Options {
+    /// The paper's campaign: fit on its calibration set points, validate on its validation set
+    /// point, default fit settings, every evaluation.
+    fn default() -> Self {
+        Self {
+            calibration_set_points: paper::CALIBRATION_SET_POINTS_CELSIUS.to_vec(),
+            validation_set_points: vec![paper::VALIDATION_SET_POINT_CELSIUS],
+            fit: FitSettings::default(),
+            held_out_repeats: true,
+            evaluate: true,
+        }
+    }
+}
+
+/// Everything the report needs.
+#[derive(Debug, Default)]
+pub struct Outcome {
+    /// Tables fitted on all calibration activations, per unit.
+    pub fitted: Vec<FittedUnit>,
+    /// The calibration activations, analysed.
+    pub calibration: Vec<Analysed>,
+    /// Evaluation results with their split.
+    pub results: Vec<(Split, ActivationResult)>,
+    /// Step durations, seconds.
+    pub timings: Vec<(String, f64)>,
+    /// Samples read in the first pass.
+    pub samples_read: u64,
+}
+
+/// Reports progress: (step, done, total).
+pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
+
+/// Whether `set_point` (°C) is one of `list`, to a micro-degree.
+pub fn is_one_of(set_point: f64, list: &[f64]) -> bool {
+    list.iter().any(|s| (s - set_point).abs() < 1e-6)
+}
+
+/// The recordings of a campaign folder (or of a folder of `.mcap` files), sorted by name.
+pub fn recording_files(dir: &Path) -> Result<Vec<PathBuf>, PipelineError> {
+    let folder = if dir.join(RECORDINGS_DIR).is_dir() {
+        dir.join(RECORDINGS_DIR)
+    } else {
+        dir.to_path_buf()
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&folder)
+        .map_err(|source| PipelineError::List {
+            path: folder.clone(),
+            source,
+        })?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "mcap") && !drift_recording::is_truth_path(p)
+        })
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(PipelineError::NoRecordings { path: folder });
+    }
+    Ok(files)
+}
+
+/// What a recording's metadata says about it, without decoding a message: `Some(true)` for a
+/// protocol recording at a calibration set point, `Some(false)` for any other, `None` when the
+/// metadata lacks the set point or series kind (then the segments' own labels must decide).
+pub fn calibration_file(path: &Path, options: &Options) -> Result<Option<bool>, PipelineError> {
+    let metadata = read_metadata(path)?;
+    let set_point = metadata
+        .get("set_point_celsius")
+        .and_then(|s| s.parse::<f64>().ok());
+    let kind = metadata
+        .get("series_kind")
+        .and_then(|s| SeriesKind::parse(s));
+    Ok(set_point.zip(kind).map(|(set_point, kind)| {
+        kind == SeriesKind::Protocol && is_one_of(set_point, &options.calibration_set_points)
+    }))
+}
+
+/// Whether an activation is calibration data: a protocol activation at a calibration set point.
+///
+/// This goes by the chamber set point at switch-on, the label the fit groups curves by
+/// (`curves.rs`): protocol sessions do not ramp, so it is also the recording's nominal one.
+/// Validation, field and noise-floor membership go by the nominal set point
+/// ([`drift_recording::SegmentLabels::nominal_set_point_celsius`]) instead.
+pub fn calibration_segment(segment: &Segment, options: &Options) -> bool {
+    segment.labels.series_kind == SeriesKind::Protocol
+        && is_one_of(
+            segment.labels.set_point_celsius,
+            &options.calibration_set_points,
+        )
+}
+
+/// The prefix that tells a noise-floor unit's results apart from the fitted units' (`noise:GIU-01`).
+pub const NOISE_FLOOR_PREFIX: &str = "noise:";
+
+/// [`run`] on `files`, then, with `noise_floor`, on a campaign of zero-drift twins measured the
+/// same way: their results are added with their unit ids prefixed by [`NOISE_FLOOR_PREFIX`], and
+/// their timings by "noise floor: ". Returns the outcome and the noise-floor unit ids, in order of
+/// first appearance.
+pub fn run_with_noise_floor(
+    files: &[PathBuf],
+    noise_floor: Option<&[PathBuf]>,
+    options: &Options,
+    progress: Progress<'_>,
+) -> Result<(Outcome, Vec<String>), PipelineError> {
+    let mut outcome = run(files, options, false, progress)?;
+    let mut noise_units = Vec::new();
+    if let Some(noise_files) = noise_floor {
+        let noise = run(noise_files, options, true, progress)?;
+        for (split, mut result) in noise.results {
+            result.labels.unit_id = format!("{NOISE_FLOOR_PREFIX}{}", result.labels.unit_id);
+            if !noise_units.contains(&result.labels.unit_id) {
+                noise_units.push(result.labels.unit_id.clone());
+            }
+            outcome.results.push((split, result));
+        }
+        outcome.timings.extend(
+            noise
+                .timings
+                .into_iter()
+                .map(|(step, seconds)| (format!("noise floor: {step}"), seconds)),
+        );
+    }
+    Ok((outcome, noise_units))
+}
+
+/// Fits every unit found in `files` and evaluates on everything the fits did not see.
+/// With `noise_floor`, the units have no systematic drift: their validation results are labelled
+/// [`Split::NoiseFloor`] and nothing else of theirs is evaluated.
+pub fn run(
+    files: &[PathBuf],
+    options: &Options,
+    noise_floor: bool,
+    progress: Progress<'_>,
+) -> Result<Outcome, PipelineError> {
+    let mut outcome = Outcome::default();
+    let settings = &options.fit;
+
+    // Pass 1: read, analyse calibration activations.
+    let mut read_seconds = 0.0;
+    let mut analyse_seconds = 0.0;
+    let mut by_unit: BTreeMap<String, Vec<Analysed>> = BTreeMap::new();
+    for (i, path) in files.iter().enumerate() {
+        progress(
+            "reading and analysing calibration recordings",
+            i as u64,
+            files.len() as u64,
+        );
+        let started = Instant::now();
+        if calibration_file(path, options)? == Some(false) {
+            // Validation and field recordings are never decoded for the fit.
+            continue;
+        }
+        let recording = read_recording(path)?;
+        read_seconds += started.elapsed().as_secs_f64();
+        outcome.samples_read += recording
+            .segments
+            .iter()
+            .map(|s| s.len() as u64)
+            .sum::<u64>();
+        let started = Instant::now();
+        let analysed: Vec<Analysed> = recording
+            .segments
+            .par_iter()
+            .filter(|s| calibration_segment(s, options))
+            .map(|s| analyse(s, settings))
+            .collect::<Result<_, _>>()?;
+        analyse_seconds += started.elapsed().as_secs_f64();
+        if !analysed.is_empty() {
+            by_unit
+                .entry(recording.unit_id.clone())
+                .or_default()
+                .extend(analysed);
+        }
+    }
+    progress(
+        "reading and analysing calibration recordings",
+        files.len() as u64,
+        files.len() as u64,
+    );
+
+    // Units are entered only with analysed activations, so every entry is non-empty.
+    if by_unit.is_empty() {
+        return Err(PipelineError::NoCalibration {
+            set_points: options.calibration_set_points.clone(),
+            files: files.len(),
+        });
+    }
+
+    // Fits: all calibration data, and one per left-out repeat.
+    let started = Instant::now();
+    let mut held_out: BTreeMap<(String, u32), FittedUnit> = BTreeMap::new();
+    for (unit, analysed) in &by_unit {
+        outcome.fitted.push(fit_unit(analysed, settings)?);
+        if options.held_out_repeats {
+            let repeats: BTreeSet<u32> = analysed.iter().map(|a| a.labels.repeat).collect();
+            if repeats.len() > 1 {
+                for &repeat in &repeats {
+                    let rest: Vec<Analysed> = analysed
+                        .iter()
+                        .filter(|a| a.labels.repeat != repeat)
+                        .cloned()
+                        .collect();
+                    held_out.insert((unit.clone(), repeat), fit_unit(&rest, settings)?);
+                }
+            }
+        }
+    }
+    let fit_seconds = started.elapsed().as_secs_f64();
+
+    // Pass 2: evaluate everything no fit saw.
+    let started = Instant::now();
+    let evaluated = if options.evaluate { files } else { &[] };
+    for (i, path) in evaluated.iter().enumerate() {
+        progress("correcting and evaluating", i as u64, files.len() as u64);
+        let recording = read_recording(path)?;
+        let Some(fitted) = outcome
+            .fitted
+            .iter()
+            .find(|f| f.unit_id == recording.unit_id)
+        else {
+            continue;
+        };
+        // What firmware keeping its history across power-off knows at each switch-on: the
+        // recording's activations in order (one unit per recording), with a clock that tells a
+        // full cool-down; nothing is known of the time between recordings.
+        let segments: Vec<&Segment> = recording.segments.iter().collect();
+        let kept = kept_before(&segments, settings, &fitted.by_history.settings, true);
+        let results: Vec<(Split, ActivationResult)> = recording
+            .segments
+            .par_iter()
+            .zip(kept.par_iter())
+            .filter_map(|(segment, previous)| {
+                let labels = &segment.labels;
+                // The set point the activation belongs to: in a field session whose ambient
+                // ramps, the switch-on label is the ambient of the moment (31.7, 35.2 … in a
+                // +33 °C session), almost never a validation set point.
+                let validation = is_one_of(
+                    labels.nominal_set_point_celsius(),
+                    &options.validation_set_points,
+                );
+                let (split, model) = if noise_floor {
+                    // The noise floor is measured where the other units are validated: every
+                    // activation of the twin's sessions at a validation set point.
+                    if !validation {
+                        return None;
+                    }
+                    (Split::NoiseFloor, fitted)
+                } else if labels.series_kind == SeriesKind::Field {
+                    (Split::Field, fitted)
+                } else if validation {
+                    (Split::Validation, fitted)
+                } else if calibration_segment(segment, options) {
+                    (
+                        Split::HeldOutRepeat,
+                        held_out.get(&(recording.unit_id.clone(), labels.repeat))?,
+                    )
+                } else {
+                    return None;
+                };
+                Some((split, evaluate_after(model, segment, settings, previous)))
+            })
+            .collect();
+        outcome.results.extend(results);
+    }
+    progress(
+        "correcting and evaluating",
+        files.len() as u64,
+        files.len() as u64,
+    );
+    let evaluate_seconds = started.elapsed().as_secs_f64();
+    outcome.calibration = by_unit.into_values().flatten().collect();
+    outcome.timings = vec![
+        ("read recordings (pass 1)".into(), read_seconds),
+        ("analyse calibration activations".into(), analyse_seconds),
+        (
+            format!(
+                "fit tables ({} units, with refits per left-out repeat)",
+                outcome.fitted.len()
+            ),
+            fit_seconds,
+        ),
+        (
+            "read again, correct and evaluate (pass 2)".into(),
+            evaluate_seconds,
+        ),
+    ];
+    Ok(outcome)
+}

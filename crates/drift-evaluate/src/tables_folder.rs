@@ -1,0 +1,183 @@
+//! A fit's tables folder, written and read in one place: `<folder>/<unit>/<model>.{json,bin}` for
+//! the models of [`StoredModel`]. The JSON is drift-core's serde form (what people read and diff),
+//! the `.bin` the checksummed firmware image (`drift_core::blob`).
+//!
+//! `gyrodrift fit`, `gyrodrift report`, `gyrodrift diagnose --extend` and Python's
+//! `FittedUnit.save` all write through [`write`], so their folders are the same bytes.
+
+use std::path::{Path, PathBuf};
+
+use drift_core::blob::{self, BlobError, Image};
+use drift_fit::FittedUnit;
+use drift_recording::write_atomic;
+use serde::Serialize;
+
+/// Why a tables folder could not be written or read, naming the file. The message carries the
+/// cause whole (it is not chained again as a `source`).
+#[derive(Debug, thiserror::Error)]
+pub enum TablesError {
+    /// A model could not be encoded as a firmware image (invalid tables).
+    #[error("{path}: cannot encode the firmware image: {problem}")]
+    Encode {
+        /// The image that was to be written.
+        path: PathBuf,
+        /// What the encoder refused.
+        problem: BlobError,
+    },
+    /// A model could not be written as JSON.
+    #[error("{path}: cannot write the tables as JSON: {problem}")]
+    Json {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// serde_json's error.
+        problem: serde_json::Error,
+    },
+    /// Reading or writing a file failed.
+    #[error("cannot {action} {path}: {problem}")]
+    Io {
+        /// "read" or "write".
+        action: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        problem: std::io::Error,
+    },
+    /// A stored image is not a valid image of the expected model.
+    #[error("{path}: {problem}")]
+    Decode {
+        /// The image.
+        path: PathBuf,
+        /// What the decoder refused.
+        problem: BlobError,
+    },
+}
+
+/// The models a tables folder holds for each unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StoredModel {
+    /// The paper's tables.
+    Modified,
+    /// The paper's curves with stage 3 keyed by heating history (firmware that keeps what it knew
+    /// of the previous activation: `power_on_after`).
+    ByHistory,
+    /// The paper's standard polynomial.
+    Standard,
+    /// The 3rd-order polynomial.
+    ThirdOrder,
+}
+
+impl StoredModel {
+    /// Every stored model, in the order files are written.
+    pub const ALL: [Self; 4] = [
+        Self::Modified,
+        Self::ByHistory,
+        Self::Standard,
+        Self::ThirdOrder,
+    ];
+
+    /// The files' stem: `modified`, `by_history`, `standard`, `third_order`.
+    pub fn stem(self) -> &'static str {
+        match self {
+            Self::Modified => "modified",
+            Self::ByHistory => "by_history",
+            Self::Standard => "standard",
+            Self::ThirdOrder => "third_order",
+        }
+    }
+
+    /// The firmware image's path for `unit` in the tables folder `folder`.
+    pub fn image_path(self, folder: &Path, unit: &str) -> PathBuf {
+        folder.join(unit).join(format!("{}.bin", self.stem()))
+    }
+}
+
+/// The firmware image of `model`, exactly as long as it needs to be.
+pub fn image_bytes<M: Image>(model: &M) -> Result<Vec<u8>, BlobError> {
+    let mut image = vec![0; blob::encoded_len(model)?];
+    let written = blob::encode(model, &mut image)?;
+    image.truncate(written);
+    Ok(image)
+}
+
+/// drift-core's JSON of `model`, pretty-printed.
+pub fn json_bytes<M: Serialize>(model: &M) -> Result<Vec<u8>, serde_json::Error> {
+    serde_json::to_string_pretty(model).map(String::into_bytes)
+}
+
+/// A model's JSON and image files at `<dir>/<stem>.{json,bin}`, encoded in memory.
+pub fn model_files<M: Image>(
+    dir: &Path,
+    stem: &str,
+    model: &M,
+) -> Result<[(PathBuf, Vec<u8>); 2], TablesError> {
+    let (json, bin) = (
+        dir.join(format!("{stem}.json")),
+        dir.join(format!("{stem}.bin")),
+    );
+    let json_text = json_bytes(model).map_err(|problem| TablesError::Json {
+        path: json.clone(),
+        problem,
+    })?;
+    let image = image_bytes(model).map_err(|problem| TablesError::Encode {
+        path: bin.clone(),
+        problem,
+    })?;
+    Ok([(json, json_text), (bin, image)])
+}
+
+/// Every file of `unit`'s folder under `folder`, encoded in memory.
+pub fn unit_files(
+    folder: &Path,
+    unit: &FittedUnit,
+) -> Result<Vec<(PathBuf, Vec<u8>)>, TablesError> {
+    let dir = folder.join(&unit.unit_id);
+    let mut files = Vec::with_capacity(2 * StoredModel::ALL.len());
+    for model in StoredModel::ALL {
+        let stem = model.stem();
+        let pair = match model {
+            StoredModel::Modified => model_files(&dir, stem, &unit.modified)?,
+            StoredModel::ByHistory => model_files(&dir, stem, &unit.by_history)?,
+            StoredModel::Standard => model_files(&dir, stem, &unit.standard)?,
+            StoredModel::ThirdOrder => model_files(&dir, stem, &unit.third_order)?,
+        };
+        files.extend(pair);
+    }
+    Ok(files)
+}
+
+/// Writes each unit's models as `<folder>/<unit>/{modified,by_history,standard,third_order}.{json,bin}`.
+///
+/// Every file is encoded in memory first, so an encoding error leaves the folder untouched; each
+/// file is then replaced atomically, so none is ever half-written.
+pub fn write(folder: &Path, fitted: &[FittedUnit]) -> Result<(), TablesError> {
+    let mut files = Vec::new();
+    for unit in fitted {
+        files.extend(unit_files(folder, unit)?);
+    }
+    write_files(&files)
+}
+
+/// Writes files encoded in memory, each atomically.
+pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<(), TablesError> {
+    for (path, bytes) in files {
+        write_atomic(path, bytes).map_err(|problem| TablesError::Io {
+            action: "write",
+            path: path.clone(),
+            problem,
+        })?;
+    }
+    Ok(())
+}
+
+/// Reads and decodes the firmware image at `path`.
+pub fn read_image<M: Image>(path: &Path) -> Result<M, TablesError> {
+    let bytes = std::fs::read(path).map_err(|problem| TablesError::Io {
+        action: "read",
+        path: path.to_owned(),
+        problem,
+    })?;
+    blob::decode(&bytes).map_err(|problem| TablesError::Decode {
+        path: path.to_owned(),
+        problem,
+    })
+}

@@ -1,0 +1,24 @@
+//! Everything a report is made from.
+
+use drift_evaluate::evaluate::ActivationResult;
+use drift_evaluate::summary::Split;
+use drift_fit::analyse::Analysed;
+use drift_fit::FittedUnit;
+
+/// Everything a report is made from.
+pub struct ReportInput<'a> {
+    /// Title line.
+    pub title: &'a str,
+    /// How the data and the report were made (commands, seeds), as Markdown lines.
+    pub provenance: Vec<String>,
+    /// Units the tables were fitted for, in column order.
+    pub fitted: &'a [FittedUnit],
+    /// Ids of units whose systematic drift is zero (the noise floor), if any.
+    pub noise_floor_units: &'a [String],
+    /// The calibration activations, analysed (for the figures of the paper's kind).
+    pub calibration: &'a [Analysed],
+    /// Evaluation results with the data split each was measured on.
+    pub results: &'a [(Split, ActivationResult)],
+    /// Measured durations of the pipeline's steps, seconds.
+    pub timings: Vec<(String, f64)>,
+}
