@@ -1,5 +1,5 @@
-//! Fitting a whole campaign, the way `gyrodrift fit` does (issue 7): from the recordings (read +
-//! analyse + fit), the reading alone (the issue-4 floor is fit < 3× read), and the fit alone from
+//! Fitting a whole campaign, the way `gyrodrift fit` does: from the recordings (read +
+//! analyse + fit), the reading alone (the fit should cost less than 3× the reading), and the fit alone from
 //! already-analysed activations — one group, so the ratios come from one run.
 //!
 //! The campaign is simulated in set-up (untimed). Full runs (`cargo bench --bench fit`) use the

@@ -3,7 +3,7 @@
 //! summary.
 //!
 //! ```sh
-//! cargo run --release --example closed_loop -- [--seeds 1] [--first-seed 1] [--sessions 6] \
+//! cargo run --release -p experiments --example closed_loop -- [--seeds 1] [--first-seed 1] [--sessions 6] \
 //!     [--scale 1] [--effects thermal_lag,supply_voltage] [--calibration 30,40] \
 //!     [--unit physical|paper_exact]
 //! ```

@@ -1,5 +1,5 @@
 //! The error temperature-sensor faults leave, beside the fault-free case:
-//! `cargo run --release --example fault_injection` (about a minute; docs/reliability.md).
+//! `cargo run --release -p experiments --example fault_injection` (about a minute; docs/reliability.md).
 //!
 //! One small campaign is simulated fault-free and once per fault kind with the same seed: faults
 //! come from a random stream of their own, so each faulty twin differs from the clean one only at

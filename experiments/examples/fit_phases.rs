@@ -8,7 +8,7 @@
 //! fit from segments as `gyrodrift.fit(segments)` runs it. Usage:
 //!
 //! ```text
-//! cargo run --release --example fit_phases -- <campaign folder> [repeats] [analyse|fit]
+//! cargo run --release -p experiments --example fit_phases -- <campaign folder> [repeats] [analyse|fit]
 //! ```
 //!
 //! For a profile, run it under `perf record` (the release profile keeps line tables); the last

@@ -6,7 +6,7 @@
 //! so their difference is the lookup alone; the drift metric is max − min of what is left.
 //!
 //! ```sh
-//! cargo run --release --example stage3_oracle -- <campaign dir> [calibration set points, default 30,40]
+//! cargo run --release -p experiments --example stage3_oracle -- <campaign dir> [calibration set points, default 30,40]
 //! ```
 //!
 //! Then the calibration curves themselves (axis X, rise and `k` at 5 and 20 s, switch-on

@@ -1,9 +1,9 @@
-//! How far the rate filter's predicted start is from the simulator's truth (docs/closed-loop.md,
-//! *Session 15*). Evaluation only: the fit sees the recordings, never the truth; this example
+//! How far the rate filter's predicted start is from the simulator's truth (its table is in
+//! experiments/README.md). Evaluation only: the fit sees the recordings, never the truth; this example
 //! reads the truth afterwards to measure the prediction.
 //!
 //! ```sh
-//! cargo run --release --example switch_on_truth -- [--seed 1] [--sessions 6] [--scale 5] \
+//! cargo run --release -p experiments --example switch_on_truth -- [--seed 1] [--sessions 6] [--scale 5] \
 //!     [--effect thermal_lag] [--unit physical|paper_exact]
 //! ```
 //!

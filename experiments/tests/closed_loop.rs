@@ -93,7 +93,7 @@ fn a_unit_the_papers_model_represents_exactly_leaves_the_loop_nothing_to_find() 
         assert!(!r.significant && r.admitted.is_empty(), "{r:#?}");
     }
     // The paper's model ends at the noise floor (the zero-drift twin's drift, °/s), which the
-    // physical unit's element lag keeps it above (docs/closed-loop.md, Session 13).
+    // physical unit's element lag keeps it above.
     let mean = |f: &dyn Fn(&Row) -> f64| rows.iter().map(f).sum::<f64>() / rows.len() as f64;
     let (before, floor) = (mean(&|r| r.before.0), mean(&|r| r.floor.0));
     assert!(

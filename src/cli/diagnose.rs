@@ -67,7 +67,7 @@ fn crossings_markdown(
 
 /// Where the calibration curves cross, as Markdown.
 fn crossings_table(fitted: &FittedUnit) -> String {
-    let mut md = String::from("## The tables' history lookup\n\nStage 3 finds an activation's heating history by its rise, which assumes a warmer start rises less. In these calibration curves warmer starts rise more (worst pair per set point and axis); stage 3 then reads the drift/rise ratio of another history on every activation. No term of the candidates below repairs a wrong lookup; the same curves keyed by the residual heat at switch-on (`by_history.bin` of `gyrodrift fit`, for firmware that keeps what it knew of the previous activation) choose them by history instead: their error on the held-out activations follows the table. `examples/stage3_oracle.rs` measures what the lookup costs.\n\n| set point | axis | warmer start | colder start | switched on warmer by | rises more by | at | pairs crossing |\n|---:|---|---|---|---:|---:|---:|---:|\n");
+    let mut md = String::from("## The tables' history lookup\n\nStage 3 finds an activation's heating history by its rise, which assumes a warmer start rises less. In these calibration curves warmer starts rise more (worst pair per set point and axis); stage 3 then reads the drift/rise ratio of another history on every activation. No term of the candidates below repairs a wrong lookup; the same curves keyed by the residual heat at switch-on (`by_history.bin` of `gyrodrift fit`, for firmware that keeps what it knew of the previous activation) choose them by history instead: their error on the held-out activations follows the table. The stage-3 oracle of experiments/ measures what the lookup costs.\n\n| set point | axis | warmer start | colder start | switched on warmer by | rises more by | at | pairs crossing |\n|---:|---|---|---|---:|---:|---:|---:|\n");
     for c in &fitted.crossings {
         let _ = writeln!(
             md,
@@ -171,7 +171,7 @@ fn history_table(held_out: &[BeforeAfter]) -> String {
 fn profile_markdown(profiles: &[Profile]) -> String {
     let bins = profile_bin_labels();
     let mut md = String::from("## Where within the held-out activations the residual sits\n\n");
-    md.push_str("The loop's model's residual (1-s mean) less each activation's own mean, averaged over the activations of a group in bins of time since switch-on, 10⁻⁴ °/s. An offset does not show here; a transient after switch-on, or a ramp, does — and when it happens, which the drift metric (max − min) does not say. After a short off-time, a transient that fades within a minute is a warm start the model does not follow (`docs/closed-loop.md`, *Session 11*).\n\n");
+    md.push_str("The loop's model's residual (1-s mean) less each activation's own mean, averaged over the activations of a group in bins of time since switch-on, 10⁻⁴ °/s. An offset does not show here; a transient after switch-on, or a ramp, does — and when it happens, which the drift metric (max − min) does not say. After a short off-time, a transient that fades within a minute is a warm start the model does not follow (docs/closed-loop.md, *Reading the report*).\n\n");
     let mut set_points: Vec<f64> = profiles.iter().map(|p| p.set_point_celsius).collect();
     set_points.sort_by(f64::total_cmp);
     set_points.dedup();

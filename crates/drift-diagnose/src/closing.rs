@@ -373,7 +373,7 @@ impl Closed<'_> {
 
     /// Where within each held-out activation the loop's residual sits, in
     /// [`PROFILE_EDGES_S`] bins since switch-on: what separates a transient after switch-on
-    /// from an offset or a ramp (`docs/closed-loop.md`, *Session 11*).
+    /// from an offset or a ramp.
     pub fn profiles(&self, fitted: &FittedUnit, settings: &FitSettings) -> Vec<Profile> {
         let plan = self.admitted();
         let model = self.model(fitted);

@@ -19,8 +19,7 @@
 //! only if it also lowers the *whole* held-out residual (offsets and shape, no activation means
 //! taken out) at the same level: a firmware term changes both, and a candidate left over from
 //! what the tables almost wholly absorb (rise², the rises) can match the tables' own lookup error
-//! in shape while a term in it makes the whole error no smaller (measured in
-//! `docs/closed-loop.md`, *Session 8*).
+//! in shape while a term in it makes the whole error no smaller.
 //!
 //! The model whose residual is diagnosed is the loop's: the paper's tables with stage 3 keyed by
 //! rise or by heating history per axis, as [`crate::closing`] chose ([`Keying`]).
@@ -453,7 +452,7 @@ pub fn diagnose_axis(
     let bonferroni = alpha / (2 * ranking.len()).max(1) as f64;
     for c in &mut ranking {
         // The drift's p-value is reported, not tested: in the null case the paper's own gap (the
-        // element lagging the sensor) passes it on many axes (docs/closed-loop.md, session 12),
+        // element lagging the sensor) passes it on many axes,
         // and the element's heating rate is offered to the guard on every axis anyway
         // (`TermPlan::choose`).
         c.significant = c.p_value < bonferroni && c.whole_p_value < bonferroni && c.explained > 0.0;

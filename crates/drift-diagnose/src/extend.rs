@@ -35,8 +35,7 @@ use drift_fit::settings::FitSettings;
 
 /// Time constant of an auxiliary term's low-pass, ms: the diagnosis scores a channel through the
 /// fit's 1-s window, and a recorded channel's sample noise (2 mV on a 5 V supply at 100 Hz) passed
-/// straight into the correction made the drift metric worse (supply voltage on Y at 5×, before
-/// session 4). A first-order low-pass of time constant τ has the noise bandwidth 1/(4τ): at 1 s half
+/// straight into the correction made the drift metric worse (supply voltage on Y at 5×). A first-order low-pass of time constant τ has the noise bandwidth 1/(4τ): at 1 s half
 /// the 1-s window's (1/(2 s)); it lags a step of its input by τ, and the offsets it is for change
 /// at switch-on (supply, orientation), not within a second.
 pub const AUX_TIME_CONSTANT_MS: u32 = 1000;
@@ -130,7 +129,7 @@ impl TermPlan {
     /// tables read. That is a gap of the paper's model on every such unit, not a finding about
     /// this one. It shows as a shape within activations that the drift metric sees and the
     /// squared residual, dominated by offsets, hardly does: the diagnosis's whole-residual test
-    /// misses it even for the element's true rate (docs/closed-loop.md, session 12), so the
+    /// misses it even for the element's true rate, so the
     /// guard's drift test decides per axis. Its filter is the rate candidate's whose drift test is
     /// strongest (then the best-explaining one's).
     ///
@@ -588,7 +587,7 @@ fn errors(
 /// shape term whose left-over values also differ in mean from one activation to the next took its
 /// coefficient from those offsets, which the warm starts' initial bias already answers. Fitted on
 /// the shape alone the element's rate cut the held-out drift excess ≥ 2× on 6 of 9 axes instead
-/// of 4 (thermal lag at 5×, seeds 2–4, docs/closed-loop.md, session 14).
+/// of 4 (thermal lag at 5×, seeds 2–4).
 fn coefficients(
     plan: &TermPlan,
     series: &[&TrainingSeries],

@@ -10,7 +10,7 @@
 //! tens of seconds, and the curves of the 2- and 5-min series rise above the independent curve.
 //!
 //! The check runs on the averaged calibration curves, so the fit can say so before anyone trusts
-//! the tables; what it costs in drift is measured by `examples/stage3_oracle.rs`.
+//! the tables; what it costs in drift is measured by the stage-3 oracle (`experiments/examples/stage3_oracle.rs`).
 
 use crate::curves::{CurveKey, SetPointCurves};
 
