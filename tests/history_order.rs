@@ -109,7 +109,7 @@ fn keyed_by_history_the_crossing_curves_are_read_right() {
         rise_nonlinearity: Some(RiseNonlinearity { per_c: 0.1 }),
         ..HiddenEffects::default()
     };
-    // The crossing costs the paper's lookup 2–4× the drift (docs/closed-loop.md); keyed by history
+    // The crossing costs the paper's lookup 2–4× the drift (experiments/README.md, *stage3_oracle*); keyed by history
     // the curves give the drift of a unit without the effect.
     for (axis, (by_rise, by_history)) in validation_drift(effects).into_iter().enumerate() {
         assert!(

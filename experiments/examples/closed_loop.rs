@@ -1,4 +1,4 @@
-//! The closed-loop experiment of `docs/closed-loop.md` ([`experiments::closed_loop`]): one table row
+//! The closed-loop experiment (tables in experiments/README.md) ([`experiments::closed_loop`]): one table row
 //! per effect, seed and axis, printed as each run ends, then the null case's and each effect's
 //! summary.
 //!

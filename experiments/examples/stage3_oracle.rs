@@ -14,7 +14,7 @@
 //!
 //! When the two columns agree, the rise identifies the history as the paper assumes; when the
 //! paper's column is larger, the curves cross (`drift_fit::history_order`) and the difference is
-//! what an input that names the history (the off-time) would recover. Numbers in docs/closed-loop.md.
+//! what an input that names the history (the off-time) would recover. Numbers in experiments/README.md.
 
 use std::collections::BTreeMap;
 use std::path::Path;

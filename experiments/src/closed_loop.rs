@@ -304,7 +304,7 @@ pub struct Plan {
 }
 
 impl Default for Plan {
-    /// The experiment of `docs/closed-loop.md`: 6 sessions, the simulator's magnitudes, +30/+40 °C.
+    /// The experiment of this crate's README: 6 sessions, the simulator's magnitudes, +30/+40 °C.
     fn default() -> Self {
         Self {
             sessions: 6,

@@ -7,7 +7,7 @@
 //! them; a hidden thermal lag is closed by the warm starts' initial bias, and its rate, started
 //! where the unit is at switch-on, is what the paper's model lacks most; and a unit the paper's
 //! model represents exactly leaves the loop nothing to find or add.
-//! (`docs/closed-loop.md` has the full table over every effect and many seeds.)
+//! (experiments/README.md has the full table over every effect and many seeds.)
 
 use drift_fit::FitSettings;
 use drift_sim::UnitModel;

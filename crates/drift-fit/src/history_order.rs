@@ -5,7 +5,7 @@
 //! stage 3 reads `k` from the wrong one on every activation, including those that repeat the
 //! calibration exactly.
 //!
-//! What breaks it, measured (docs/closed-loop.md, *Rise nonlinearity*): heating power that grows
+//! What breaks it, measured (experiments/README.md, *Rise nonlinearity and a third calibration ambient*): heating power that grows
 //! with the unit's own temperature. A warm start then heats faster than a cold one for the first
 //! tens of seconds, and the curves of the 2- and 5-min series rise above the independent curve.
 //!
