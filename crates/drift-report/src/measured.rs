@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use drift_evaluate::measured::{Characterisation, Estimate, Obstacle};
 
 use super::plots;
-use crate::output::write_atomic;
+use crate::write_atomic;
 
 fn pm(e: Option<Estimate>, scale: f64, digits: usize) -> String {
     e.map_or("–".into(), |e| {

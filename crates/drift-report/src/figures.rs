@@ -11,7 +11,7 @@ use drift_recording::SeriesKind;
 
 use super::input::ReportInput;
 use super::plots::{draw, Chart, Series};
-use crate::output::write_atomic;
+use crate::write_atomic;
 
 const AXIS: usize = 0;
 
