@@ -2,14 +2,13 @@
 
 use std::path::{Path, PathBuf};
 
-
 use super::campaign_args::CampaignArgs;
 use super::measured;
 use super::progress::Steps;
-use drift_report::measured::write_measured_report;
 use drift_evaluate::pipeline::PipelineError;
 use drift_evaluate::pipeline::{self, Options, Outcome};
 use drift_recording::paper;
+use drift_report::measured::write_measured_report;
 
 /// Options of `gyrodrift report`.
 #[derive(Debug, clap::Args)]

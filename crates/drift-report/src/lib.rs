@@ -23,11 +23,13 @@ pub use input::ReportInput;
 /// Writes `bytes` to `path` whole or not at all ([`drift_recording::write_atomic`]); the error
 /// names the file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    drift_recording::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
+    drift_recording::write_atomic(path, bytes)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// The report's title line.
-pub const TITLE: &str = "gyrodrift report: temperature-drift correction on data the fit did not see";
+pub const TITLE: &str =
+    "gyrodrift report: temperature-drift correction on data the fit did not see";
 
 /// Fits on `files`, evaluates on everything the fits did not see (and the noise-floor twin's
 /// `noise_floor` files, if given), writes the tables folder `<out>/tables/` and the report into
