@@ -42,7 +42,7 @@ pub use extension::{
 };
 pub use flags::Flags;
 pub use history::{Previous, SwitchOn};
-pub use model::{AxisModel, Model, TemperatureBlock, BLOCK_SAMPLES};
+pub use model::{AxisModel, Model};
 pub use polynomial::{
     PolynomialAxis, PolynomialAxisState, PolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
 };
