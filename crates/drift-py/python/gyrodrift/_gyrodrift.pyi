@@ -236,8 +236,7 @@ class ModifiedTables:
         from: `[heating °C/s, cooling_per_second, cooling_per_second_per_remaining]`, float32
         `(3, 3)`. The rate is `heating − residual_heat · (cooling_per_second +
         cooling_per_second_per_remaining · remaining)` for the history `Corrector.power_on_after`
-        was given (`power_on`: a cold start, the heating alone). Zeros: the filter starts at rest,
-        as every model before image format 6 did."""
+        was given (`power_on`: a cold start, the heating alone). Zeros: the filter starts at rest."""
     def with_extension(
         self, terms: Sequence[ExtraTerm], switch_on_rate: _FloatRows | None = None
     ) -> ModifiedTables:
