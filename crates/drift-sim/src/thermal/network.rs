@@ -97,7 +97,9 @@ impl ThermalParams {
         }
         for &(a, b, g) in extra_links {
             if a >= NODES || b >= NODES || a == b {
-                return Err(format!("extra link {a} ↔ {b}: nodes must differ and be < {NODES}"));
+                return Err(format!(
+                    "extra link {a} ↔ {b}: nodes must differ and be < {NODES}"
+                ));
             }
             link(a, b, g);
         }
