@@ -20,8 +20,8 @@ use std::sync::Mutex;
 use anyhow::Context;
 use drift_sim::world::effects::EffectFamily;
 use experiments::worlds::{
-    close_blind, fit_settings, record, score, table, world_lines, Failure, Kind, Outcome,
-    Recorded, WorldPaths, WorldScore, DEFAULT_FIRST_SEED,
+    close_blind, fit_settings, record, score, table, world_lines, Failure, Kind, Outcome, Recorded,
+    WorldPaths, WorldScore, DEFAULT_FIRST_SEED,
 };
 
 const USAGE: &str = "worlds [--families all|accelerometer,humidity,…] [--worlds-per-family 20] \
@@ -39,7 +39,8 @@ where
     T::Err: std::error::Error + Send + Sync + 'static,
 {
     value(args, flag).map_or(Ok(default), |s| {
-        s.parse().with_context(|| format!("{flag}: cannot read `{s}`"))
+        s.parse()
+            .with_context(|| format!("{flag}: cannot read `{s}`"))
     })
 }
 
@@ -103,7 +104,11 @@ fn child_part(args: &[String]) -> anyhow::Result<()> {
     } else {
         // Sees the two recordings folders and nothing else.
         let settings = fit_settings(small(3));
-        serde_json::to_string(&close_blind(Path::new(arg(1)?), Path::new(arg(2)?), &settings)?)?
+        serde_json::to_string(&close_blind(
+            Path::new(arg(1)?),
+            Path::new(arg(2)?),
+            &settings,
+        )?)?
     };
     println!("{line}");
     Ok(())
@@ -160,7 +165,13 @@ fn main() -> anyhow::Result<()> {
         kinds.push(Kind::Null);
     }
     // World k of every kind before world k + 1 of any: a run cut short has every row.
-    let count = |kind: Kind| if kind == Kind::Null { nulls } else { per_family };
+    let count = |kind: Kind| {
+        if kind == Kind::Null {
+            nulls
+        } else {
+            per_family
+        }
+    };
     let max = per_family.max(nulls);
     let queue: Vec<(Kind, u64)> = (0..max)
         .flat_map(|k| {
@@ -179,7 +190,9 @@ fn main() -> anyhow::Result<()> {
         queue.len(),
         if small { "small" } else { "full" }
     );
-    let work = tempfile::Builder::new().prefix("gyrodrift-worlds-").tempdir()?;
+    let work = tempfile::Builder::new()
+        .prefix("gyrodrift-worlds-")
+        .tempdir()?;
     let queue = Mutex::new(queue.into_iter());
     let results: Mutex<(Vec<WorldScore>, Vec<Failure>)> = Mutex::new((Vec::new(), Vec::new()));
     let started = std::time::Instant::now();
