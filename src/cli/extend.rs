@@ -2,7 +2,6 @@
 //! ([`drift_diagnose::closing`]): the guard's decisions, the admitted terms, the error before and after
 //! on the held-out activations, and the firmware image.
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
