@@ -157,14 +157,18 @@ pub fn write(folder: &Path, fitted: &[FittedUnit]) -> Result<(), TablesError> {
     write_files(&files)
 }
 
-/// Writes files encoded in memory, each atomically.
+/// Writes files encoded in memory, each atomically, creating their folders.
 pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<(), TablesError> {
     for (path, bytes) in files {
-        write_atomic(path, bytes).map_err(|problem| TablesError::Io {
-            action: "write",
-            path: path.clone(),
-            problem,
-        })?;
+        path.parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map_or(Ok(()), std::fs::create_dir_all)
+            .and_then(|()| write_atomic(path, bytes))
+            .map_err(|problem| TablesError::Io {
+                action: "write",
+                path: path.clone(),
+                problem,
+            })?;
     }
     Ok(())
 }
