@@ -6,9 +6,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use drift_core::blob;
+use drift_diagnose::before_after::group_errors;
 use drift_diagnose::closing::{BeforeAfter, Closed};
 use drift_diagnose::switch_on_rate::SwitchOnRateFit;
-use drift_diagnose::before_after::group_errors;
 use drift_evaluate::noise_floor::Floor;
 use drift_evaluate::tables_folder;
 use drift_fit::FittedUnit;
@@ -199,7 +199,8 @@ fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String 
             row.drift_before_dps,
             row.drift_after_dps,
             shown(row.floor_drift_dps),
-            row.excess_cut.map_or_else(|| "–".to_owned(), |c| c.to_string()),
+            row.excess_cut
+                .map_or_else(|| "–".to_owned(), |c| c.to_string()),
         );
     }
     let worse: Vec<String> = rows

@@ -61,11 +61,18 @@ pub fn group_errors(results: &[BeforeAfter], floor: Option<&Floor>) -> Vec<Group
         let n = members.len() as f64;
         let at = floor.and_then(|f| f.get(&group));
         for (a, axis) in AXES.into_iter().enumerate() {
-            let mean = |f: &dyn Fn(&BeforeAfter) -> f64| members.iter().map(|r| f(r)).sum::<f64>() / n;
+            let mean =
+                |f: &dyn Fn(&BeforeAfter) -> f64| members.iter().map(|r| f(r)).sum::<f64>() / n;
             let drift = |after: bool| -> Vec<f64> {
                 members
                     .iter()
-                    .map(|r| if after { r.drift_dps[a].1 } else { r.drift_dps[a].0 })
+                    .map(|r| {
+                        if after {
+                            r.drift_dps[a].1
+                        } else {
+                            r.drift_dps[a].0
+                        }
+                    })
                     .collect()
             };
             let cut = at.map(|f| excess_cut(&drift(false), &drift(true), &f.drift[a]));

@@ -13,6 +13,7 @@
 //!
 //! See `docs/simulator.md`, *Worlds*.
 
+mod channels;
 pub mod effects;
 pub(crate) mod runtime;
 pub mod structure;
@@ -33,14 +34,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use structure::Structure;
 
-/// The named channel of the chamber air's relative humidity (%RH).
-pub const HUMIDITY: &str = "humidity";
-/// Its reference (%RH): effects read the deviation from it.
-pub const HUMIDITY_REFERENCE: f64 = 40.0;
-/// The named channel of the barometric pressure (hPa).
-pub const AIR_PRESSURE: &str = "air_pressure";
-/// Its reference (hPa).
-pub const AIR_PRESSURE_REFERENCE: f64 = 1013.25;
+pub use channels::{AIR_PRESSURE, AIR_PRESSURE_REFERENCE, HUMIDITY, HUMIDITY_REFERENCE};
 /// The truth file's name in `<out>/truth/` when the caller gives no path.
 pub const TRUTH_FILE: &str = "world.json";
 

@@ -185,7 +185,7 @@ impl Source {
     pub fn held(&self) -> bool {
         match self {
             Self::Accelerometer { .. } | Self::SupplyVoltage => true,
-            Self::Aux { name, .. } => name == super::AIR_PRESSURE,
+            Self::Aux { name, .. } => name == super::channels::AIR_PRESSURE,
             _ => false,
         }
     }
@@ -235,7 +235,7 @@ fn source_scale(source: &Source) -> (f64, f64, &'static str) {
     match source {
         Source::Accelerometer { .. } => (1.0, 0.0, "g"),
         Source::SupplyVoltage => (0.3, 0.0, "V"),
-        Source::Aux { name, .. } if name == super::AIR_PRESSURE => (5.0, 0.1, "hPa"),
+        Source::Aux { name, .. } if name == super::channels::AIR_PRESSURE => (5.0, 0.1, "hPa"),
         Source::Aux { .. } => (10.0, 3.0, "%RH"),
         Source::ElementTemperature { .. } => (ELEMENT_LEVEL_C, ELEMENT_RISE_C, "°C"),
         Source::SensorTemperature { .. } => (SENSOR_LEVEL_C, SENSOR_RISE_C, "°C"),
@@ -310,12 +310,12 @@ fn source_for(family: EffectFamily, a: usize, form: EffectForm, r: &mut ChaCha8R
         },
         EffectFamily::SupplyVoltage => Source::SupplyVoltage,
         EffectFamily::Humidity => Source::Aux {
-            name: super::HUMIDITY.into(),
-            reference: super::HUMIDITY_REFERENCE,
+            name: super::channels::HUMIDITY.into(),
+            reference: super::channels::HUMIDITY_REFERENCE,
         },
         EffectFamily::AirPressure => Source::Aux {
-            name: super::AIR_PRESSURE.into(),
-            reference: super::AIR_PRESSURE_REFERENCE,
+            name: super::channels::AIR_PRESSURE.into(),
+            reference: super::channels::AIR_PRESSURE_REFERENCE,
         },
         EffectFamily::ElementTemperature => Source::ElementTemperature {
             axis: own_or_other(r),

@@ -76,12 +76,12 @@ fn uniform(r: &mut ChaCha8Rng, lo: f64, hi: f64) -> f64 {
 pub(crate) fn aux_channels() -> Vec<AuxChannelSpec> {
     vec![
         AuxChannelSpec {
-            name: super::HUMIDITY.into(),
+            name: super::channels::HUMIDITY.into(),
             unit: "%RH".into(),
             noise: 0.3,
         },
         AuxChannelSpec {
-            name: super::AIR_PRESSURE.into(),
+            name: super::channels::AIR_PRESSURE.into(),
             unit: "hPa".into(),
             noise: 0.05,
         },
