@@ -20,9 +20,12 @@ use drift_fit::FittedUnit;
 
 pub use input::ReportInput;
 
-/// Writes `bytes` to `path` whole or not at all ([`drift_recording::write_atomic`]); the error
-/// names the file.
+/// Writes `bytes` to `path` whole or not at all ([`drift_recording::write_atomic`]), creating its
+/// folder if missing; the error names the file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
     drift_recording::write_atomic(path, bytes)
         .with_context(|| format!("writing {}", path.display()))
 }
