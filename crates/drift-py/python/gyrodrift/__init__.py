@@ -50,9 +50,9 @@ from ._gyrodrift import (
     excess_cut,
     fit,
     load_campaign,
+    report,
     resolve_campaign,
     simulate,
-    report,
     summarise,
 )
 from .tables import paper_table
@@ -92,9 +92,9 @@ __all__ = [
     "fit",
     "load_campaign",
     "paper_table",
+    "report",
     "resolve_campaign",
     "simulate",
-    "report",
     "summarise",
 ]
 
