@@ -63,6 +63,7 @@ __all__ = [
     "excess_cut",
     "fit",
     "load_campaign",
+    "report",
     "resolve_campaign",
     "simulate",
     "summarise",
