@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use drift_core::blob::{self, BlobError, Image};
 use drift_fit::FittedUnit;
-use drift_recording::write_atomic;
+use drift_recording::write_atomic_creating_folder;
 use serde::Serialize;
 
 /// Why a tables folder could not be written or read, naming the file. The message carries the
@@ -100,7 +100,7 @@ pub fn image_bytes<M: Image>(model: &M) -> Result<Vec<u8>, BlobError> {
 }
 
 /// drift-core's JSON of `model`, pretty-printed.
-pub fn json_bytes<M: Serialize>(model: &M) -> Result<Vec<u8>, serde_json::Error> {
+fn json_bytes<M: Serialize>(model: &M) -> Result<Vec<u8>, serde_json::Error> {
     serde_json::to_string_pretty(model).map(String::into_bytes)
 }
 
@@ -160,15 +160,11 @@ pub fn write(folder: &Path, fitted: &[FittedUnit]) -> Result<(), TablesError> {
 /// Writes files encoded in memory, each atomically, creating their folders.
 pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<(), TablesError> {
     for (path, bytes) in files {
-        path.parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .map_or(Ok(()), std::fs::create_dir_all)
-            .and_then(|()| write_atomic(path, bytes))
-            .map_err(|problem| TablesError::Io {
-                action: "write",
-                path: path.clone(),
-                problem,
-            })?;
+        write_atomic_creating_folder(path, bytes).map_err(|problem| TablesError::Io {
+            action: "write",
+            path: path.clone(),
+            problem,
+        })?;
     }
     Ok(())
 }

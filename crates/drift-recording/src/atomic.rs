@@ -27,6 +27,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// [`write_atomic`] into a folder that may not exist yet: the folder is created first. For result
+/// folders a command makes (tables, reports); a file a caller names keeps the plain rule.
+pub fn write_atomic_creating_folder(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        fs::create_dir_all(dir)?;
+    }
+    write_atomic(path, bytes)
+}
+
 /// A name beside `path` that no other writer in this or another process uses at the same time.
 fn temporary_beside(path: &Path) -> PathBuf {
     static NEXT: AtomicU64 = AtomicU64::new(0);
@@ -47,7 +56,11 @@ mod tests {
     fn writes_whole_files_and_leaves_no_temporary() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("result.json");
-        assert!(write_atomic(&dir.path().join("missing").join("x"), b"no").is_err());
+        let nested = dir.path().join("missing").join("x");
+        assert!(write_atomic(&nested, b"no").is_err());
+        write_atomic_creating_folder(&nested, b"yes").unwrap();
+        assert_eq!(fs::read(&nested).unwrap(), b"yes");
+        fs::remove_dir_all(dir.path().join("missing")).unwrap();
         write_atomic(&path, b"first").unwrap();
         write_atomic(&path, b"second").unwrap();
         assert_eq!(fs::read(&path).unwrap(), b"second");

@@ -25,7 +25,7 @@ mod writable;
 mod write;
 pub mod writer;
 
-pub use atomic::write_atomic;
+pub use atomic::{write_atomic, write_atomic_creating_folder};
 pub use aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic, FIXED_AUX_CHANNELS};
 pub use csv_aux::CsvAuxColumn;
 pub use csv_file::{

@@ -23,10 +23,7 @@ pub use input::ReportInput;
 /// Writes `bytes` to `path` whole or not at all ([`drift_recording::write_atomic`]), creating its
 /// folder if missing; the error names the file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    drift_recording::write_atomic(path, bytes)
+    drift_recording::write_atomic_creating_folder(path, bytes)
         .with_context(|| format!("writing {}", path.display()))
 }
 
