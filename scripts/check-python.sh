@@ -2,8 +2,10 @@
 # The Python module's checks, from a really clean state: a fresh venv in .venv-check/ (deleted and
 # recreated on every run), `pip install ./crates/drift-py[test,plot]` (a real PEP 517 build through
 # maturin, with matplotlib, pandas and mcap so the optional paths run), then pytest (with the CLI
-# binary, to compare simulated bytes), mypy's stubtest, a strict type check of the package's Python
-# code and the examples, ruff, and the examples themselves. Prints how long each step took. Safe to re-run; meant to be called from
+# binary, to compare simulated bytes), the benchmark scripts at their tiny size (a check that they
+# still run and that what they compare agrees; timings printed, never asserted), mypy's stubtest, a
+# strict type check of the package's Python code, the examples and the benchmarks, ruff, and the
+# examples themselves. Prints how long each step took. Safe to re-run; meant to be called from
 # scripts/check.sh (the single test command).
 #
 # Needs: python3 >= 3.9 (with venv; installed via apt-get if missing), Rust (cargo), and PyPI.
@@ -60,6 +62,17 @@ run_pytest() {
     GYRODRIFT_BIN=target/release/gyrodrift "$VENV/bin/python" -m pytest crates/drift-py/tests -q -p no:cacheprovider --durations=5
 }
 
+run_benches() {
+    # Every bench script at its tiny size (`--tiny`, which each must accept): outputs checked
+    # against gyrodrift's, timings only printed. The pure-Rust reference example is built first,
+    # outside the scripts' output.
+    cargo build --quiet --release --locked --example correct_throughput
+    for script in crates/drift-py/bench/bench_*.py; do
+        echo "--- $script --tiny"
+        "$VENV/bin/python" "$script" --tiny
+    done
+}
+
 run_stubtest() {
     "$VENV/bin/python" -m mypy.stubtest gyrodrift._gyrodrift \
         --allowlist crates/drift-py/stubtest-allowlist.txt
@@ -77,7 +90,7 @@ run_ruff() {
 }
 
 run_recording_read_test() {
-    # The Python `mcap` package must read what `gyrodrift simulate` writes (issue 3).
+    # The Python `mcap` package must read what `gyrodrift simulate` writes.
     "$VENV/bin/python" -m pip install --quiet mcap-ros2-support
     GYRODRIFT_BIN=target/release/gyrodrift "$VENV/bin/python" -m pytest crates/drift-sim/tests/python -q -p no:cacheprovider
 }
@@ -95,6 +108,7 @@ step "fresh venv in $VENV" make_venv
 step "pip install ./crates/drift-py[test,plot] (maturin build)" install_package
 step "cargo build --release -p gyrodrift (the CLI)" build_cli
 step "pytest crates/drift-py/tests" run_pytest
+step "bench scripts at tiny size" run_benches
 step "stubtest gyrodrift._gyrodrift" run_stubtest
 step "mypy --strict examples, bench and the package" run_mypy_examples
 step "ruff check and format --check" run_ruff

@@ -24,6 +24,9 @@ step "format"
 cargo fmt --all --check
 (cd embedded && cargo fmt --check)
 
+step "structure: no two modules of a crate import each other"
+python3 scripts/module-cycles.py
+
 step "clippy: host workspace, all targets and features"
 cargo clippy --workspace --all-targets --all-features --locked -- -D warnings
 

@@ -175,14 +175,14 @@ fn fit_names_a_missing_campaign_folder() {
 fn atomic_write_leaves_the_old_file_when_it_fails() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("table.bin");
-    gyrodrift::output::write_atomic(&path, b"first").unwrap();
-    gyrodrift::output::write_atomic(&path, b"second").unwrap();
+    drift_report::write_atomic(&path, b"first").unwrap();
+    drift_report::write_atomic(&path, b"second").unwrap();
     assert_eq!(std::fs::read(&path).unwrap(), b"second");
     // A target that is a directory cannot be replaced: the error names it, nothing else is left.
     let target = dir.path().join("occupied");
     std::fs::create_dir(&target).unwrap();
     std::fs::write(target.join("keep"), b"x").unwrap();
-    let error = gyrodrift::output::write_atomic(&target, b"data").unwrap_err();
+    let error = drift_report::write_atomic(&target, b"data").unwrap_err();
     assert!(format!("{error:#}").contains("occupied"), "{error:#}");
     let left: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()

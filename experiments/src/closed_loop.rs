@@ -22,7 +22,7 @@ use drift_fit::{fit_unit, FitSettings};
 use drift_recording::{paper, read_recording, Segment, SeriesKind};
 use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, UnitModel};
 
-use gyrodrift::report::tables::ten_thousandths;
+use drift_report::tables::ten_thousandths;
 
 /// The paper's calibration set points (°C).
 pub const DEFAULT_CALIBRATION: [f64; 2] = paper::CALIBRATION_SET_POINTS_CELSIUS;

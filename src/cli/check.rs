@@ -17,7 +17,7 @@ use drift_recording::read_recording;
 
 use super::campaign_args::load_settings;
 use super::progress::Steps;
-use crate::output::write_atomic;
+use drift_report::write_atomic;
 
 /// Which of a unit's stored models to check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -15,9 +15,9 @@ use drift_recording::{read_recording, Segment};
 
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
-use crate::output::write_atomic;
-use crate::report::plots;
-use crate::report::tables::ten_thousandths;
+use drift_report::plots;
+use drift_report::tables::ten_thousandths;
+use drift_report::write_atomic;
 
 /// Options of `gyrodrift diagnose`.
 #[derive(Debug, clap::Args)]

@@ -14,7 +14,7 @@ use drift_recording::{
     SeriesKind, TimeUnit, RECORDINGS_DIR,
 };
 
-use crate::output::write_atomic;
+use drift_report::write_atomic;
 
 /// Options of `gyrodrift import`.
 #[derive(Debug, clap::Args)]

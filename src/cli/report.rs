@@ -2,17 +2,13 @@
 
 use std::path::{Path, PathBuf};
 
-use drift_evaluate::summary::Split;
-
 use super::campaign_args::CampaignArgs;
 use super::measured;
 use super::progress::Steps;
-use crate::report::measured::write_measured_report;
-use crate::report::{write_report, ReportInput};
 use drift_evaluate::pipeline::PipelineError;
 use drift_evaluate::pipeline::{self, Options, Outcome};
-use drift_evaluate::tables_folder;
 use drift_recording::paper;
+use drift_report::measured::write_measured_report;
 
 /// Options of `gyrodrift report`.
 #[derive(Debug, clap::Args)]
@@ -36,7 +32,8 @@ pub struct Args {
     pub out: PathBuf,
 }
 
-/// Fits, evaluates and writes the report; returns the report's path and the main outcome.
+/// Fits, evaluates and writes the report ([`drift_report::make`]) with progress bars; returns the
+/// report's path and the main outcome.
 pub fn make(
     campaign: &Path,
     noise_floor: Option<&Path>,
@@ -46,57 +43,30 @@ pub fn make(
     quiet: bool,
 ) -> anyhow::Result<(PathBuf, Outcome)> {
     let steps = Steps::new(quiet);
-    let progress = |s: &str, d, t| steps.update(s, d, t);
     let files = pipeline::recording_files(campaign)?;
     let noise_files = noise_floor.map(pipeline::recording_files).transpose()?;
-    let (outcome, noise_units) =
-        pipeline::run_with_noise_floor(&files, noise_files.as_deref(), options, &progress)?;
-    steps.finish();
-    tables_folder::write(&out.join("tables"), &outcome.fitted)?;
-    let input = ReportInput {
-        title: "gyrodrift report: temperature-drift correction on data the fit did not see",
+    let made = drift_report::make(
+        &files,
+        noise_files.as_deref(),
+        options,
+        out,
         provenance,
-        fitted: &outcome.fitted,
-        noise_floor_units: &noise_units,
-        calibration: &outcome.calibration,
-        results: &outcome.results,
-        timings: outcome.timings.clone(),
-    };
-    let path = write_report(out, &input)?;
-    Ok((path, outcome))
+        &|s, d, t| steps.update(s, d, t),
+    );
+    steps.finish();
+    made
 }
 
 /// Prints the headline table of a finished report.
 pub fn print_headline(outcome: &Outcome) {
-    let records = drift_evaluate::summary::summarise(&outcome.results);
-    print!(
-        "{}",
-        crate::report::headline_text(&records, &outcome.fitted, &noise_ids(outcome))
-    );
-}
-
-fn noise_ids(outcome: &Outcome) -> Vec<String> {
-    let mut ids: Vec<String> = outcome
-        .results
-        .iter()
-        .filter(|(s, _)| *s == Split::NoiseFloor)
-        .map(|(_, r)| r.labels.unit_id.clone())
-        .collect();
-    ids.sort();
-    ids.dedup();
-    ids
+    print!("{}", drift_report::headline_of(outcome));
 }
 
 /// Runs `gyrodrift report`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
     let options = input.options(&args.validation, true)?;
-    let provenance = vec![format!(
-        "Recordings: `{}`; calibration {:?} °C, validation {:?} °C.",
-        input.campaign.display(),
-        input.calibration,
-        args.validation
-    )];
+    let provenance = drift_report::provenance(&input.campaign.display().to_string(), &options);
     let made = make(
         &input.campaign,
         args.noise_floor.as_deref(),

@@ -1,7 +1,5 @@
 //! The run-time corrector: immutable model (tables) + small per-unit state, one call per sample.
 
-mod block;
-
 use crate::error::{Error, Location, Problem};
 use crate::extension::{ExtensionState, AUX_INPUTS};
 use crate::flags::Flags;
@@ -223,7 +221,7 @@ impl<S: Copy + Default> CorrectorState<S> {
             *flags = activation;
         }
         // Without a history every start is taken as cold: the rate filters start at the heating
-        // alone (at rest for images before format 6).
+        // alone.
         self.extension = ExtensionState::power_on_after(model.extension(), &switch_ons);
         Ok(flags)
     }
@@ -244,6 +242,25 @@ impl<S: Copy + Default> CorrectorState<S> {
         M::Axis: AxisModel<State = S>,
     {
         self.correct_with_aux(model, sample, &[f32::NAN; AUX_INPUTS])
+    }
+
+    /// Corrects `samples` in order into `outputs` without auxiliary inputs and returns how many
+    /// (the shorter of the two lengths): [`Self::correct`] sample by sample, so the same outputs
+    /// and the same final state, bit for bit.
+    pub fn correct_block<M>(
+        &mut self,
+        model: &M,
+        samples: &[Sample],
+        outputs: &mut [Output],
+    ) -> usize
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
+            *output = self.correct(model, sample);
+        }
+        samples.len().min(outputs.len())
     }
 
     /// Corrects one sample, with the auxiliary inputs the extended model's extra terms may read
@@ -443,8 +460,7 @@ struct Reading {
 }
 
 /// The checks every model shares, before the model: activation, rate and temperature faults, the
-/// stuck counter. The per-sample and the block path both go through `read_axis`, `hold_drift` and
-/// `axis_output`, so they give the same bits by construction.
+/// stuck counter.
 #[inline(always)]
 fn read_axis<S>(
     settings: &Settings,
@@ -593,10 +609,10 @@ mod tests {
     use super::CorrectorState;
     use crate::ModifiedAxisState;
 
-    /// Issue 2's floor for a unit's run-time state, extension included (docs/embedded.md). The
+    /// The floor for a unit's run-time state, 256 bytes, extension included (docs/embedded.md). The
     /// layout has no pointers, so the host's size is the Cortex-M4's (which the firmware prints).
     #[test]
-    fn state_fits_issue_2s_floor() {
+    fn state_fits_its_floor() {
         assert!(core::mem::size_of::<CorrectorState<ModifiedAxisState>>() <= 256);
     }
 }

@@ -1,5 +1,5 @@
 //! The extended model: a few extra linear terms on top of the paper's tables, for the effects the
-//! tables cannot know when the unit is used differently from its calibration (issue 6's closed
+//! tables cannot know when the unit is used differently from its calibration (the closed
 //! loop: the diagnosis names the effect, the fitter adds its term).
 //!
 //! Each term is a quantity the microcontroller computes per sample without heap — the axis's own
@@ -47,7 +47,7 @@ pub enum Term {
         /// Index into the auxiliary inputs.
         input: u8,
         /// The low-pass's time constant, milliseconds; 0 passes the input through unfiltered
-        /// (what images of format version 2 meant, and JSON tables without the field).
+        /// (also what JSON tables without the field mean).
         #[cfg_attr(feature = "serde", serde(default))]
         time_constant_ms: u32,
     },
@@ -81,7 +81,7 @@ pub struct ExtraTerm {
 /// and, after a short off-time, the unit is still cooling by an amount that depends on the
 /// off-time. The first seconds of the estimate are then wrong, partly by a history-dependent
 /// amount, and the drift curves, which start from the first seconds' bias, carry that error as an
-/// offset the tables spread into a ramp (docs/closed-loop.md, sessions 13 and 14). The rate at
+/// offset the tables spread into a ramp (docs/closed-loop.md). The rate at
 /// switch-on is
 /// `heating − residual_heat · (cooling_per_second + cooling_per_second_per_remaining · remaining)`
 /// ([`SwitchOn`]): a unit cools faster per °C while the fast part of its heat is still there
@@ -101,8 +101,7 @@ pub struct SwitchOnRate {
 }
 
 impl SwitchOnRate {
-    /// Start the rate filter at rest, whatever the history (what images before format version 6
-    /// did).
+    /// Start the rate filter at rest, whatever the history.
     pub const AT_REST: Self = Self {
         heating_celsius_per_s: 0.0,
         cooling_per_second: 0.0,

@@ -26,6 +26,7 @@ mod flags;
 mod history;
 mod interp;
 mod model;
+mod modified;
 mod polynomial;
 mod settings;
 mod stage;
@@ -42,14 +43,15 @@ pub use extension::{
 };
 pub use flags::Flags;
 pub use history::{Previous, SwitchOn};
-pub use model::{AxisModel, Model, TemperatureBlock, BLOCK_SAMPLES};
+pub use model::{AxisModel, Model};
+pub use modified::ModifiedAxisState;
 pub use polynomial::{
     PolynomialAxis, PolynomialAxisState, PolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
 };
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};
-pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedAxisState, ModifiedTables};
+pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables};
 pub use warm_start::WarmStart;
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.

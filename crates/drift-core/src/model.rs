@@ -48,43 +48,7 @@ pub trait AxisModel {
         temperature_celsius: f32,
         rise_celsius: f32,
     ) -> (f32, Flags);
-
-    /// The block path's form of [`Self::drift`], for a model whose drift depends on the temperature
-    /// alone (not on time, rise or a state that changes per sample): hands `block` a function of
-    /// the temperature (°C) that returns what `drift` returns for it, and returns what `block` made
-    /// of it. The corrector then runs that function inside its own loops over
-    /// [`BLOCK_SAMPLES`] readings, fused with its checks and outputs, which the compiler vectorises
-    /// (the polynomial baselines). The default returns `None`: the corrector goes sample by sample.
-    ///
-    /// The function must give the same bits as `drift` for every temperature, and a model that
-    /// answers once must answer every block of the activation.
-    fn drift_of_temperatures<B: TemperatureBlock>(
-        &self,
-        _settings: &Settings,
-        _state: &Self::State,
-        _block: B,
-    ) -> Option<B::Output> {
-        None
-    }
 }
-
-/// What the block path does with a model's drift as a function of the temperature (see
-/// [`AxisModel::drift_of_temperatures`]): a loop over a block of readings, generic in the function
-/// so that the model's arithmetic is inlined into it.
-pub trait TemperatureBlock {
-    /// What the loop returns.
-    type Output;
-
-    /// Runs the loop with `drift`, which maps a temperature (°C) to the drift since switch-on
-    /// (°/s) and the model's flags, as [`AxisModel::drift`] would.
-    fn run(self, drift: impl Fn(f32) -> (f32, Flags)) -> Self::Output;
-}
-
-/// Samples the block path evaluates at once (see [`AxisModel::drift_of_temperatures`]): enough for
-/// the vector loops and the per-block bookkeeping to amortise their set-up (128 rather than 64:
-/// 10 % fewer instructions per sample for the baselines), few enough for the stack (~4 KiB per
-/// axis).
-pub const BLOCK_SAMPLES: usize = 128;
 
 /// A drift model for a whole unit: settings plus one [`AxisModel`] per axis.
 pub trait Model {

@@ -8,7 +8,7 @@ use heapless::Vec;
 
 use crate::error::{check_finite, Error, Location, Problem};
 use crate::flags::Flags;
-use crate::model::{AxisModel, Model, TemperatureBlock};
+use crate::model::{AxisModel, Model};
 use crate::settings::Settings;
 use crate::AXES;
 
@@ -57,7 +57,7 @@ impl PolynomialAxis {
     }
 }
 
-/// The fitted range and what `evaluate` derives from it. Shared by the per-sample and the block
+/// The fitted range and what `evaluate` derives from it. Shared by the switch-on and the per-sample
 /// evaluation, so both give the same bits.
 #[derive(Clone, Copy)]
 struct Span {
@@ -83,8 +83,8 @@ impl Span {
 
     /// `celsius` clamped to the range and mapped onto [−1, 1]. The clamp compares rather than
     /// calling `max`/`min`: the same value (NaN reads as the low end; only the sign of a zero
-    /// could differ, which the subtraction of `mid ≠ 0` erases), and it vectorises. (`clamp`
-    /// would panic on an inverted range.)
+    /// could differ, which the subtraction of `mid ≠ 0` erases). (`clamp` would panic on an
+    /// inverted range.)
     #[inline(always)]
     fn normalised(&self, celsius: f32) -> f32 {
         let above_low = if celsius > self.low {
@@ -143,7 +143,7 @@ impl AxisModel for PolynomialAxis {
         _rise_celsius: f32,
     ) -> (f32, Flags) {
         // Split as initial bias + drift since switch-on, like the modified model, so the two report
-        // comparable quantities. The block path runs the same `drift_at`.
+        // comparable quantities.
         drift_at(
             Span::new(self.range_celsius, settings.ambient_margin_celsius),
             state.at_switch_on_dps,
@@ -151,56 +151,9 @@ impl AxisModel for PolynomialAxis {
             &self.coefficients,
         )
     }
-
-    /// `drift` as a function of the temperature: the same operations per temperature as
-    /// [`PolynomialAxis::evaluate`], in the same order, for the corrector's block loops.
-    fn drift_of_temperatures<B: TemperatureBlock>(
-        &self,
-        settings: &Settings,
-        state: &Self::State,
-        block: B,
-    ) -> Option<B::Output> {
-        let span = Span::new(self.range_celsius, settings.ambient_margin_celsius);
-        let at_switch_on_dps = state.at_switch_on_dps;
-        // The coefficient count as a constant: each temperature goes through the whole
-        // polynomial in registers, in one pass over the block (measured ~1.1× the block path's
-        // speed against a pass per coefficient).
-        let coefficients = self.coefficients.as_slice();
-        Some(match coefficients.len() {
-            1 => with_count::<1, B>(coefficients, span, at_switch_on_dps, block),
-            2 => with_count::<2, B>(coefficients, span, at_switch_on_dps, block),
-            3 => with_count::<3, B>(coefficients, span, at_switch_on_dps, block),
-            4 => with_count::<4, B>(coefficients, span, at_switch_on_dps, block),
-            5 => with_count::<5, B>(coefficients, span, at_switch_on_dps, block),
-            6 => with_count::<6, B>(coefficients, span, at_switch_on_dps, block),
-            7 => with_count::<7, B>(coefficients, span, at_switch_on_dps, block),
-            _ => with_count::<MAX_POLYNOMIAL_COEFFICIENTS, B>(
-                coefficients,
-                span,
-                at_switch_on_dps,
-                block,
-            ),
-        })
-    }
 }
 
-/// `block` run with the polynomial's drift, the coefficients as an array of `N` when they are `N`.
-#[inline(always)]
-fn with_count<const N: usize, B: TemperatureBlock>(
-    coefficients: &[f32],
-    span: Span,
-    at_switch_on_dps: f32,
-    block: B,
-) -> B::Output {
-    match <[f32; N]>::try_from(coefficients) {
-        // By value (`move`): the block's loop may run out of line, with the coefficients its own.
-        Ok(fixed) => block.run(move |celsius| drift_at(span, at_switch_on_dps, celsius, &fixed)),
-        Err(_) => block.run(move |celsius| drift_at(span, at_switch_on_dps, celsius, coefficients)),
-    }
-}
-
-/// The drift at `celsius` (the polynomial minus its value at switch-on) and the flag: the one
-/// formula of the per-sample `drift` and the block path.
+/// The drift at `celsius` (the polynomial minus its value at switch-on) and the flag.
 #[inline(always)]
 fn drift_at(span: Span, at_switch_on_dps: f32, celsius: f32, coefficients: &[f32]) -> (f32, Flags) {
     let drift = horner(coefficients, span.normalised(celsius)) - at_switch_on_dps;
@@ -213,7 +166,7 @@ fn drift_at(span: Span, at_switch_on_dps: f32, celsius: f32, coefficients: &[f32
 }
 
 /// A polynomial at `x`, constant term first: Horner's scheme from the highest coefficient. The
-/// one formula of the per-sample and the block evaluation.
+/// one formula of the switch-on and the per-sample evaluation.
 #[inline(always)]
 fn horner(coefficients: &[f32], x: f32) -> f32 {
     coefficients

@@ -79,14 +79,14 @@ fn each_bad_input_gets_its_own_error() {
         Err(BlobError::BadMagic { .. })
     ));
 
-    let mut bytes = good.clone();
-    bytes[4..6].copy_from_slice(&(FORMAT_VERSION + 1).to_le_bytes());
-    assert_eq!(
-        decode::<FixtureTables>(&bytes),
-        Err(BlobError::UnsupportedVersion {
-            found: FORMAT_VERSION + 1
-        })
-    );
+    for version in [0, FORMAT_VERSION + 1] {
+        let mut bytes = good.clone();
+        bytes[4..6].copy_from_slice(&version.to_le_bytes());
+        assert_eq!(
+            decode::<FixtureTables>(&bytes),
+            Err(BlobError::UnsupportedVersion { found: version })
+        );
+    }
 
     assert_eq!(
         decode::<PolynomialTables>(&good),
@@ -241,137 +241,47 @@ fn encoded_len_is_exact() {
     assert_eq!(encode(&model, &mut short), Err(BlobError::BufferTooSmall));
 }
 
-/// An image written by the version-1 build (before the extended model), committed as it was:
-/// it still loads, with no extra terms, into exactly the tables it held.
+/// The committed image of the paper's fixture (`testdata/image-v1-modified.bin`), written by this
+/// format's first build: it loads into exactly the tables it held, and the encoder still writes
+/// those very bytes. If this fails, the format changed: that is a new [`FORMAT_VERSION`] (and a
+/// new committed image: `GYRODRIFT_BLESS=1` writes it).
 #[test]
-fn version_1_images_still_load() {
-    let v1 = std::fs::read(concat!(
+fn the_committed_image_still_loads_and_is_written_the_same() {
+    const PATH: &str = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../testdata/image-v1-modified.bin"
-    ))
-    .unwrap();
-    assert_eq!(u16::from_le_bytes([v1[4], v1[5]]), 1);
-    let tables: FixtureTables = decode(&v1).unwrap();
+    );
+    if std::env::var_os("GYRODRIFT_BLESS").is_some() {
+        std::fs::write(PATH, image()).unwrap();
+    }
+    let committed = std::fs::read(PATH).unwrap();
+    assert_eq!(FORMAT_VERSION, 1);
+    assert_eq!(
+        u16::from_le_bytes([committed[4], committed[5]]),
+        FORMAT_VERSION
+    );
+    let tables: FixtureTables = decode(&committed).unwrap();
     assert!(tables.extension.is_empty());
     assert_eq!(tables, fixture::modified());
-    // Re-encoding writes the current version, which a version-1 reader would refuse by number.
-    let mut buffer = vec![0; 64 * 1024];
-    let len = encode(&tables, &mut buffer).unwrap();
-    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
-    assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), tables);
+    assert_eq!(image(), committed);
 }
 
-/// The extended fixture as the version-2 build wrote it (`testdata/image-v2-extended.bin`, the
-/// `extended` image of `testdata/vectors.json` before version 3), committed as it was: it still
-/// loads, its auxiliary term unfiltered (time constant 0), everything else as it was.
+/// Every fixture survives encode → decode: the extended model, stage 3 keyed by history, warm
+/// starts.
 #[test]
-fn version_2_images_still_load_with_unfiltered_aux_terms() {
-    use drift_core::Term;
-    let v2 = std::fs::read(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../testdata/image-v2-extended.bin"
-    ))
-    .unwrap();
-    assert_eq!(u16::from_le_bytes([v2[4], v2[5]]), 2);
-    let tables: FixtureTables = decode(&v2).unwrap();
-    let mut expected = cooling_at_rest(fixture::extended());
-    for term in &mut expected.extension.terms {
-        if let Term::Aux {
-            time_constant_ms, ..
-        } = &mut term.term
-        {
-            *time_constant_ms = 0;
-        }
+fn every_fixture_round_trips() {
+    assert!(fixture::by_history().axes[0].keyed_by_history());
+    assert!(fixture::warm_started().axes[0].warm_started());
+    let mut buffer = vec![0; 64 * 1024];
+    for tables in [
+        fixture::extended(),
+        fixture::by_history(),
+        fixture::warm_started(),
+    ] {
+        let len = encode(&tables, &mut buffer).unwrap();
+        assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
+        assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), tables);
     }
-    assert_eq!(tables, expected);
-    // Re-encoding writes the current version, which a version-2 reader would refuse by number.
-    let mut buffer = vec![0; 64 * 1024];
-    let len = encode(&tables, &mut buffer).unwrap();
-    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
-    assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), tables);
-}
-
-/// The extended fixture as the version-3 build wrote it (`testdata/image-v3-extended.bin`, the
-/// `extended` image of `testdata/vectors.json` before version 4), committed as it was: it still
-/// loads, stage 3 keyed by rise (no residual heats), everything else as it was; the history-keyed
-/// fixture round-trips through the current version.
-#[test]
-fn version_3_images_still_load_keyed_by_rise() {
-    let v3 = std::fs::read(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../testdata/image-v3-extended.bin"
-    ))
-    .unwrap();
-    assert_eq!(u16::from_le_bytes([v3[4], v3[5]]), 3);
-    let tables: FixtureTables = decode(&v3).unwrap();
-    assert!(tables.axes.iter().all(|axis| !axis.keyed_by_history()));
-    assert_eq!(tables, cooling_at_rest(fixture::extended()));
-    let by_history = fixture::by_history();
-    let mut buffer = vec![0; 64 * 1024];
-    let len = encode(&by_history, &mut buffer).unwrap();
-    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
-    let back: FixtureTables = decode(&buffer[..len]).unwrap();
-    assert!(back.axes.iter().all(|axis| axis.keyed_by_history()));
-    assert_eq!(back, by_history);
-}
-
-/// `tables` with every axis's rate filter started at rest, as images before version 6 meant.
-fn cooling_at_rest(mut tables: FixtureTables) -> FixtureTables {
-    tables.extension.switch_on_rate = [drift_core::SwitchOnRate::AT_REST; 3];
-    tables
-}
-
-/// The extended fixture as the version-5 build wrote it (`testdata/image-v5-extended.bin`, the
-/// `extended` image of `testdata/vectors.json` before version 6), committed as it was: it still
-/// loads, its rate filter started at rest at every switch-on, everything else as it was; the
-/// fixture with a switch-on cooling round-trips through the current version.
-#[test]
-fn version_5_images_still_load_with_the_rate_filter_at_rest() {
-    let v5 = std::fs::read(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../testdata/image-v5-extended.bin"
-    ))
-    .unwrap();
-    assert_eq!(u16::from_le_bytes([v5[4], v5[5]]), 5);
-    let tables: FixtureTables = decode(&v5).unwrap();
-    assert_eq!(tables, cooling_at_rest(fixture::extended()));
-    let extended = fixture::extended();
-    assert_ne!(extended, tables);
-    let mut buffer = vec![0; 64 * 1024];
-    let len = encode(&extended, &mut buffer).unwrap();
-    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
-    assert_eq!(decode::<FixtureTables>(&buffer[..len]).unwrap(), extended);
-}
-
-/// The history-keyed fixture as the version-4 build wrote it (`testdata/image-v4-by_history.bin`,
-/// the `by_history` image of `testdata/vectors.json` before version 5), committed as it was: it
-/// still loads, keyed by history, with the paper's initial bias (no warm starts); the fixture with
-/// warm starts round-trips through the current version.
-#[test]
-fn version_4_images_still_load_without_warm_starts() {
-    let v4 = std::fs::read(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../testdata/image-v4-by_history.bin"
-    ))
-    .unwrap();
-    assert_eq!(u16::from_le_bytes([v4[4], v4[5]]), 4);
-    let tables: FixtureTables = decode(&v4).unwrap();
-    assert!(tables
-        .axes
-        .iter()
-        .all(|axis| axis.keyed_by_history() && !axis.warm_started()));
-    let mut without = fixture::by_history();
-    for ambient in without.axes.iter_mut().flat_map(|axis| &mut axis.ambients) {
-        ambient.warm_starts.clear();
-    }
-    assert_eq!(tables, without);
-    let warm_started = fixture::warm_started();
-    let mut buffer = vec![0; 64 * 1024];
-    let len = encode(&warm_started, &mut buffer).unwrap();
-    assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), FORMAT_VERSION);
-    let back: FixtureTables = decode(&buffer[..len]).unwrap();
-    assert!(back.axes.iter().all(|axis| axis.warm_started()));
-    assert_eq!(back, warm_started);
 }
 
 /// Warm starts that are not in increasing residual heat, or start at none, are refused, named.

@@ -1,13 +1,16 @@
 """Correction throughput from numpy through the binding vs pure Rust, in one run.
 
     python crates/drift-py/bench/bench_correct.py [--samples 10000000] [--repeats 3]
+    python crates/drift-py/bench/bench_correct.py --tiny   # what CI runs: a correctness check, in seconds
 
 Builds the same deterministic synthetic stream as the Rust example `correct_throughput` (root
 `examples/`), which this script builds and runs with `cargo run --release`; both sides correct it
-with the three demonstration models of `testdata/vectors.json`, best of `--repeats`, and must agree
-on a checksum of every output bit. Prints samples/s for both and the ratios; exits 1 if a checksum
-differs or the binding (float32 inputs into reused `out=` arrays, which is what the Rust reference
-does: it writes into a buffer it allocated once) is below the floor, 50 % of pure Rust.
+with the models of `testdata/vectors.json` the example knows (the paper's model and both polynomial
+baselines; the others are skipped, saying so), best of `--repeats`, and must agree on a checksum of
+every output bit. Prints samples/s for both and the ratios; exits 1 if a checksum differs or a model
+the example should know is missing from its output. The floor (the binding, float32 inputs into
+reused `out=` arrays, which is what the Rust reference does: it writes into a buffer it allocated
+once, at 50 % of pure Rust or more) is printed, and fails the run only with `--enforce-floors`.
 """
 
 from __future__ import annotations
@@ -30,6 +33,8 @@ Model = Union[gyrodrift.ModifiedTables, gyrodrift.PolynomialTables]
 
 ROOT = Path(__file__).resolve().parents[3]
 FLOOR = 0.5
+# The models examples/correct_throughput.rs corrects.
+RUST_MODELS = ("modified", "standard", "third_order")
 
 
 def stream(n: int) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any]]:
@@ -124,7 +129,13 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=10_000_000)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument(
+        "--tiny", action="store_true", help="CI's size, a check that it runs: --samples 20000 --repeats 1"
+    )
+    parser.add_argument("--enforce-floors", action="store_true", help="exit 1 if the floor is not met")
     args = parser.parse_args()
+    if args.tiny:
+        args.samples, args.repeats = 20_000, 1
 
     vectors = json.loads((ROOT / "testdata" / "vectors.json").read_text())
     models = {
@@ -139,6 +150,14 @@ def main() -> int:
     )
     print(f"{args.samples:,} samples, best of {args.repeats}")
     reference = rust(args.samples, args.repeats)
+    failed = False
+    for name in RUST_MODELS:
+        if name not in reference or name not in models:
+            print(f"FAILED: {name} is missing (from the vectors or from the Rust example's output)")
+            failed = True
+    for name in models:
+        if name not in reference:
+            print(f"skipped: {name} (the Rust example `correct_throughput` does not correct it)")
     inputs32 = stream(args.samples)
     inputs64 = (inputs32[0], inputs32[1].astype(np.float64), inputs32[2].astype(np.float64))
 
@@ -153,10 +172,9 @@ def main() -> int:
         f"{'model':<12} {'pure Rust':>10} {'Rust, fresh':>12}"
         + "".join(f" {label:>20}" for label, _, _ in variants)
     )
-    failed = False
+    below = False
     for name, model in models.items():
         if name not in reference:
-            # The extended model needs auxiliary inputs per sample; the stream has none.
             continue
         rust_rate, rust_fresh, rust_check = reference[name]
         cells, same = [], True
@@ -165,15 +183,18 @@ def main() -> int:
             same &= check == rust_check
             cells.append(f"{rate / 1e6:>11.1f} ({rate / rust_rate:4.2f})")
             if reuse and inputs is inputs32 and rate / rust_rate < FLOOR:
-                print(f"{name}: below the floor, the binding must reach {FLOOR:.0%} of pure Rust")
-                failed = True
+                enforced = "" if args.enforce_floors else " (not enforced)"
+                print(f"{name}: floor not met{enforced}, the binding should reach {FLOOR:.0%} of pure Rust")
+                below = True
         print(
             f"{name:<12} {rust_rate / 1e6:>10.1f} {rust_fresh / 1e6:>12.1f}"
             + "".join(f" {c:>20}" for c in cells)
             + ("  same outputs" if same else "  CHECKSUM DIFFERS")
         )
+        if not same:
+            print(f"FAILED: {name}: the binding's outputs differ from pure Rust's")
         failed |= not same
-    return 1 if failed else 0
+    return 1 if failed or (args.enforce_floors and below) else 0
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""A plain numpy peer of gyrodrift's Rust code, written for the performance comparison (issue 7).
+"""A plain numpy peer of gyrodrift's Rust code, written for the performance comparison.
 
 The way a good numpy programmer would write it — whole-array operations, no Python loop per sample —
 and doing the SAME work as the Rust code, so timing both compares equal work (tests/test_peer.py
@@ -8,7 +8,10 @@ checks that the outputs agree):
   polynomial.rs) for the paper's ("modified") model and the polynomial baselines, on batches of
   samples, in float32 like the firmware: fault checks (non-finite rate or temperature, stuck sensor
   with its repeat counter), hold of the last good drift, the three stages and every flag. The tables
-  are read through the Python API (`to_json`).
+  are read through the Python API (`to_json`). Tables keyed by heating history and tables with warm
+  starts are corrected as after `power_on` (nothing kept of the previous activation: a cold start,
+  flagged `HISTORY_UNKNOWN`); there is no `power_on_after`. Tables with an extension's extra terms
+  (which read auxiliary inputs) are not implemented: `PeerCorrector` rejects them (ValueError).
 - `fit`: drift-fit's fit from segments (analyse.rs, lowpass.rs, curves.rs, knots.rs, fit.rs,
   baselines.rs): low-pass, switch-on temperature, initial bias, rise; curves averaged per
   (interval, activation); greedy reference times; tables; both polynomial baselines. In float64,
@@ -59,6 +62,8 @@ _TEMPERATURE_INVALID = int(gyrodrift.Flags.TEMPERATURE_INVALID)
 _TEMPERATURE_STUCK = int(gyrodrift.Flags.TEMPERATURE_STUCK)
 _RATE_INVALID = int(gyrodrift.Flags.RATE_INVALID)
 _MODEL_INVALID = int(gyrodrift.Flags.MODEL_INVALID)
+_HISTORY_UNKNOWN = int(gyrodrift.Flags.HISTORY_UNKNOWN)
+_HISTORY_OUT_OF_SPAN = int(gyrodrift.Flags.HISTORY_OUT_OF_SPAN)
 
 
 def _round(x: float) -> int:
@@ -84,6 +89,9 @@ class _ModifiedAxis:
     k: F32Array  # (C, R)
     initial_bias: np.float32
     flags: int
+    # A table keyed by history: the curve below the activation's residual heat and the weight of
+    # the next one (fixed for the activation; stage 3 then reads no rise). None: the paper's search.
+    history: tuple[int, np.float32] | None = None
 
 
 @dataclass
@@ -107,11 +115,33 @@ def _polynomial(axis: _PolynomialAxis, celsius: F32Array, margin: np.float32) ->
     return value, outside
 
 
+def _locate(at: F32Array, x: np.float32, margin: np.float32) -> tuple[int, int, np.float32, bool]:
+    """`AmbientPosition::locate`: (lo, hi, weight, out of range) of `x` among increasing `at`."""
+    above = int(np.searchsorted(at, x, side="right"))  # partition_point(a <= x)
+    last = len(at) - 1
+    if above == 0:
+        return 0, 0, F32(0.0), bool(np.isnan(x) or x < at[0] - margin)
+    if above <= last:
+        lo = above - 1
+        weight = F32((x - at[lo]) / (at[above] - at[lo]))
+        return lo, (lo + 1 if weight > 0 else lo), weight, False
+    return last, last, F32(0.0), bool(x > at[last] + margin)
+
+
+def implements(model: Model) -> bool:
+    """Whether `PeerCorrector` corrects `model`: everything but an extension's extra terms."""
+    if isinstance(model, gyrodrift.PolynomialTables):
+        return True
+    return not json.loads(model.to_json()).get("extension", {}).get("terms")
+
+
 class PeerCorrector:
     """drift-core's `Corrector` for one unit, in numpy: `power_on`, then `correct_batch` on blocks
     of samples that continue the same activation. Outputs are float32/uint16 arrays (n, 3)."""
 
     def __init__(self, model: Model) -> None:
+        if not implements(model):
+            raise ValueError("the peer does not implement the extension's extra terms")
         self.tables: dict[str, Any] = json.loads(model.to_json())
         self.modified = isinstance(model, gyrodrift.ModifiedTables)
         s = self.tables["settings"]
@@ -149,24 +179,11 @@ class PeerCorrector:
         return (self.axes[0].flags, self.axes[1].flags, self.axes[2].flags)
 
     def _power_on_modified(self, table: Mapping[str, Any], celsius: np.float32) -> _ModifiedAxis:
-        """`AmbientPosition::locate` and the blend of the two bracketing ambients' knots (stage 2)."""
+        """`AmbientPosition::locate` and the blend of the two bracketing ambients' knots (stage 2);
+        for a table keyed by history, the curves bracketing the residual heat (0: nothing kept)."""
         ambients = table["ambients"]
         at = np.array([a["ambient_celsius"] for a in ambients], np.float32)
-        above = int(np.searchsorted(at, celsius, side="right"))  # partition_point(a <= x)
-        last = len(at) - 1
-        weight, out_of_range = F32(0.0), False
-        if above == 0:
-            lo = hi = 0
-            out_of_range = bool(np.isnan(celsius) or celsius < at[0] - self.ambient_margin)
-        elif above <= last:
-            lo = above - 1
-            weight = (celsius - at[lo]) / (at[above] - at[lo])
-            hi = lo + 1 if weight > 0 else lo
-        elif celsius > at[last]:
-            lo = hi = last
-            out_of_range = bool(celsius > at[last] + self.ambient_margin)
-        else:
-            lo = hi = last
+        lo, hi, weight, out_of_range = _locate(at, celsius, self.ambient_margin)
 
         def knots(i: int) -> tuple[F32Array, F32Array]:
             points = np.array(
@@ -183,12 +200,27 @@ class PeerCorrector:
             rise_hi, k_hi = knots(hi)
             rise, k = _lerp(rise, rise_hi, weight), _lerp(k, k_hi, weight)
         bias = _lerp(F32(ambients[lo]["initial_bias_dps"]), F32(ambients[hi]["initial_bias_dps"]), weight)
+        flags = _AMBIENT_OUT_OF_RANGE if out_of_range else 0
+        history = None
+        by_history = bool(ambients[0].get("residual_heat_celsius"))
+        if by_history or any(a.get("warm_starts") for a in ambients):
+            # Nothing kept of the previous activation: a cold start (no residual heat, so no
+            # warm-start offset of the initial bias and the ambient at the switch-on temperature).
+            flags |= _HISTORY_UNKNOWN
+        if by_history:
+            labels = np.array(ambients[lo]["residual_heat_celsius"], np.float32)
+            upper = np.array(ambients[hi]["residual_heat_celsius"], np.float32)
+            blended = _lerp(labels, upper, weight)
+            h_lo, _h_hi, h_weight, h_out = _locate(blended, F32(0.0), self.rise_margin)
+            history = (h_lo, h_weight)
+            flags |= _HISTORY_OUT_OF_SPAN if h_out else 0
         return _ModifiedAxis(
             reference_ms=np.array(table["reference_ms"], np.uint32),
             rise=np.ascontiguousarray(rise),
             k=np.ascontiguousarray(k),
             initial_bias=F32(bias),
-            flags=_AMBIENT_OUT_OF_RANGE if out_of_range else 0,
+            flags=flags,
+            history=history,
         )
 
     def _power_on_polynomial(self, table: Mapping[str, Any], celsius: np.float32) -> _PolynomialAxis:
@@ -210,6 +242,11 @@ class PeerCorrector:
         flags = np.zeros(len(times), np.uint16)
         count = axis.rise.shape[0]
         last_curve = count - 1
+        history_k = None
+        if axis.history is not None:
+            # `heating::by_history`: one curve per activation, blended between the two histories.
+            h, weight = axis.history
+            history_k = axis.k[h] if not weight > 0 else _lerp(axis.k[h], axis.k[h + 1], weight)
         for start in range(0, len(times), BLOCK):
             t = times[start : start + BLOCK]
             r = rise[start : start + BLOCK]
@@ -228,6 +265,11 @@ class PeerCorrector:
             hi = np.where(before | (offset == 0), lo, hi)
             rise_scale = np.where(before, t.astype(np.float32) / F32(first), F32(1.0))
             past_last = at_last & (offset > 0) & ~before
+            if history_k is not None:
+                # No rise search: never out of the curves' span.
+                drift[start : start + n] = _lerp(history_k[lo], history_k[hi], fraction) * r
+                flags[start : start + n] = np.where(past_last, _PAST_LAST_REFERENCE, 0)
+                continue
             # Every curve's point at this time: (n, C).
             rise_lo, rise_hi = axis.rise[:, lo].T, axis.rise[:, hi].T
             k_lo, k_hi = axis.k[:, lo].T, axis.k[:, hi].T

@@ -161,6 +161,8 @@ pub enum Error {
     Fit(RustFitError),
     /// The fit/evaluate pipeline stopped.
     Pipeline(PipelineError),
+    /// The report could not be made (the message names the step and the file).
+    Report(String),
 }
 
 impl From<ReadError> for Error {
@@ -295,6 +297,7 @@ impl From<Error> for PyErr {
                 RecordingError::new_err(source.to_string())
             }
             Error::Pipeline(source) => FitError::new_err(source.to_string()),
+            Error::Report(message) => FitError::new_err(message),
         })
     }
 }

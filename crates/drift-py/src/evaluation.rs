@@ -2,6 +2,7 @@
 //! correct everything the fit did not see), `gyrodrift.Evaluation`, `gyrodrift.ActivationResult`
 //! and `gyrodrift.summarise` (the report's table as data, the records of `report.json`).
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use drift_evaluate::evaluate::ActivationResult;
@@ -129,30 +130,25 @@ impl PyEvaluation {
     }
 }
 
-/// Fits on the calibration set points and evaluates every activation no fit saw, as
-/// `gyrodrift report` does: validation set points, field sessions, and (with `held_out_repeats`)
-/// each repeat at the calibration set points against tables refitted without it. `source` is a
-/// campaign folder, a folder of `.mcap` files or a list of files; `noise_floor` a campaign of
-/// zero-drift units measured at the validation set points. The GIL is released.
-#[pyfunction]
-#[pyo3(signature = (source, *, calibration = None, validation = None, settings = None, held_out_repeats = true, noise_floor = None))]
-pub fn evaluate(
+/// The recording files, the noise-floor twin's files and the pipeline's options that `evaluate`
+/// and `report` take from their arguments.
+#[allow(clippy::type_complexity)]
+fn pipeline_inputs(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
+    noise_floor: Option<&Bound<'_, PyAny>>,
     calibration: Option<&Bound<'_, PyAny>>,
     validation: Option<&Bound<'_, PyAny>>,
     settings: Option<&Bound<'_, PyAny>>,
     held_out_repeats: bool,
-    noise_floor: Option<&Bound<'_, PyAny>>,
-) -> PyResult<PyEvaluation> {
+) -> Result<(Vec<PathBuf>, Option<Vec<PathBuf>>, Options), Error> {
     let Source::Files(files) = sources::source(py, "source", source)? else {
         return Err(Error::Input(
             "`source` must be recording files (a campaign folder, a folder of .mcap files or a \
-             list of files): evaluate reads them twice, as `gyrodrift report` does; for \
+             list of files): the pipeline reads them twice, as `gyrodrift report` does; for \
              recordings in memory use FittedUnit.evaluate and summarise"
                 .into(),
-        )
-        .into());
+        ));
     };
     let noise_files = match noise_floor.filter(|n| !n.is_none()) {
         None => None,
@@ -162,8 +158,7 @@ pub fn evaluate(
                 return Err(Error::Input(format!(
                     "`noise_floor` must be a path to recording files, got {}",
                     describe(value)
-                ))
-                .into())
+                )))
             }
         },
     };
@@ -180,6 +175,86 @@ pub fn evaluate(
         held_out_repeats,
         evaluate: true,
     };
+    Ok((files, noise_files, options))
+}
+
+/// Writes the report of `gyrodrift report` into `out` — `report.md` with its figures,
+/// `report.json`, `timings.json` and the tables folder `tables/` — through the same function, so
+/// the same recordings and options give the same bytes; returns the path of `report.md`. `source`
+/// is a campaign folder, a folder of `.mcap` files or a list of files; `noise_floor` a campaign of
+/// zero-drift units measured like it. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (source, out, *, calibration = None, validation = None, settings = None, noise_floor = None))]
+pub fn report(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    out: &Bound<'_, PyAny>,
+    calibration: Option<&Bound<'_, PyAny>>,
+    validation: Option<&Bound<'_, PyAny>>,
+    settings: Option<&Bound<'_, PyAny>>,
+    noise_floor: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PathBuf> {
+    let out = args::path("out", out)?;
+    let (files, noise_files, options) = pipeline_inputs(
+        py,
+        source,
+        noise_floor,
+        calibration,
+        validation,
+        settings,
+        true,
+    )?;
+    let described = describe_source(source);
+    py.detach(|| {
+        drift_report::make(
+            &files,
+            noise_files.as_deref(),
+            &options,
+            &out,
+            drift_report::provenance(&described, &options),
+            &|_, _, _| {},
+        )
+    })
+    .map(|(path, _)| path)
+    .map_err(|error| match error.downcast::<pipeline::PipelineError>() {
+        Ok(error) => Error::from(error).into(),
+        Err(error) => Error::Report(format!("{error:#}")).into(),
+    })
+}
+
+/// A source as the report's provenance names it: the path as given, or the number of files.
+fn describe_source(source: &Bound<'_, PyAny>) -> String {
+    match source.extract::<PathBuf>() {
+        Ok(path) => path.display().to_string(),
+        Err(_) => format!("{} files", source.len().unwrap_or(0)),
+    }
+}
+
+/// Fits on the calibration set points and evaluates every activation no fit saw, as
+/// `gyrodrift report` does: validation set points, field sessions, and (with `held_out_repeats`)
+/// each repeat at the calibration set points against tables refitted without it. `source` is a
+/// campaign folder, a folder of `.mcap` files or a list of files; `noise_floor` a campaign of
+/// zero-drift units measured at the validation set points. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (source, *, calibration = None, validation = None, settings = None, held_out_repeats = true, noise_floor = None))]
+pub fn evaluate(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    calibration: Option<&Bound<'_, PyAny>>,
+    validation: Option<&Bound<'_, PyAny>>,
+    settings: Option<&Bound<'_, PyAny>>,
+    held_out_repeats: bool,
+    noise_floor: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyEvaluation> {
+    let (files, noise_files, options) = pipeline_inputs(
+        py,
+        source,
+        noise_floor,
+        calibration,
+        validation,
+        settings,
+        held_out_repeats,
+    )?;
     let (outcome, noise_floor_units) = py
         .detach(|| {
             pipeline::run_with_noise_floor(&files, noise_files.as_deref(), &options, &|_, _, _| {})

@@ -60,6 +60,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<evaluation::PyEvaluation>()?;
     module.add_function(wrap_pyfunction!(evaluation::evaluate, module)?)?;
     module.add_function(wrap_pyfunction!(evaluation::summarise, module)?)?;
+    module.add_function(wrap_pyfunction!(evaluation::report, module)?)?;
     module.add_function(wrap_pyfunction!(excess::excess_cut, module)?)?;
     Ok(())
 }

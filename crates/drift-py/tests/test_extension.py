@@ -285,12 +285,12 @@ def test_json_without_an_extension_reads_as_none(modified: ModifiedTables) -> No
     assert ModifiedTables.from_json(json.dumps(data)) == modified
 
 
-def test_version_1_image_still_loads(modified: ModifiedTables) -> None:
-    """drift-core's committed version-1 fixture (written before the extension existed)."""
+def test_committed_image_still_loads(modified: ModifiedTables) -> None:
+    """drift-core's committed image of the paper's tables (format version 1, no extension)."""
     fixture = VECTORS.parent / "image-v1-modified.bin"
-    old = ModifiedTables.load_image(fixture)
-    assert old == modified and old.extension == ()
-    assert fixture.read_bytes() != old.to_image()  # written back in the current version
+    stored = ModifiedTables.load_image(fixture)
+    assert stored == modified and stored.extension == ()
+    assert fixture.read_bytes() == stored.to_image()  # the format has not changed
 
 
 def test_extension_changes_the_correction(modified: ModifiedTables, extended: ModifiedTables) -> None:

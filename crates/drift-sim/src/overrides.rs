@@ -166,15 +166,19 @@ mod tests {
             units: Some(1),
             repeats: Some(2),
             field_only: true,
-            zero_drift: true,
             effects: vec!["thermal_lag".into()],
             ..Overrides::default()
         };
         let c = overrides.apply(Campaign::default()).unwrap();
         assert_eq!((c.seed, c.units), (7, 1));
         assert!(c.protocol.is_none() && c.field.is_some());
-        assert_eq!(c.unit_model, UnitModel::ZeroSystematicDrift);
         assert!(c.effects.thermal_lag.is_some());
+        let twin = Overrides {
+            zero_drift: true,
+            ..Overrides::default()
+        };
+        let c = twin.apply(Campaign::default()).unwrap();
+        assert_eq!(c.unit_model, UnitModel::ZeroSystematicDrift);
         let both = Overrides {
             field: true,
             field_only: true,

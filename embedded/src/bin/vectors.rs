@@ -26,12 +26,10 @@ fn fail(what: &str) -> ! {
     loop {}
 }
 
-/// Stack a firmware may budget for decoding its table image at start-up: 44 228 bytes measured
-/// (docs/embedded.md, session 9: format 5's warm starts grew the table by 1 188 bytes, and the
-/// decoder now builds, checks and validates the model in one frame per image version instead of
-/// copying it through two more; 54 676 with format 4, 46 276 with format 3, 66 332 before each
-/// image version got a function of its own). A ceiling, so a change that copies the tables once
-/// more on the way fails here rather than on a customer's part.
+/// Stack a firmware may budget for decoding its table image at start-up (measured: docs/embedded.md;
+/// the decoder builds, checks and validates the model in one frame rather than copying it through
+/// more). A ceiling, so a change that copies the tables once more on the way fails here rather than
+/// on a customer's part.
 const DECODE_STACK_CEILING: usize = 48 * 1024;
 
 fn same(expected: u32, got: u32) -> bool {

@@ -52,6 +52,7 @@ from ._gyrodrift import (
     load_campaign,
     resolve_campaign,
     simulate,
+    report,
     summarise,
 )
 from .tables import paper_table
@@ -93,6 +94,7 @@ __all__ = [
     "paper_table",
     "resolve_campaign",
     "simulate",
+    "report",
     "summarise",
 ]
 

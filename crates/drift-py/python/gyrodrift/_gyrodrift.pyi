@@ -236,8 +236,7 @@ class ModifiedTables:
         from: `[heating °C/s, cooling_per_second, cooling_per_second_per_remaining]`, float32
         `(3, 3)`. The rate is `heating − residual_heat · (cooling_per_second +
         cooling_per_second_per_remaining · remaining)` for the history `Corrector.power_on_after`
-        was given (`power_on`: a cold start, the heating alone). Zeros: the filter starts at rest,
-        as every model before image format 6 did."""
+        was given (`power_on`: a cold start, the heating alone). Zeros: the filter starts at rest."""
     def with_extension(
         self, terms: Sequence[ExtraTerm], switch_on_rate: _FloatRows | None = None
     ) -> ModifiedTables:
@@ -926,8 +925,9 @@ class FittedUnit:
         on the held-out activations. The GIL is released. Raises `InputError` (no activation of
         this unit to diagnose) or `FitError`."""
     def save(self, folder: _Path) -> Path:
-        """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} as
-        `gyrodrift fit` does; returns the unit's folder. Raises `FileError`."""
+        """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} through
+        the command line's own writer (the same bytes as `gyrodrift fit`); returns the unit's
+        folder. Raises `FileError`."""
 
 def fit(
     source: _Source,
@@ -984,6 +984,21 @@ def evaluate(
     files, a list of files); `noise_floor` a campaign of zero-drift units, measured at the
     validation set points. The GIL is released. Raises `FitError`, `RecordingError`, `FileError`
     or `InputError`."""
+
+def report(
+    source: _Path | Sequence[_Path],
+    out: _Path,
+    *,
+    calibration: Sequence[float] | None = None,
+    validation: Sequence[float] | None = None,
+    settings: FitSettings | None = None,
+    noise_floor: _Path | Sequence[_Path] | None = None,
+) -> Path:
+    """Writes the report of `gyrodrift report` into `out`: `report.md` with its SVG figures,
+    `report.json` (the table as data), `timings.json` and the fitted tables folder `tables/`, through
+    the same function as the command line, so the same recordings and options give the same bytes.
+    Returns the path of `report.md`. Arguments as `evaluate`'s. The GIL is released. Raises
+    `FitError`, `RecordingError`, `FileError` or `InputError`."""
 
 def summarise(results: Sequence[ActivationResult]) -> list[_Record]:
     """Averages activation results into the report's records (as `Evaluation.records`)."""
