@@ -143,7 +143,7 @@ fn warm_start_table(warm_start: &[WarmStartChoice; 3]) -> String {
 /// Mean drift per set point, series kind and axis of the held-out activations with stage 3 keyed
 /// by rise (the paper's) and by history.
 fn history_table(held_out: &[BeforeAfter]) -> String {
-    let groups = super::extend::by_set_point_and_kind(held_out);
+    let groups = drift_diagnose::before_after::by_group(held_out);
     let mut md = String::from("\n| held out | activations | drift keyed by rise X / Y / Z | drift keyed by history X / Y / Z |\n|---|---:|---|---|\n");
     for (key, rows) in &groups {
         let n = rows.len() as f64;
@@ -531,6 +531,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "stage3": stage3,
             "warm_start": warm_start,
             "before_after": before_after,
+            // The per-group table of the Markdown, with the noise floor and each excess cut's
+            // interval, as data.
+            "held_out_error": drift_diagnose::before_after::group_errors(&before_after, floor.as_ref()),
+            "noise_floor_given": floor.is_some(),
             "profiles": profiles,
         }));
     }

@@ -9,8 +9,8 @@ use std::path::Path;
 use drift_core::blob;
 use drift_diagnose::closing::{BeforeAfter, Closed};
 use drift_diagnose::switch_on_rate::SwitchOnRateFit;
-use drift_evaluate::excess::excess_cut;
-use drift_evaluate::noise_floor::{group_name, Floor};
+use drift_diagnose::before_after::group_errors;
+use drift_evaluate::noise_floor::Floor;
 use drift_evaluate::tables_folder;
 use drift_fit::FittedUnit;
 
@@ -180,54 +180,34 @@ fn switch_on_rate_markdown(element: bool, fits: &[SwitchOnRateFit; 3]) -> String
     md
 }
 
-/// The held-out activations' results by set point and series kind (`+33.0 °C field`), in order.
-pub fn by_set_point_and_kind(results: &[BeforeAfter]) -> BTreeMap<String, Vec<&BeforeAfter>> {
-    let mut groups: BTreeMap<String, Vec<&BeforeAfter>> = BTreeMap::new();
-    for r in results {
-        groups
-            .entry(group_name(r.set_point_celsius, r.series_kind))
-            .or_default()
-            .push(r);
-    }
-    groups
-}
-
 /// Means per set point, series kind and axis of the held-out activations' errors, with the noise
 /// floor of their set point when measured, and then how many times the model cuts the drift in
 /// excess of it, with a 95 % interval.
 fn before_after_table(results: &[BeforeAfter], floor: Option<&Floor>) -> String {
-    let groups = by_set_point_and_kind(results);
-    let mut worse = Vec::new();
+    let rows = group_errors(results, floor);
     let mut md = String::from("\nError on the held-out activations (nothing was fitted or chosen on them):\n\n| set point | axis | activations | RMS before | RMS after | noise floor RMS | drift before | drift after | noise floor drift | drift excess cut (95 %) |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (key, rows) in &groups {
-        let n = rows.len() as f64;
-        let at = floor.and_then(|f| f.get(key));
-        for (a, axis) in ["X", "Y", "Z"].iter().enumerate() {
-            let mean = |f: &dyn Fn(&BeforeAfter) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
-            let floor = |pick: fn(&(f64, f64)) -> f64| {
-                at.map_or_else(|| "–".to_owned(), |f| format!("{:.4}", pick(&f.mean[a])))
-            };
-            let drift = |pick: fn(&(f64, f64)) -> f64| -> Vec<f64> {
-                rows.iter().map(|r| pick(&r.drift_dps[a])).collect()
-            };
-            let cut = at.map(|f| excess_cut(&drift(|d| d.0), &drift(|d| d.1), &f.drift[a]));
-            if cut.is_some_and(|c| c.ratio > 0.0 && c.surely_below(1.0)) {
-                worse.push(format!("{key} {axis}"));
-            }
-            let cut = cut.map_or_else(|| "–".to_owned(), |c| c.to_string());
-            let _ = writeln!(
-                md,
-                "| {key} | {axis} | {} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {} | {cut} |",
-                rows.len(),
-                mean(&|r| r.rms_dps[a].0),
-                mean(&|r| r.rms_dps[a].1),
-                floor(|f| f.1),
-                mean(&|r| r.drift_dps[a].0),
-                mean(&|r| r.drift_dps[a].1),
-                floor(|f| f.0),
-            );
-        }
+    let shown = |v: Option<f64>| v.map_or_else(|| "–".to_owned(), |v| format!("{v:.4}"));
+    for row in &rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {:.4} | {:.4} | {} | {:.4} | {:.4} | {} | {} |",
+            row.group,
+            row.axis,
+            row.activations,
+            row.rms_before_dps,
+            row.rms_after_dps,
+            shown(row.floor_rms_dps),
+            row.drift_before_dps,
+            row.drift_after_dps,
+            shown(row.floor_drift_dps),
+            row.excess_cut.map_or_else(|| "–".to_owned(), |c| c.to_string()),
+        );
     }
+    let worse: Vec<String> = rows
+        .iter()
+        .filter(|r| r.worse_with_confidence)
+        .map(|r| format!("{} {}", r.group, r.axis))
+        .collect();
     md.push_str(if floor.is_some() {
         "\nRMS: of the 1-s mean of the corrected rate (offsets and drift); drift: its max − min per activation (the paper's metric). Noise floor: the zero-drift units of `--noise-floor`, the same set point and series kind, uncorrected, less each unit's constant bias — the physical limit beside each figure; – where the twin has no such activations. Drift excess cut: (drift before − floor) / (drift after − floor) over the activations pooled, with the 2.5–97.5 % range of a bootstrap over the held-out activations and the twin's; – where the drift before is at the floor, or below it.\n\n"
     } else {
