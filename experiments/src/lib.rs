@@ -3,3 +3,4 @@
 //! (after the fact, never inside the fit) compare with the simulator's truth. See the README.
 
 pub mod closed_loop;
+pub mod worlds;

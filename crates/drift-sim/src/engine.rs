@@ -11,6 +11,7 @@ use crate::schedule::{ActivationPlan, FilePlan};
 use crate::thermal::network::{asic, element, NODES};
 use crate::thermal::rc::{Discrete, RcNetwork};
 use crate::unit::{UnitModel, UnitParams, NOMINAL_SUPPLY_V, REFERENCE_CELSIUS};
+use crate::world::runtime::{AuxActivation, Inputs, Runtime};
 use drift_recording::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use drift_recording::writer::McapFile;
 use drift_recording::{AUX_RATE_HZ, RAW_PER_CELSIUS};
@@ -45,6 +46,17 @@ pub(crate) struct FileSim<'a> {
     pub network: &'a RcNetwork,
     pub step: &'a Discrete,
     pub plan: &'a FilePlan,
+    /// A world's extra terms, lags, named channels and sensor resolution; `None` for a campaign.
+    pub world: Option<&'a Runtime>,
+    /// A world's named channels per activation of the file (empty without a world).
+    pub world_aux: &'a [AuxActivation],
+}
+
+/// A world's state carried through a file: lag states, and the orientation of the last
+/// activation (held through the off-time).
+struct WorldState {
+    lags: Vec<f64>,
+    gravity: [f64; 3],
 }
 
 /// Batch buffers, reused across messages.
@@ -58,6 +70,8 @@ struct Buffers {
     truth_element: [Vec<f32>; 3],
     truth_asic: [Vec<f32>; 3],
     truth_instability: [Vec<f32>; 3],
+    /// A world's named channels (empty without a world).
+    named: Vec<Vec<f32>>,
 }
 
 impl Buffers {
@@ -78,6 +92,7 @@ impl Buffers {
             truth_element: [a(), a(), a()],
             truth_asic: [a(), a(), a()],
             truth_instability: [a(), a(), a()],
+            named: Vec::new(),
         }
     }
     fn clear(&mut self) {
@@ -102,6 +117,9 @@ impl Buffers {
         }
         self.supply.clear();
         self.set_point.clear();
+        for v in &mut self.named {
+            v.clear();
+        }
     }
 }
 
@@ -142,10 +160,15 @@ impl FileSim<'_> {
     }
 
     fn open_recording(&self, path: &Path) -> Result<McapFile, SimError> {
-        Ok(drift_recording::create_recording(
-            path,
-            self.recording_metadata(),
-        )?)
+        let mut f = drift_recording::create_recording(path, self.recording_metadata())?;
+        for channel in self.world.map_or(&[][..], |w| &w.aux) {
+            f.add_topic(
+                &drift_recording::named_aux_topic(&channel.name),
+                schema::SCHEMA_SCALAR,
+                &[("unit", channel.unit.as_str())],
+            )?;
+        }
+        Ok(f)
     }
 
     fn open_truth(&self, path: &Path) -> Result<McapFile, SimError> {
@@ -205,6 +228,23 @@ impl FileSim<'_> {
         let mut clock_ms = self.plan.start_ms;
         let mut counts = FileCounts::default();
         let mut buffers = Buffers::new((c.sample_rate_hz / 10) as usize);
+        let mut world = self.world.map(|w| {
+            buffers.named = vec![Vec::new(); w.aux.len()];
+            let first = self.plan.activations.first();
+            let gravity = first.map_or(crate::schedule::Z_UP, |a| a.gravity_body);
+            let mut aux = vec![0.0; w.aux.len()];
+            if let Some(a) = self.world_aux.first() {
+                a.at(0.0, &mut aux);
+            }
+            let lags = w.initial_lags(&Inputs {
+                temps: &x,
+                on_asic: &[0.0; 3],
+                gravity,
+                supply_v: NOMINAL_SUPPLY_V,
+                aux: &aux,
+            });
+            WorldState { lags, gravity }
+        });
         let mut fault_log: Vec<FaultEvent> = Vec::new();
         for (index, act) in self.plan.activations.iter().enumerate() {
             // A stream of their own: switching faults on changes no other draw.
@@ -229,6 +269,21 @@ impl FileSim<'_> {
             };
             // Off-time: unpowered, ambient held: the exact solution, however long.
             let off_s = act.off_before_ms as f64 / 1000.0;
+            if let (Some(w), Some(state)) = (self.world, world.as_mut()) {
+                let mut aux = vec![0.0; w.aux.len()];
+                if let Some(a) = self.world_aux.get(index) {
+                    a.at(0.0, &mut aux);
+                }
+                w.off_time(
+                    self.network,
+                    &x,
+                    act.ambient_off_c,
+                    off_s,
+                    state.gravity,
+                    &aux,
+                    &mut state.lags,
+                );
+            }
             let cooled = self
                 .network
                 .advance(&x, &[0.0; NODES], act.ambient_off_c, off_s);
@@ -249,6 +304,7 @@ impl FileSim<'_> {
                 clock_ms,
                 &mut x,
                 &mut instability,
+                (world.as_mut(), self.world_aux.get(index)),
                 &mut r,
                 &mut rec,
                 &mut tru,
@@ -297,6 +353,7 @@ impl FileSim<'_> {
         on_ms: u64,
         x: &mut [f64; NODES],
         instability: &mut [f64; 3],
+        (mut world, world_aux): (Option<&mut WorldState>, Option<&AuxActivation>),
         r: &mut ChaCha8Rng,
         rec: &mut McapFile,
         tru: &mut McapFile,
@@ -361,6 +418,28 @@ impl FileSim<'_> {
 
         let grid_s = f64::from(aux_every) * h;
         let mut inject = (!faults.is_empty()).then(|| Injector::new(faults));
+        // A world's extra bias, evaluated on the 10 ms grid and interpolated like the
+        // temperatures; its named channels' true values at the grid point and the next.
+        let runtime = self.world.filter(|_| world.is_some());
+        let on_asic: [f64; 3] = std::array::from_fn(|a| x[asic(a)]);
+        let n_aux = runtime.map_or(0, |w| w.aux.len());
+        let (mut aux_now, mut aux_next) = (vec![0.0; n_aux], vec![0.0; n_aux]);
+        let (mut extra_now, mut extra_next) = ([0.0; 3], [0.0; 3]);
+        let lsb_raw = runtime.map_or(1.0, |w| w.temperature_lsb_raw);
+        if let (Some(w), Some(state)) = (runtime, world.as_deref_mut()) {
+            state.gravity = accel_true;
+            if let Some(a) = world_aux {
+                a.at(0.0, &mut aux_next);
+            }
+            let inputs = Inputs {
+                temps: x,
+                on_asic: &on_asic,
+                gravity: accel_true,
+                supply_v: act.supply_v,
+                aux: &aux_next,
+            };
+            w.extra(&inputs, &state.lags, &mut extra_next);
+        }
         for i in 0..act.samples {
             let t = f64::from(i) * h;
             let ambient = act.ambient_on_c + ramp * t;
@@ -381,6 +460,31 @@ impl FileSim<'_> {
                         .forcing(&power, ambient + 0.5 * grid_s * ramp, &mut forcing);
                 }
                 self.step.step(x, &forcing, &mut next);
+                if let (Some(w), Some(state)) = (runtime, world.as_deref_mut()) {
+                    std::mem::swap(&mut aux_now, &mut aux_next);
+                    if let Some(a) = world_aux {
+                        a.at(t + grid_s, &mut aux_next);
+                    }
+                    let at = |temps, aux| Inputs {
+                        temps,
+                        on_asic: &on_asic,
+                        gravity: accel_true,
+                        supply_v: act.supply_v,
+                        aux,
+                    };
+                    w.step_lags(
+                        &at(x, &aux_now),
+                        &at(&next, &aux_next),
+                        grid_s,
+                        &mut state.lags,
+                    );
+                    extra_now = extra_next;
+                    w.extra(&at(&next, &aux_next), &state.lags, &mut extra_next);
+                    for (k, channel) in w.aux.iter().enumerate() {
+                        let v = aux_now[k] + channel.noise * noise * normal(r);
+                        buf.named[k].push(v as f32);
+                    }
+                }
                 // Bias instability is updated on the same grid: its correlation time is
                 // ≥ 100 s, so holding it for 10 ms changes nothing measurable.
                 for a in 0..3 {
@@ -417,11 +521,18 @@ impl FileSim<'_> {
                     supply_v: act.supply_v,
                     campaign_s: days_base_s + t,
                 };
-                let systematic = bias::systematic_dps(axis, &inputs) + jitter[a];
+                let mut systematic = bias::systematic_dps(axis, &inputs) + jitter[a];
+                if runtime.is_some() {
+                    systematic += extra_now[a] + frac * (extra_next[a] - extra_now[a]);
+                }
                 let rate = (systematic + instability[a] + white[a] * normal(r))
                     .clamp(-RANGE_DPS, RANGE_DPS);
-                let raw = (asic_c + axis.temperature_offset_c) * RAW_PER_CELSIUS
+                let mut raw = (asic_c + axis.temperature_offset_c) * RAW_PER_CELSIUS
                     + temp_noise[a] * normal(r);
+                if lsb_raw != 1.0 {
+                    // A coarser sensor: its reading is a multiple of its LSB.
+                    raw = (raw / lsb_raw).round() * lsb_raw;
+                }
                 // The unit outputs 24-bit words: quantise to the output LSB.
                 let counts = rate * RATE_PER_LSB_INV;
                 let counts = (counts + 0.5f64.copysign(counts)) as i32;
@@ -455,6 +566,10 @@ impl FileSim<'_> {
                 rec.write_encoded(schema::TOPIC_SUPPLY, log_ns)?;
                 ScalarBatch::encode(aux_first, AUX_RATE_HZ, &buf.set_point, &mut rec.enc);
                 rec.write_encoded(schema::TOPIC_SET_POINT, log_ns)?;
+                for (k, channel) in runtime.map_or(&[][..], |w| &w.aux).iter().enumerate() {
+                    ScalarBatch::encode(aux_first, AUX_RATE_HZ, &buf.named[k], &mut rec.enc);
+                    rec.write_encoded(&drift_recording::named_aux_topic(&channel.name), log_ns)?;
+                }
                 let (bias_first, bias_rate) = if every_sample_truth {
                     (first, fs)
                 } else {

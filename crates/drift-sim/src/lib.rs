@@ -15,6 +15,7 @@ pub mod simulate;
 pub mod thermal;
 pub mod truth;
 pub mod unit;
+pub mod world;
 
 pub use campaign::{Campaign, Field, Protocol};
 pub use error::SimError;

@@ -11,8 +11,9 @@
 use crate::campaign::Campaign;
 use crate::engine::FileSim;
 use crate::error::SimError;
-use crate::schedule;
+use crate::schedule::{self, FilePlan};
 use crate::unit::UnitParams;
+use crate::world::runtime::{AuxActivation, Runtime};
 use drift_recording::{SeriesKind, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -86,7 +87,7 @@ pub fn total_samples(c: &Campaign) -> u64 {
         .sum()
 }
 
-fn write_json(path: &Path, value: &impl Serialize) -> Result<(), SimError> {
+pub(crate) fn write_json(path: &Path, value: &impl Serialize) -> Result<(), SimError> {
     let text = serde_json::to_string_pretty(value).map_err(|e| SimError::Json {
         path: path.to_path_buf(),
         source: e,
@@ -107,6 +108,22 @@ pub fn simulate_campaign(
     let started = Instant::now();
     let plans = schedule::plan(c);
     let units = draw_units(c);
+    record(c, &units, &plans, None, out_dir, started, &mut progress)
+}
+
+/// A world's part of a run: its runtime, and its named channels per file and activation.
+pub(crate) type WorldPart<'a> = (&'a Runtime, &'a [Vec<AuxActivation>]);
+
+/// Records planned files of drawn units (and a world's extras) into `out_dir`.
+pub(crate) fn record(
+    c: &Campaign,
+    units: &[UnitParams],
+    plans: &[FilePlan],
+    world: Option<WorldPart>,
+    out_dir: &Path,
+    started: Instant,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Summary, SimError> {
     let recordings = out_dir.join(RECORDINGS_DIR);
     let truth = out_dir.join(TRUTH_DIR);
     for dir in [&recordings, &truth] {
@@ -126,7 +143,11 @@ pub fn simulate_campaign(
     let networks = units
         .iter()
         .map(|u| {
-            u.thermal.network().map_err(|reason| SimError::Physics {
+            let network = match world {
+                Some((w, _)) => u.thermal.network_with(&w.links),
+                None => u.thermal.network(),
+            };
+            network.map_err(|reason| SimError::Physics {
                 unit: u.unit_id.clone(),
                 reason,
             })
@@ -135,7 +156,7 @@ pub fn simulate_campaign(
     // The thermal state is stepped exactly on the 100 Hz auxiliary grid (see engine).
     let grid_s = 1.0 / f64::from(drift_recording::AUX_RATE_HZ);
     let steps: Vec<_> = networks.iter().map(|n| n.discretise(grid_s)).collect();
-    for plan in &plans {
+    for (file, plan) in plans.iter().enumerate() {
         let u = plan.unit_index as usize;
         let sim = FileSim {
             campaign: c,
@@ -143,6 +164,8 @@ pub fn simulate_campaign(
             network: &networks[u],
             step: &steps[u],
             plan,
+            world: world.map(|(w, _)| w),
+            world_aux: world.and_then(|(_, aux)| aux.get(file)).map_or(&[], |a| a),
         };
         let rec_path = recordings.join(format!("{}.mcap", plan.stem));
         let truth_path = truth.join(format!("{}.{TRUTH_EXTENSION}", plan.stem));

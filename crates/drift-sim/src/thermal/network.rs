@@ -66,6 +66,12 @@ pub struct ThermalParams {
 impl ThermalParams {
     /// Builds the solvable network.
     pub fn network(&self) -> Result<RcNetwork, String> {
+        self.network_with(&[])
+    }
+
+    /// Builds the solvable network with extra conductances `(node, node, W/K)` added after the
+    /// unit's own links (node indices as [`asic`], [`element`], [`HOUSING`], [`BOARD`]).
+    pub fn network_with(&self, extra_links: &[(usize, usize, f64)]) -> Result<RcNetwork, String> {
         let mut capacity = [0.0; NODES];
         let mut between = [0.0; NODES * NODES];
         let mut to_ambient = [0.0; NODES];
@@ -88,6 +94,14 @@ impl ThermalParams {
                     link(element(a), asic(b), self.cross_axis_w_per_k);
                 }
             }
+        }
+        for &(a, b, g) in extra_links {
+            if a >= NODES || b >= NODES || a == b {
+                return Err(format!(
+                    "extra link {a} ↔ {b}: nodes must differ and be < {NODES}"
+                ));
+            }
+            link(a, b, g);
         }
         RcNetwork::new(&capacity, &between, &to_ambient)
     }

@@ -1,0 +1,56 @@
+//! The worlds benchmark end to end on its smoke size: one effect world and one null world,
+//! recorded, closed blind, scored against the truth; the table has its rows. Whether the loop
+//! finds the effect is the benchmark's measurement, not this test's.
+
+use drift_sim::world::effects::EffectFamily;
+use experiments::worlds::{run_world, table, Kind};
+
+#[test]
+fn one_effect_world_and_one_null_world_are_scored_into_the_table() {
+    let work = tempfile::tempdir().unwrap();
+    let kinds = [Kind::Effect(EffectFamily::Humidity), Kind::Null];
+    let scores: Vec<_> = kinds
+        .iter()
+        .map(|&kind| run_world(kind, 3, work.path(), true).unwrap())
+        .collect();
+    for s in &scores {
+        assert_eq!(s.axes.len(), 3);
+        for a in &s.axes {
+            assert!(a.drift.0.is_finite() && a.drift.1.is_finite() && a.drift.2.is_finite());
+            assert!(!a.cut.ratio.is_nan(), "{s:?}");
+            assert!(a.top != "–", "a ranking on every axis: {s:?}");
+        }
+        assert!(s.record_seconds > 0.0 && s.loop_seconds > 0.0);
+    }
+    // A humidity world moves every axis; a null world none.
+    assert!(scores[0].axes.iter().all(|a| a.affected));
+    assert!(scores[1]
+        .axes
+        .iter()
+        .all(|a| !a.affected && !a.right_family));
+    // Nothing of a world is left on disk (the empty truth folder aside).
+    let left: Vec<_> = walk(work.path());
+    assert!(left.is_empty(), "left behind: {left:?}");
+    let text = table(&scores, &[], &kinds);
+    for row in [
+        "| humidity | 1 | 3 |",
+        "| null | 1 | 3 |",
+        "| humidity | 1 | 0 |",
+        "| null | 1 | 0 |",
+    ] {
+        assert!(text.contains(row), "no `{row}` in\n{text}");
+    }
+}
+
+fn walk(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap().filter_map(Result::ok) {
+        let path = entry.path();
+        if path.is_dir() {
+            files.extend(walk(&path));
+        } else {
+            files.push(path);
+        }
+    }
+    files
+}
