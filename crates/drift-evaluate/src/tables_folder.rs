@@ -3,7 +3,7 @@
 //! the `.bin` the checksummed firmware image (`drift_core::blob`).
 //!
 //! `gyrodrift fit`, `gyrodrift report`, `gyrodrift diagnose --extend` and Python's
-//! `FittedUnit.save` all write through [`write`], so their folders are the same bytes.
+//! `FittedUnit.save` all write through [`write()`], so their folders are the same bytes.
 
 use std::path::{Path, PathBuf};
 
