@@ -31,6 +31,11 @@ pub struct StartRates {
     pub element: [f32; 3],
 }
 
+/// The temperature an auxiliary channel's sensitivity is measured from, °C: the data sheets'
+/// room temperature. Any other constant changes an interaction only by the channel itself, which
+/// is a candidate of its own.
+pub const REFERENCE_CELSIUS: f64 = 25.0;
+
 /// The auxiliary channel holding the chamber's set point (the ambient the unit is kept at).
 pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
 
@@ -57,6 +62,23 @@ pub enum Kind {
         /// The low-pass's time constant (the element's lag), s.
         time_constant_s: u32,
     },
+    /// A recorded auxiliary channel times the axis's own rise since switch-on (channel unit × °C):
+    /// a sensitivity to the channel that grows as the unit heats (g-sensitivity or supply
+    /// sensitivity with a temperature coefficient of its own).
+    AuxTimesRise(String),
+    /// A recorded auxiliary channel times the axis's own sensor temperature less
+    /// [`REFERENCE_CELSIUS`] (channel unit × °C): the same sensitivity, growing with the
+    /// temperature itself rather than with the heating, so it also differs between ambients.
+    AuxTimesTemperature(String),
+    /// Another axis's temperature rate through the element's lag (°C/s; the axis `offset` places
+    /// further on, τ from [`ELEMENT_RATE_TIME_CONSTANTS_S`]): a bias that follows a neighbour's
+    /// heating, as a shared substrate or a capsule's gas would carry it.
+    OtherAxisRate {
+        /// The axis `offset` (1 or 2) places further on.
+        offset: usize,
+        /// The low-pass's time constant, s.
+        time_constant_s: u32,
+    },
     /// The axis's own temperature rise since switch-on, squared, °C².
     RiseSquared,
     /// Another axis's rise since switch-on, °C: the axis `offset` (1 or 2) places further on.
@@ -75,7 +97,14 @@ pub enum Kind {
 impl Kind {
     /// Every kind a segment with these auxiliary channels offers.
     pub fn all(aux_channels: impl IntoIterator<Item = String>, has_set_point: bool) -> Vec<Self> {
-        let mut kinds: Vec<Self> = aux_channels.into_iter().map(Self::Aux).collect();
+        let channels: Vec<String> = aux_channels.into_iter().collect();
+        let mut kinds: Vec<Self> = channels.iter().cloned().map(Self::Aux).collect();
+        // The chamber's set point is constant over a recording: its interactions are what stage 2
+        // (the ambient) and stage 3 (the rise) already read.
+        for channel in channels.iter().filter(|c| *c != SET_POINT_CHANNEL) {
+            kinds.push(Self::AuxTimesRise(channel.clone()));
+            kinds.push(Self::AuxTimesTemperature(channel.clone()));
+        }
         kinds.extend(
             SENSOR_RATE_TIME_CONSTANTS_S
                 .map(|time_constant_s| Self::TemperatureRate { time_constant_s }),
@@ -84,6 +113,14 @@ impl Kind {
             ELEMENT_RATE_TIME_CONSTANTS_S
                 .map(|time_constant_s| Self::ElementRate { time_constant_s }),
         );
+        for offset in [1, 2] {
+            kinds.extend(
+                ELEMENT_RATE_TIME_CONSTANTS_S.map(|time_constant_s| Self::OtherAxisRate {
+                    offset,
+                    time_constant_s,
+                }),
+            );
+        }
         kinds.extend([
             Self::RiseSquared,
             Self::OtherAxisRise(1),
@@ -109,6 +146,17 @@ impl Kind {
             Self::ElementRate { time_constant_s } => {
                 format!("element rate {own} (τ {time_constant_s} s)")
             }
+            Self::AuxTimesRise(channel) => format!("aux:{channel} × rise {own}"),
+            Self::AuxTimesTemperature(channel) => {
+                format!("aux:{channel} × temperature {own} (from {REFERENCE_CELSIUS} °C)")
+            }
+            Self::OtherAxisRate {
+                offset,
+                time_constant_s,
+            } => format!(
+                "element rate {} on {own} (τ {time_constant_s} s)",
+                AXES[(axis + offset) % 3]
+            ),
             Self::RiseSquared => format!("rise² {own}"),
             Self::OtherAxisRise(offset) => format!("rise {}", AXES[(axis + offset) % 3]),
             Self::SinceSwitchOn => "time since switch-on".into(),
@@ -118,16 +166,18 @@ impl Kind {
         }
     }
 
-    /// The low-pass time constant, s, of a rate candidate's name (what [`Self::name`] writes:
-    /// "temperature rate X (τ 8 s)", "element rate X (τ 30 s)"); `None` for any other name.
+    /// The low-pass time constant, s, of an own-axis rate candidate's name (what [`Self::name`]
+    /// writes: "temperature rate X (τ 8 s)", "element rate X (τ 30 s)"); `None` for any other
+    /// name, another axis's rate ("element rate Y on X (τ 30 s)") included.
     pub fn rate_time_constant_s(name: &str) -> Option<u32> {
-        name.strip_prefix("temperature rate ")
+        let (axis, tau) = name
+            .strip_prefix("temperature rate ")
             .or_else(|| name.strip_prefix("element rate "))?
-            .split_once("(τ ")?
-            .1
-            .strip_suffix(" s)")?
-            .parse()
-            .ok()
+            .split_once(" (τ ")?;
+        if !AXES.contains(&axis) {
+            return None;
+        }
+        tau.strip_suffix(" s)")?.parse().ok()
     }
 
     /// Whether a rate candidate's name is the element's rate (its filter starts without the
@@ -160,22 +210,56 @@ impl Kind {
             .map(|r| r / RAW_PER_CELSIUS - on_celsius[axis])
             .collect()
         };
-        match self {
-            Self::Aux(channel) => {
-                let channel = segment.aux.get(channel)?;
-                if channel.values.is_empty() {
-                    return None;
-                }
-                let ratio = f64::from(channel.sample_rate_hz) / rate_hz;
-                same(
-                    (0..n)
-                        .map(|i| {
-                            let at = ((i as f64 * ratio) as usize).min(channel.values.len() - 1);
-                            channel.values[at]
-                        })
-                        .collect(),
-                )
+        let aux = |name: &str| -> Option<Vec<f64>> {
+            let channel = segment.aux.get(name)?;
+            if channel.values.is_empty() {
+                return None;
             }
+            let ratio = f64::from(channel.sample_rate_hz) / rate_hz;
+            Some(
+                (0..n)
+                    .map(|i| {
+                        let at = ((i as f64 * ratio) as usize).min(channel.values.len() - 1);
+                        f64::from(channel.values[at])
+                    })
+                    .collect(),
+            )
+        };
+        let times = |channel: &[f64], heat: Vec<f64>| -> Vec<f32> {
+            channel
+                .iter()
+                .zip(heat)
+                .map(|(c, h)| (c * h) as f32)
+                .collect()
+        };
+        match self {
+            Self::Aux(channel) => same(aux(channel)?.into_iter().map(|v| v as f32).collect()),
+            Self::AuxTimesRise(channel) => {
+                let channel = aux(channel)?;
+                per_axis(&|axis| times(&channel, rise(axis)))
+            }
+            Self::AuxTimesTemperature(channel) => {
+                let channel = aux(channel)?;
+                per_axis(&|axis| {
+                    let from_reference = rise(axis)
+                        .into_iter()
+                        .map(|r| r + on_celsius[axis] - REFERENCE_CELSIUS)
+                        .collect();
+                    times(&channel, from_reference)
+                })
+            }
+            Self::OtherAxisRate {
+                offset,
+                time_constant_s,
+            } => per_axis(&|axis| {
+                let other = (axis + offset) % 3;
+                filtered_rate(
+                    &rise(other),
+                    f64::from(*time_constant_s),
+                    1.0 / rate_hz,
+                    f64::from(start.element[other]),
+                )
+            }),
             Self::TemperatureRate { time_constant_s } | Self::ElementRate { time_constant_s } => {
                 let from = match self {
                     Self::ElementRate { .. } => &start.element,
@@ -268,6 +352,18 @@ mod tests {
         ] {
             assert_eq!(Kind::rate_time_constant_s(&other), None, "{other}");
             assert!(!Kind::is_element_rate(&other), "{other}");
+        }
+        let neighbour = Kind::OtherAxisRate {
+            offset: 1,
+            time_constant_s: 30,
+        };
+        assert_eq!(neighbour.name(0), "element rate Y on X (τ 30 s)");
+        assert_eq!(Kind::rate_time_constant_s(&neighbour.name(0)), None);
+        for kind in [
+            Kind::AuxTimesRise("supply_voltage".into()),
+            Kind::AuxTimesTemperature("supply_voltage".into()),
+        ] {
+            assert_eq!(Kind::rate_time_constant_s(&kind.name(2)), None);
         }
     }
 

@@ -11,15 +11,17 @@
 //! explains is then left with nothing to explain, and what is left is exactly what a term in that
 //! candidate would add to the paper's model.
 //!
-//! Score: out-of-sample explained variance of the residual, cross-validated by activation
-//! (K folds of whole activations, never samples), for a one-coefficient linear term. Significance:
+//! Score: out-of-sample explained variance of the residual, cross-validated by series (K folds of
+//! whole series of activations, never samples or single activations of a series), for a
+//! one-coefficient linear term. Significance:
 //! per-activation reductions of squared error on held-out activations, one-sided t-test of their
 //! mean against zero, Bonferroni-corrected over every candidate of the axis. Activations are the
 //! independent samples; the noise inside one is strongly autocorrelated. A candidate is significant
-//! only if it also lowers the *whole* held-out residual (offsets and shape, no activation means
-//! taken out) at the same level: a firmware term changes both, and a candidate left over from
-//! what the tables almost wholly absorb (rise², the rises) can match the tables' own lookup error
-//! in shape while a term in it makes the whole error no smaller.
+//! only if its coefficient has the same sign in every fold, and it either also lowers the *whole*
+//! held-out residual (offsets and shape, no activation means taken out) at the same level or
+//! explains most of the residual out of sample: a candidate left over from what the tables almost
+//! wholly absorb (rise², the rises) can match the tables' own lookup error in shape while a term
+//! in it makes the whole error no smaller.
 //!
 //! The model whose residual is diagnosed is the loop's: the paper's tables with stage 3 keyed by
 //! rise or by heating history per axis, as [`crate::closing`] chose ([`Keying`]).
@@ -222,6 +224,10 @@ impl AxisDiagnosis {
     }
 }
 
+/// Out-of-sample share of the residual's variance beyond which a candidate, stable across the
+/// folds, needs no whole-residual test to be significant.
+const EXPLAINS_MOST: f64 = 0.5;
+
 /// A candidate whose variance the paper's tables explain beyond this share is the table's already.
 const ABSORBED: f64 = 0.999;
 
@@ -283,17 +289,48 @@ struct Score {
     /// activation): the paper's metric, which an offset cannot move.
     drift_p_value: f64,
     coefficient: f64,
+    /// Every fold's coefficient has the same sign: the relation does not hang on one series.
+    stable: bool,
 }
 
-/// Scores one candidate on groups of points (one group per activation), cross-validated by
-/// group: the explained share, the p-values of the held-out squared residual's and drift's
-/// reductions, and the coefficient on all data.
-fn score(groups: &[Vec<Point>], folds: usize) -> Score {
+/// Which fold each activation is held out in: whole series together (a series' activations share
+/// their unit, set point and off-times, so one held out beside its siblings in the training set
+/// would be judged by what it has in common with them), `folds` folds; activation by activation
+/// when there are fewer series than folds.
+pub fn series_folds(activations: &[ActivationSeries], folds: usize) -> (Vec<usize>, usize) {
+    let key = |a: &ActivationSeries| {
+        (
+            a.labels.unit_id.clone(),
+            (a.labels.set_point_celsius * 1000.0).round() as i64,
+            a.labels.series_kind.as_str(),
+            a.labels.series,
+        )
+    };
+    let mut series: Vec<_> = activations.iter().map(key).collect();
+    series.sort();
+    series.dedup();
+    if series.len() >= folds.max(2) {
+        let fold = activations
+            .iter()
+            .map(|a| series.binary_search(&key(a)).unwrap_or(0) % folds)
+            .collect();
+        (fold, folds)
+    } else {
+        let folds = folds.clamp(2, activations.len().max(2));
+        ((0..activations.len()).map(|i| i % folds).collect(), folds)
+    }
+}
+
+/// Scores one candidate on groups of points (one group per activation), cross-validated with
+/// `fold[i]` the fold group `i` is held out in: the explained share, the p-values of the held-out
+/// squared residual's and drift's reductions, the coefficient on all data, and whether every
+/// fold's coefficient has the same sign.
+fn score(groups: &[Vec<Point>], fold_of: &[usize], folds: usize) -> Score {
     let finite = |p: &&Point| p.0.is_finite() && p.1.is_finite();
     let all: Vec<&Point> = groups.iter().flatten().filter(finite).collect();
     let mean_y = all.iter().map(|p| p.0).sum::<f64>() / all.len().max(1) as f64;
     let total: f64 = all.iter().map(|p| (p.0 - mean_y).powi(2)).sum();
-    let folds = folds.clamp(2, groups.len().max(2));
+    let mut signs = (0usize, 0usize);
     let mut improvements = Vec::with_capacity(groups.len());
     let mut drift_gains = Vec::with_capacity(groups.len());
     let mut sse = 0.0;
@@ -301,12 +338,17 @@ fn score(groups: &[Vec<Point>], folds: usize) -> Score {
         let train: Vec<&Vec<Point>> = groups
             .iter()
             .enumerate()
-            .filter(|(i, _)| i % folds != fold)
+            .filter(|(i, _)| fold_of.get(*i) != Some(&fold))
             .map(|(_, g)| g)
             .collect();
         let Some((slope, intercept)) = line(&train) else {
             continue;
         };
+        if slope > 0.0 {
+            signs.0 += 1;
+        } else if slope < 0.0 {
+            signs.1 += 1;
+        }
         let intercept_only = mean(
             train
                 .iter()
@@ -317,7 +359,7 @@ fn score(groups: &[Vec<Point>], folds: usize) -> Score {
         for group in groups
             .iter()
             .enumerate()
-            .filter(|(i, _)| i % folds == fold)
+            .filter(|(i, _)| fold_of.get(*i) == Some(&fold))
             .map(|(_, g)| g)
         {
             let (mut without, mut with, mut n) = (0.0, 0.0, 0usize);
@@ -346,6 +388,7 @@ fn score(groups: &[Vec<Point>], folds: usize) -> Score {
         p_value,
         drift_p_value,
         coefficient,
+        stable: signs.0 == 0 || signs.1 == 0,
     }
 }
 
@@ -386,6 +429,8 @@ pub fn diagnose_axis(
             .flat_map(|a| a.residual_dps[axis].iter().map(|y| y * y)),
     )
     .sqrt();
+    let (fold_of, folds) = series_folds(activations, folds);
+    let mut stable = BTreeMap::new();
     let mut ranking: Vec<CandidateScore> = names
         .iter()
         .map(|name| {
@@ -430,9 +475,9 @@ pub fn diagnose_axis(
                     y.iter().copied().zip(c.iter().copied()).collect()
                 })
                 .collect();
-            let within = score(&within, folds);
-            let between = score(&between, folds);
-            candidate.whole_p_value = score(&whole, folds).p_value;
+            let within = score(&within, &fold_of, folds);
+            let between = score(&between, &fold_of, folds);
+            candidate.whole_p_value = score(&whole, &fold_of, folds).p_value;
             // Only a shape has a drift; the between level's one point per activation has none.
             candidate.drift_p_value = within.drift_p_value;
             let (best, level) = if within.p_value <= between.p_value {
@@ -440,6 +485,7 @@ pub fn diagnose_axis(
             } else {
                 (between, "between activations")
             };
+            stable.insert(name.clone(), best.stable);
             (
                 candidate.explained,
                 candidate.p_value,
@@ -452,10 +498,17 @@ pub fn diagnose_axis(
     let bonferroni = alpha / (2 * ranking.len()).max(1) as f64;
     for c in &mut ranking {
         // The drift's p-value is reported, not tested: in the null case the paper's own gap (the
-        // element lagging the sensor) passes it on many axes,
-        // and the element's heating rate is offered to the guard on every axis anyway
-        // (`TermPlan::choose`).
-        c.significant = c.p_value < bonferroni && c.whole_p_value < bonferroni && c.explained > 0.0;
+        // element lagging the sensor) passes it on many axes, and the element's heating rate is
+        // offered to the guard on every axis anyway (`TermPlan::choose`). The whole residual's
+        // test guards against a candidate that matches the tables' own lookup error in shape
+        // while a term in it leaves the whole error no smaller; a candidate that explains most of
+        // the residual out of sample, with the same sign in every fold, has shown what that test
+        // asks for and passes without it.
+        let whole = c.whole_p_value < bonferroni || c.explained >= EXPLAINS_MOST;
+        c.significant = c.p_value < bonferroni
+            && whole
+            && c.explained > 0.0
+            && stable.get(&c.name).copied().unwrap_or(false);
     }
     // Significant first, then by explained share.
     ranking.sort_by(|a, b| {
@@ -495,7 +548,8 @@ mod tests {
                 .collect()
         };
         let ramp: Vec<Vec<Point>> = (0..20).map(|k| activation(k, &|ramp| ramp)).collect();
-        let shape = score(&ramp, 5);
+        let folds: Vec<usize> = (0..ramp.len()).map(|i| i % 5).collect();
+        let shape = score(&ramp, &folds, 5);
         assert!(
             shape.drift_p_value < 1e-3 && shape.p_value < 1e-3,
             "{}",
@@ -504,7 +558,7 @@ mod tests {
         let unrelated: Vec<Vec<Point>> = (0..20)
             .map(|k| activation(k, &|ramp| (13.0 * ramp).cos()))
             .collect();
-        assert!(score(&unrelated, 5).drift_p_value > 0.05);
+        assert!(score(&unrelated, &folds, 5).drift_p_value > 0.05);
         assert_eq!(spread([1.0, f64::NAN, -2.0]), 3.0);
         assert_eq!(spread([]), 0.0);
     }

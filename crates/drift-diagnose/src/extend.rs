@@ -101,6 +101,11 @@ impl TermPlan {
             });
         }
         let channel = candidate.strip_prefix("aux:")?;
+        // An interaction (`aux:supply_voltage × rise X`) has no firmware term yet: diagnosed,
+        // reported, not added.
+        if channel.contains(' ') {
+            return None;
+        }
         // The chamber's set point is the bench's ambient: a unit in the field has no chamber to
         // ask, and the paper's tables already index the ambient (by the switch-on temperature).
         if channel == SET_POINT_CHANNEL {
