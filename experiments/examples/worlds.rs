@@ -5,7 +5,7 @@
 //! ```sh
 //! cargo run --release -p experiments --example worlds -- [--families all|humidity,…] \
 //!     [--worlds-per-family 20] [--null-worlds 30] [--first-seed 10000] [--jobs 1] \
-//!     [--out table.md] [--small]
+//!     [--out table.md] [--json scores.jsonl] [--small]
 //! ```
 //!
 //! World k of every family (and null world k) is drawn from seed `first-seed + k`: the same unit
@@ -25,7 +25,7 @@ use experiments::worlds::{
 };
 
 const USAGE: &str = "worlds [--families all|accelerometer,humidity,…] [--worlds-per-family 20] \
-[--null-worlds 30] [--first-seed 10000] [--jobs 1] [--out table.md] [--small]";
+[--null-worlds 30] [--first-seed 10000] [--jobs 1] [--out table.md] [--json scores.jsonl] [--small]";
 
 /// The value after `flag`.
 fn value(args: &[String], flag: &str) -> Option<String> {
@@ -129,13 +129,14 @@ fn main() -> anyhow::Result<()> {
     }
     let small = args.iter().any(|a| a == "--small");
     let rest: Vec<&String> = args.iter().filter(|a| *a != "--small").collect();
-    const FLAGS: [&str; 6] = [
+    const FLAGS: [&str; 7] = [
         "--families",
         "--worlds-per-family",
         "--null-worlds",
         "--first-seed",
         "--jobs",
         "--out",
+        "--json",
     ];
     for pair in rest.chunks(2) {
         anyhow::ensure!(
@@ -159,6 +160,9 @@ fn main() -> anyhow::Result<()> {
     let first: u64 = number(&args, "--first-seed", DEFAULT_FIRST_SEED)?;
     let jobs: usize = number(&args, "--jobs", 1usize)?.max(1);
     let out: Option<PathBuf> = value(&args, "--out").map(PathBuf::from);
+    // Every world's score with its whole ranking, one JSON line each: what the significance
+    // threshold is calibrated from (experiments/null_threshold.py).
+    let json: Option<PathBuf> = value(&args, "--json").map(PathBuf::from);
 
     let mut kinds: Vec<Kind> = families.iter().map(|&f| Kind::Effect(f)).collect();
     if nulls > 0 {
@@ -247,6 +251,14 @@ fn main() -> anyhow::Result<()> {
     println!("{text}");
     for f in &failures {
         println!("- failed: {} seed {}: {}", f.kind, f.seed, f.error);
+    }
+    if let Some(path) = json {
+        let lines: Vec<String> = scores
+            .iter()
+            .map(serde_json::to_string)
+            .collect::<Result<_, _>>()?;
+        std::fs::write(&path, lines.join("\n") + "\n")
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = out {
         let mut body = text;

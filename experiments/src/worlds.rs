@@ -45,8 +45,6 @@ pub const NEGLIGIBLE_DPS: f64 = 1.5e-4;
 const ELEMENT_RATE_SPAN_C_PER_S: f64 = 0.04;
 /// An extended model is "worse" on a null axis when its drift excess cut is surely below this.
 pub const WORSE_BELOW: f64 = 0.9;
-/// Candidates kept per axis (best first) in the loop's outcome.
-const KEPT_CANDIDATES: usize = 3;
 const AXES: [&str; 3] = ["X", "Y", "Z"];
 
 /// What a world is drawn with: one effect family, or none.
@@ -214,8 +212,21 @@ pub fn record(kind: Kind, seed: u64, paths: &WorldPaths, small: bool) -> anyhow:
 pub struct Ranked {
     /// Its name.
     pub name: String,
-    /// Significant (Bonferroni, at its level and on the whole residual).
+    /// Significant (family-wise by shuffling, `drift_diagnose::permutation`).
     pub significant: bool,
+    /// Its family-wise p-value.
+    #[serde(default)]
+    pub family_p_value: f64,
+    /// Out-of-sample share of the residual's variance it explains.
+    pub explained: f64,
+    /// One-sided p-value of the held-out improvement at its level.
+    pub p_value: f64,
+    /// The same on the whole residual.
+    pub whole_p_value: f64,
+    /// Same coefficient sign in every fold.
+    pub stable: bool,
+    /// Coefficient, (°/s) per candidate unit.
+    pub coefficient: f64,
 }
 
 /// What the loop said on one axis, and what it measured there.
@@ -225,6 +236,9 @@ pub struct AxisOutcome {
     pub ranking: Vec<Ranked>,
     /// Whether any candidate on the axis is significant.
     pub any_significant: bool,
+    /// The explained share a candidate had to exceed to be significant on this axis.
+    #[serde(default)]
+    pub detectable_share: f64,
     /// Terms the guard admitted on the axis.
     pub admitted: Vec<String>,
     /// Drift (max − min of the 1-s mean) of each held-out +33 °C field activation, paper's model,
@@ -290,13 +304,19 @@ pub fn close_blind(
                 ranking: diagnosis
                     .ranking
                     .iter()
-                    .take(KEPT_CANDIDATES)
                     .map(|c| Ranked {
                         name: c.name.clone(),
                         significant: c.significant,
+                        family_p_value: c.family_p_value,
+                        explained: c.explained,
+                        p_value: c.p_value,
+                        whole_p_value: c.whole_p_value,
+                        stable: c.stable,
+                        coefficient: c.coefficient,
                     })
                     .collect(),
                 any_significant: diagnosis.ranking.iter().any(|c| c.significant),
+                detectable_share: diagnosis.detectable_share,
                 admitted: closed
                     .extended
                     .iter()
@@ -408,10 +428,15 @@ pub struct AxisScore {
     pub right_family_admitted: bool,
     /// Whether anything on the axis is significant.
     pub any_significant: bool,
+    /// The explained share a candidate had to exceed to be significant on this axis.
+    pub detectable_share: f64,
     /// Terms admitted on the axis.
     pub admitted: Vec<String>,
     /// Mean drift before, after, and the floor's, °/s.
     pub drift: (f64, f64, f64),
+    /// Every candidate as the loop ranked it, best first, with whether it names the world's
+    /// family: what a threshold calibrated on null worlds is computed from.
+    pub ranking: Vec<(Ranked, bool)>,
     /// The drift excess cut over the floor with its 95 % interval.
     pub cut: ExcessCut,
 }
@@ -490,8 +515,14 @@ pub fn score(
                 right_family: top.is_some_and(|c| names(&c.name)),
                 right_family_admitted: o.admitted.iter().any(|c| names(c)),
                 any_significant: o.any_significant,
+                detectable_share: o.detectable_share,
                 admitted: o.admitted.clone(),
                 drift: (mean(&o.before_dps), mean(&o.after_dps), mean(&o.floor_dps)),
+                ranking: o
+                    .ranking
+                    .iter()
+                    .map(|c| (c.clone(), names(&c.name)))
+                    .collect(),
                 cut: excess_cut(&o.before_dps, &o.after_dps, &o.floor_dps),
             }
         })

@@ -196,28 +196,31 @@ fn profile_markdown(profiles: &[Profile]) -> String {
 
 /// The ranking as Markdown.
 pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
-    let mut md = String::from("## Diagnosis of the residual after the loop's model (stage 3 and the initial bias as chosen above)\n\nCandidates ranked by out-of-sample explained variance (5-fold cross-validation by activation), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: one-sided test of the held-out improvement per activation at the candidate's level (p) and of the whole residual, offsets and shape together (p whole: what a firmware term changes), both under Bonferroni over the axis's candidates, family-wise α = 0.05.\n\n");
+    let mut md = String::from("## Diagnosis of the residual after the loop's model (stage 3 and the initial bias as chosen above)\n\nCandidates ranked by out-of-sample explained share of the residual's variance (cross-validated with whole series held out together, at the better of two levels: shapes within activations, offsets between them; 0 when the folds' coefficients disagree in sign), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: family-wise α = 0.05 by shuffling — the candidates are shuffled among activations of the same unit and set point 99 times, and a candidate is significant when the best of all candidates reached its share in at most 5 % of the shuffles (p family). *Detectable*: the share a candidate must exceed to be significant with these activations; a smaller effect cannot be told from chance here. The per-activation t-tests at the candidate's level (p) and on the whole residual (p whole: offsets and shape together, what a firmware term changes) are shown, not gated on.\n\n");
     for axis in axes {
         let _ = writeln!(
             md,
-            "### Axis {} ({} activations, residual RMS {:.4} °/s): {}\n",
+            "### Axis {} ({} activations, residual RMS {:.4} °/s, detectable share {:.3}): {}\n",
             axis.axis,
             axis.activations,
             axis.residual_rms_dps,
-            axis.chosen().map_or(
-                "no significant systematic effect left".to_owned(),
-                |c| format!("**{}**", c.name)
-            )
+            axis.detectable_share,
+            axis.chosen()
+                .map_or("nothing beyond chance".to_owned(), |c| format!(
+                    "**{}**",
+                    c.name
+                ))
         );
-        md.push_str("| rank | candidate | level | explained | p | p whole | significant | coefficient | absorbed by the model |\n|---:|---|---|---:|---:|---:|:---:|---:|---:|\n");
+        md.push_str("| rank | candidate | level | explained | p family | p | p whole | significant | coefficient | absorbed by the model |\n|---:|---|---|---:|---:|---:|---:|:---:|---:|---:|\n");
         for (i, c) in axis.ranking.iter().take(top).enumerate() {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {:.3} | {:.1e} | {:.1e} | {} | {:.3e} | {:.3} |",
+                "| {} | {} | {} | {:.3} | {:.2} | {:.1e} | {:.1e} | {} | {:.3e} | {:.3} |",
                 i + 1,
                 c.name,
                 c.level,
                 c.explained,
+                c.family_p_value,
                 c.p_value,
                 c.whole_p_value,
                 if c.significant { "yes" } else { "" },
@@ -490,20 +493,31 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         }
         for axis in axes.iter() {
-            let chosen = axis
-                .chosen()
-                .map_or("no significant systematic effect left".to_owned(), |c| {
-                    format!("{} (explains {:.0} %)", c.name, 100.0 * c.explained)
-                });
+            let chosen = axis.chosen().map_or_else(
+                || {
+                    format!(
+                        "nothing beyond chance (with these activations only an effect explaining more than {:.0} % of the residual would show)",
+                        100.0 * axis.detectable_share
+                    )
+                },
+                |c| {
+                    format!(
+                        "{} (explains {:.0} %; chance reaches {:.0} % in 5 % of shuffles)",
+                        c.name,
+                        100.0 * c.explained,
+                        100.0 * axis.detectable_share
+                    )
+                },
+            );
             println!("  {}: {chosen}", axis.axis);
             for (i, c) in axis.ranking.iter().take(args.top).enumerate() {
                 println!(
-                    "     {}. {:<42} {:<20} explained {:>6.3}  p {:.1e}{}",
+                    "     {}. {:<42} {:<20} explained {:>6.3}  p family {:.2}{}",
                     i + 1,
                     c.name,
                     c.level,
                     c.explained,
-                    c.p_value,
+                    c.family_p_value,
                     if c.significant { "  *" } else { "" }
                 );
             }

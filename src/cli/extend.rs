@@ -85,14 +85,8 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
     };
     let _ = writeln!(
         md,
-        "Guard: each proposed term is admitted on an axis only if the refitted model with it (coefficients and tables fitted without the held-out fold) does better on held-out activations among the {} field-like activations at the calibration set points within the calibrated ambient range (5-fold cross-validation by activation, against the terms admitted before it; one-sided test, Bonferroni over every term and axis, family-wise 5 %). An auxiliary input, which moves offsets between activations, must lower the squared residual without making the paper's drift metric significantly worse (one-sided, 5 %, by more than 1 %). A term that changes the shape within activations (temperature rate, rise², another axis's rise) must lower the drift without making the squared residual significantly worse. The element's heating rate is proposed on every unit ({}): the sensing element lags the temperature sensor, a gap of the paper's model on every such unit, and its shape is what the drift sees.\n",
+        "Guard: each proposed term is admitted on an axis only if the refitted model with it (coefficients and tables fitted without the held-out fold) does better on held-out activations among the {} field-like activations at the calibration set points within the calibrated ambient range (5-fold cross-validation by activation, against the terms admitted before it; one-sided test, Bonferroni over every term and axis, family-wise 5 %). An auxiliary input, which moves offsets between activations, must lower the squared residual without making the paper's drift metric significantly worse (one-sided, 5 %, by more than 1 %). A term that changes the shape within activations (temperature rate, rise², another axis's rise) must lower the drift without making the squared residual significantly worse.\n",
         training.len(),
-        closed
-            .proposed
-            .terms
-            .iter()
-            .find(|t| t.standing)
-            .map_or("none this time: a rate candidate was significant, the tables absorb every one, or four terms leave no room", |t| t.candidate.as_str())
     );
     md.push_str(
         "| term | axis | held-out gain, (°/s)² | p | held-out drift gain, °/s | p drift | admitted |\n|---|---|---:|---:|---:|---:|:---:|\n",

@@ -58,6 +58,16 @@ pub enum Term {
     },
     /// The axis's own rise since switch-on, squared, °C².
     RiseSquared,
+    /// Auxiliary input `input`, low-passed as [`Term::Aux`] is, times the axis's own rise since
+    /// switch-on (input unit × °C): a sensitivity to the input that grows as the unit heats (a
+    /// g-sensitivity or supply sensitivity with a temperature coefficient of its own). 0 before
+    /// the input's first finite value.
+    AuxTimesRise {
+        /// Index into the auxiliary inputs.
+        input: u8,
+        /// The input's low-pass time constant, milliseconds (0: unfiltered).
+        time_constant_ms: u32,
+    },
 }
 
 /// One extra term: its kind, and per axis its centre (the term's calibration mean) and coefficient.
@@ -196,7 +206,7 @@ impl Extension {
                     }
                     None
                 }
-                Term::Aux { input, .. } => {
+                Term::Aux { input, .. } | Term::AuxTimesRise { input, .. } => {
                     (usize::from(input) >= AUX_INPUTS).then_some(("term_input", AUX_INPUTS))
                 }
                 Term::AxisRise { axis } => {
@@ -253,8 +263,8 @@ pub struct ExtensionState {
     /// than a temperature (~30 °C: 2e-6 °C), so the rate's rounding stays below 1e-5 °C/s at
     /// 1 kHz.
     filtered_rise: [f32; AXES],
-    /// Per term, the low-passed auxiliary input ([`Term::Aux`]; unused by other kinds): NaN until
-    /// the first finite input, then held through non-finite ones.
+    /// Per term, the low-passed auxiliary input ([`Term::Aux`], [`Term::AuxTimesRise`]; unused by
+    /// other kinds): NaN until the first finite input, then held through non-finite ones.
     aux: [f32; MAX_TERMS],
     /// Time of the previous sample, ms since switch-on.
     last_ms: u32,
@@ -356,6 +366,14 @@ impl ExtensionState {
                 }
                 Term::AxisRise { axis } => [shared(&inputs.rise_celsius, axis); AXES],
                 Term::RiseSquared => inputs.rise_celsius.map(|rise| rise * rise),
+                Term::AuxTimesRise {
+                    input,
+                    time_constant_ms,
+                } => {
+                    let input = shared(&inputs.aux, input);
+                    let tau_ms = time_constant_ms.min(previous_ms);
+                    aux_times_rise(held, term, input, tau_ms, elapsed_ms, &inputs.rise_celsius).0
+                }
             };
             for ((axis_values, raw), centre) in values.iter_mut().zip(raw).zip(term.centre) {
                 if let Some(value) = axis_values.get_mut(t) {
@@ -411,6 +429,22 @@ impl ExtensionState {
                 }
                 Term::AxisRise { axis } => add([shared(rise_celsius, axis); AXES]),
                 Term::RiseSquared => add(rise_celsius.map(|rise| rise * rise)),
+                Term::AuxTimesRise {
+                    input,
+                    time_constant_ms,
+                } => {
+                    let tau_ms = time_constant_ms.min(previous_ms);
+                    let (value, ok) = aux_times_rise(
+                        held,
+                        term,
+                        shared(aux, input),
+                        tau_ms,
+                        elapsed_ms,
+                        rise_celsius,
+                    );
+                    inputs_ok &= ok;
+                    add(value);
+                }
             }
         }
         ([x, y, z], !inputs_ok)
@@ -482,6 +516,27 @@ fn aux_value(
         term.centre
     } else {
         [value; AXES]
+    };
+    (values, ok)
+}
+
+/// [`Term::AuxTimesRise`]'s value for every axis: the input filtered as [`aux_value`] does, times
+/// each axis's rise; the term's centre (it adds 0) before the first finite input.
+#[inline(always)]
+fn aux_times_rise(
+    held: &mut f32,
+    term: &ExtraTerm,
+    input: f32,
+    tau_ms: u32,
+    elapsed_ms: u32,
+    rise_celsius: &[f32; AXES],
+) -> ([f32; AXES], bool) {
+    let (_, ok) = aux_value(held, term, input, tau_ms, elapsed_ms);
+    let filtered = *held;
+    let values = if filtered.is_nan() {
+        term.centre
+    } else {
+        rise_celsius.map(|rise| filtered * rise)
     };
     (values, ok)
 }

@@ -121,6 +121,10 @@ fn each_term_reads_what_it_names() {
         },
         Term::AxisRise { axis: 1 },
         Term::RiseSquared,
+        Term::AuxTimesRise {
+            input: 2,
+            time_constant_ms: 0,
+        },
     ]
     .map(|term| ExtraTerm {
         term,
@@ -140,10 +144,26 @@ fn each_term_reads_what_it_names() {
             aux: [0.0, 0.0, 7.0, 0.0],
         },
     );
-    // values[axis][term] = raw − centre[axis]
-    assert_eq!(values[0][..3], [6.0, 1.0, 0.0]);
-    assert_eq!(values[1][..3], [5.0, 0.0, 2.0]);
-    assert_eq!(values[2][..3], [4.0, -1.0, 6.0]);
+    // values[axis][term] = raw − centre[axis]; the last term is input 2 × the axis's own rise.
+    assert_eq!(values[0], [6.0, 1.0, 0.0, 6.0]);
+    assert_eq!(values[1], [5.0, 0.0, 2.0, 12.0]);
+    assert_eq!(values[2], [4.0, -1.0, 6.0, 18.0]);
+    // Before its input's first finite value the interaction adds nothing (its centre).
+    let mut waiting = ExtensionState::power_on();
+    let values = waiting.values(
+        &extension,
+        &TermInputs {
+            since_power_on_ms: 10,
+            rise_celsius: [1.0, 2.0, 3.0],
+            aux: [f32::NAN; 4],
+        },
+    );
+    assert_eq!([values[0][3], values[1][3], values[2][3]], [0.0; AXES]);
+    let fewer = Extension {
+        terms: heapless::Vec::from_slice(&terms[..3]).unwrap(),
+        ..Extension::NONE
+    };
+    let values = ExtensionState::power_on().values(&fewer, &TermInputs::default());
     assert_eq!(values[0][3], 0.0, "unused term slots are 0");
 }
 

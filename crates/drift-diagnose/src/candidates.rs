@@ -39,6 +39,37 @@ pub const REFERENCE_CELSIUS: f64 = 25.0;
 /// The auxiliary channel holding the chamber's set point (the ambient the unit is kept at).
 pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
 
+/// A recorded auxiliary channel less its mean over the calibration activations: what an
+/// interaction multiplies. Uncentred, a channel that hardly moves times the heating is the heating
+/// itself, scaled — a candidate that matches the tables' own lookup error rather than anything the
+/// channel does.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Deviation {
+    /// The channel's name.
+    pub channel: String,
+    /// Its calibration mean, in thousandths of the channel's unit (an integer, so that kinds
+    /// compare and sort).
+    pub centre_milli: i64,
+}
+
+impl Deviation {
+    /// `channel` less `centre` (its calibration mean, in the channel's unit).
+    pub fn new(channel: &str, centre: f64) -> Self {
+        Self {
+            channel: channel.to_owned(),
+            centre_milli: if centre.is_finite() {
+                (centre * 1000.0).round() as i64
+            } else {
+                0
+            },
+        }
+    }
+
+    fn centre(&self) -> f64 {
+        self.centre_milli as f64 / 1000.0
+    }
+}
+
 /// One kind of candidate; its value for axis `a` may depend on `a`.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Kind {
@@ -65,11 +96,11 @@ pub enum Kind {
     /// A recorded auxiliary channel times the axis's own rise since switch-on (channel unit × °C):
     /// a sensitivity to the channel that grows as the unit heats (g-sensitivity or supply
     /// sensitivity with a temperature coefficient of its own).
-    AuxTimesRise(String),
+    AuxTimesRise(Deviation),
     /// A recorded auxiliary channel times the axis's own sensor temperature less
     /// [`REFERENCE_CELSIUS`] (channel unit × °C): the same sensitivity, growing with the
     /// temperature itself rather than with the heating, so it also differs between ambients.
-    AuxTimesTemperature(String),
+    AuxTimesTemperature(Deviation),
     /// Another axis's temperature rate through the element's lag (°C/s; the axis `offset` places
     /// further on, τ from [`ELEMENT_RATE_TIME_CONSTANTS_S`]): a bias that follows a neighbour's
     /// heating, as a shared substrate or a capsule's gas would carry it.
@@ -95,15 +126,19 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// Every kind a segment with these auxiliary channels offers.
-    pub fn all(aux_channels: impl IntoIterator<Item = String>, has_set_point: bool) -> Vec<Self> {
-        let channels: Vec<String> = aux_channels.into_iter().collect();
-        let mut kinds: Vec<Self> = channels.iter().cloned().map(Self::Aux).collect();
+    /// Every kind a segment with these auxiliary channels (each with its calibration mean)
+    /// offers.
+    pub fn all(
+        aux_channels: impl IntoIterator<Item = (String, f64)>,
+        has_set_point: bool,
+    ) -> Vec<Self> {
+        let channels: Vec<(String, f64)> = aux_channels.into_iter().collect();
+        let mut kinds: Vec<Self> = channels.iter().map(|(c, _)| Self::Aux(c.clone())).collect();
         // The chamber's set point is constant over a recording: its interactions are what stage 2
         // (the ambient) and stage 3 (the rise) already read.
-        for channel in channels.iter().filter(|c| *c != SET_POINT_CHANNEL) {
-            kinds.push(Self::AuxTimesRise(channel.clone()));
-            kinds.push(Self::AuxTimesTemperature(channel.clone()));
+        for (channel, centre) in channels.iter().filter(|(c, _)| c != SET_POINT_CHANNEL) {
+            kinds.push(Self::AuxTimesRise(Deviation::new(channel, *centre)));
+            kinds.push(Self::AuxTimesTemperature(Deviation::new(channel, *centre)));
         }
         kinds.extend(
             SENSOR_RATE_TIME_CONSTANTS_S
@@ -114,12 +149,12 @@ impl Kind {
                 .map(|time_constant_s| Self::ElementRate { time_constant_s }),
         );
         for offset in [1, 2] {
-            kinds.extend(
-                ELEMENT_RATE_TIME_CONSTANTS_S.map(|time_constant_s| Self::OtherAxisRate {
+            kinds.extend(ELEMENT_RATE_TIME_CONSTANTS_S.map(|time_constant_s| {
+                Self::OtherAxisRate {
                     offset,
                     time_constant_s,
-                }),
-            );
+                }
+            }));
         }
         kinds.extend([
             Self::RiseSquared,
@@ -146,9 +181,12 @@ impl Kind {
             Self::ElementRate { time_constant_s } => {
                 format!("element rate {own} (τ {time_constant_s} s)")
             }
-            Self::AuxTimesRise(channel) => format!("aux:{channel} × rise {own}"),
-            Self::AuxTimesTemperature(channel) => {
-                format!("aux:{channel} × temperature {own} (from {REFERENCE_CELSIUS} °C)")
+            Self::AuxTimesRise(d) => format!("aux:{} × rise {own}", d.channel),
+            Self::AuxTimesTemperature(d) => {
+                format!(
+                    "aux:{} × temperature {own} (from {REFERENCE_CELSIUS} °C)",
+                    d.channel
+                )
             }
             Self::OtherAxisRate {
                 offset,
@@ -225,6 +263,14 @@ impl Kind {
                     .collect(),
             )
         };
+        let deviation = |d: &Deviation| -> Option<Vec<f64>> {
+            Some(
+                aux(&d.channel)?
+                    .into_iter()
+                    .map(|v| v - d.centre())
+                    .collect(),
+            )
+        };
         let times = |channel: &[f64], heat: Vec<f64>| -> Vec<f32> {
             channel
                 .iter()
@@ -234,12 +280,12 @@ impl Kind {
         };
         match self {
             Self::Aux(channel) => same(aux(channel)?.into_iter().map(|v| v as f32).collect()),
-            Self::AuxTimesRise(channel) => {
-                let channel = aux(channel)?;
+            Self::AuxTimesRise(d) => {
+                let channel = deviation(d)?;
                 per_axis(&|axis| times(&channel, rise(axis)))
             }
-            Self::AuxTimesTemperature(channel) => {
-                let channel = aux(channel)?;
+            Self::AuxTimesTemperature(d) => {
+                let channel = deviation(d)?;
                 per_axis(&|axis| {
                     let from_reference = rise(axis)
                         .into_iter()
@@ -360,8 +406,8 @@ mod tests {
         assert_eq!(neighbour.name(0), "element rate Y on X (τ 30 s)");
         assert_eq!(Kind::rate_time_constant_s(&neighbour.name(0)), None);
         for kind in [
-            Kind::AuxTimesRise("supply_voltage".into()),
-            Kind::AuxTimesTemperature("supply_voltage".into()),
+            Kind::AuxTimesRise(Deviation::new("supply_voltage", 3.3)),
+            Kind::AuxTimesTemperature(Deviation::new("supply_voltage", 3.3)),
         ] {
             assert_eq!(Kind::rate_time_constant_s(&kind.name(2)), None);
         }

@@ -11,17 +11,17 @@
 //! explains is then left with nothing to explain, and what is left is exactly what a term in that
 //! candidate would add to the paper's model.
 //!
-//! Score: out-of-sample explained variance of the residual, cross-validated by series (K folds of
-//! whole series of activations, never samples or single activations of a series), for a
-//! one-coefficient linear term. Significance:
-//! per-activation reductions of squared error on held-out activations, one-sided t-test of their
-//! mean against zero, Bonferroni-corrected over every candidate of the axis. Activations are the
-//! independent samples; the noise inside one is strongly autocorrelated. A candidate is significant
-//! only if its coefficient has the same sign in every fold, and it either also lowers the *whole*
-//! held-out residual (offsets and shape, no activation means taken out) at the same level or
-//! explains most of the residual out of sample: a candidate left over from what the tables almost
-//! wholly absorb (rise², the rises) can match the tables' own lookup error in shape while a term
-//! in it makes the whole error no smaller.
+//! Score: out-of-sample explained share of the residual's variance for a one-coefficient linear
+//! term, cross-validated by series (whole series of activations held out together, never samples
+//! or single activations of a series), at the better of two levels (shapes within activations,
+//! offsets between them), and 0 unless every fold's coefficient has the same sign. Significance:
+//! family-wise, by shuffling the candidates among activations of the same unit and set point
+//! ([`crate::permutation`]): a candidate is significant when the best of all candidates reached its
+//! share in at most `alpha` of the shuffles. That corrects for the number of candidates, their
+//! correlation and the autocorrelation inside activations as they are on the data diagnosed, and
+//! gives per axis the smallest share these activations can show ([`AxisDiagnosis::detectable_share`]).
+//! The per-activation t-tests (of the squared residual at the candidate's level, of the whole
+//! residual, of the drift) are reported beside it.
 //!
 //! The model whose residual is diagnosed is the loop's: the paper's tables with stage 3 keyed by
 //! rise or by heating history per axis, as [`crate::closing`] chose ([`Keying`]).
@@ -36,6 +36,7 @@ use serde::Serialize;
 use crate::absorb::Absorber;
 use crate::candidates::{Kind, SET_POINT_CHANNEL};
 use crate::keying::Keying;
+use crate::permutation::{Level, Null, Scored};
 use crate::statistics::one_sided_mean_test;
 use crate::switch_on_rate::start_rates;
 use drift_evaluate::evaluate::{spread, switch_on_raw};
@@ -109,7 +110,18 @@ impl Diagnoser {
         channels.retain(|c| calibration.iter().all(|s| s.aux.contains_key(c)));
         let has_set_point = channels.iter().any(|c| c == SET_POINT_CHANNEL);
         let core = fitted.modified.settings;
-        let kinds = Kind::all(channels, has_set_point)
+        // Each channel's mean over every calibration sample: where its interactions are centred.
+        let centred = channels.into_iter().map(|c| {
+            let (sum, n) = calibration
+                .iter()
+                .filter_map(|s| s.aux.get(&c))
+                .flat_map(|channel| channel.values.iter())
+                .filter(|v| v.is_finite())
+                .fold((0.0, 0usize), |(sum, n), &v| (sum + f64::from(v), n + 1));
+            let centre = sum / n.max(1) as f64;
+            (c, centre)
+        });
+        let kinds = Kind::all(centred, has_set_point)
             .into_iter()
             .map(|kind| {
                 let absorber = Absorber::fit(
@@ -179,7 +191,8 @@ impl Diagnoser {
 pub struct CandidateScore {
     /// Candidate name.
     pub name: String,
-    /// Out-of-sample share of the residual's variance explained (cross-validated by activation).
+    /// Out-of-sample share of the residual's variance explained at its level, cross-validated by
+    /// series; 0 when the folds' coefficients disagree in sign.
     pub explained: f64,
     /// One-sided p-value of the mean held-out improvement (before multiple-comparison correction).
     pub p_value: f64,
@@ -190,11 +203,17 @@ pub struct CandidateScore {
     /// residual over each activation) when the candidate's within-activation fit is taken out:
     /// the paper's metric, which a shape term changes and an offset cannot.
     pub drift_p_value: f64,
-    /// Whether it passes the Bonferroni-corrected test at `alpha`, at its level and on the whole
-    /// residual.
+    /// Family-wise p-value of its explained share: the share of shuffles of the candidates among
+    /// activations in which the best of every candidate explained as much
+    /// ([`crate::permutation`]).
+    pub family_p_value: f64,
+    /// Whether `family_p_value` is at most `alpha`.
     pub significant: bool,
     /// Fitted coefficient on all data ((°/s) per candidate unit, on what the tables leave of it).
     pub coefficient: f64,
+    /// Every cross-validation fold's coefficient has the same sign: the relation does not hang on
+    /// one series.
+    pub stable: bool,
     /// Share of the candidate's own variance that the paper's tables, fitted to it on the
     /// calibration activations, predict. Near 1: the table accounts for this quantity, and it is
     /// not scored.
@@ -213,6 +232,10 @@ pub struct AxisDiagnosis {
     pub activations: usize,
     /// RMS of the residual, °/s.
     pub residual_rms_dps: f64,
+    /// The explained share a candidate must exceed to be significant with these activations: an
+    /// effect explaining less of the residual's variance (out of sample) cannot be told from
+    /// chance here.
+    pub detectable_share: f64,
     /// Candidates, best first.
     pub ranking: Vec<CandidateScore>,
 }
@@ -223,10 +246,6 @@ impl AxisDiagnosis {
         self.ranking.first().filter(|c| c.significant)
     }
 }
-
-/// Out-of-sample share of the residual's variance beyond which a candidate, stable across the
-/// folds, needs no whole-residual test to be significant.
-const EXPLAINS_MOST: f64 = 0.5;
 
 /// A candidate whose variance the paper's tables explain beyond this share is the table's already.
 const ABSORBED: f64 = 0.999;
@@ -282,7 +301,6 @@ fn line(train: &[&Vec<Point>]) -> Option<(f64, f64)> {
 
 /// A candidate's cross-validated score at one level.
 struct Score {
-    explained: f64,
     /// One-sided p-value of the mean held-out reduction of the squared residual.
     p_value: f64,
     /// One-sided p-value of the mean held-out reduction of the drift (max − min over the
@@ -321,19 +339,34 @@ pub fn series_folds(activations: &[ActivationSeries], folds: usize) -> (Vec<usiz
     }
 }
 
+/// Each activation's stratum for the shuffle test: its unit and nominal set point, so that what
+/// differs between units or set points (a channel's level, the ambient) stays paired with the
+/// residual it came with.
+fn set_point_strata(activations: &[ActivationSeries]) -> Vec<usize> {
+    let key = |a: &ActivationSeries| {
+        (
+            a.labels.unit_id.clone(),
+            (a.labels.nominal_set_point_celsius() * 1000.0).round() as i64,
+        )
+    };
+    let mut keys: Vec<_> = activations.iter().map(key).collect();
+    keys.sort();
+    keys.dedup();
+    activations
+        .iter()
+        .map(|a| keys.binary_search(&key(a)).unwrap_or(0))
+        .collect()
+}
+
 /// Scores one candidate on groups of points (one group per activation), cross-validated with
-/// `fold[i]` the fold group `i` is held out in: the explained share, the p-values of the held-out
+/// `fold[i]` the fold group `i` is held out in: the p-values of the held-out
 /// squared residual's and drift's reductions, the coefficient on all data, and whether every
 /// fold's coefficient has the same sign.
 fn score(groups: &[Vec<Point>], fold_of: &[usize], folds: usize) -> Score {
     let finite = |p: &&Point| p.0.is_finite() && p.1.is_finite();
-    let all: Vec<&Point> = groups.iter().flatten().filter(finite).collect();
-    let mean_y = all.iter().map(|p| p.0).sum::<f64>() / all.len().max(1) as f64;
-    let total: f64 = all.iter().map(|p| (p.0 - mean_y).powi(2)).sum();
     let mut signs = (0usize, 0usize);
     let mut improvements = Vec::with_capacity(groups.len());
     let mut drift_gains = Vec::with_capacity(groups.len());
-    let mut sse = 0.0;
     for fold in 0..folds {
         let train: Vec<&Vec<Point>> = groups
             .iter()
@@ -369,7 +402,6 @@ fn score(groups: &[Vec<Point>], fold_of: &[usize], folds: usize) -> Score {
                 n += 1;
             }
             if n > 0 {
-                sse += with;
                 improvements.push((without - with) / n as f64);
                 let residual = || group.iter().filter(finite);
                 drift_gains.push(
@@ -382,9 +414,7 @@ fn score(groups: &[Vec<Point>], fold_of: &[usize], folds: usize) -> Score {
     let (_, drift_p_value) = one_sided_mean_test(&drift_gains);
     let all_groups: Vec<&Vec<Point>> = groups.iter().collect();
     let coefficient = line(&all_groups).map_or(0.0, |(slope, _)| slope);
-    let explained = if total > 0.0 { 1.0 - sse / total } else { 0.0 };
     Score {
-        explained,
         p_value,
         drift_p_value,
         coefficient,
@@ -430,7 +460,29 @@ pub fn diagnose_axis(
     )
     .sqrt();
     let (fold_of, folds) = series_folds(activations, folds);
-    let mut stable = BTreeMap::new();
+    let scored_names: Vec<String> = names
+        .iter()
+        .filter(|n| absorbed_share(activations, axis, n) <= ABSORBED)
+        .cloned()
+        .collect();
+    let residuals: Vec<&[f64]> = activations
+        .iter()
+        .map(|a| a.residual_dps[axis].as_slice())
+        .collect();
+    let candidates: Vec<&BTreeMap<String, Vec<f64>>> =
+        activations.iter().map(|a| &a.left_over[axis]).collect();
+    let strata = set_point_strata(activations);
+    let null = Null::measure(
+        &Scored {
+            residuals: &residuals,
+            candidates: &candidates,
+            strata: &strata,
+            fold_of: &fold_of,
+            folds,
+        },
+        &scored_names,
+        axis as u64,
+    );
     let mut ranking: Vec<CandidateScore> = names
         .iter()
         .map(|name| {
@@ -442,7 +494,9 @@ pub fn diagnose_axis(
                 whole_p_value: 1.0,
                 drift_p_value: 1.0,
                 significant: false,
+                family_p_value: 1.0,
                 coefficient: 0.0,
+                stable: false,
                 absorbed_by_model: absorbed,
                 level: "",
             };
@@ -480,35 +534,31 @@ pub fn diagnose_axis(
             candidate.whole_p_value = score(&whole, &fold_of, folds).p_value;
             // Only a shape has a drift; the between level's one point per activation has none.
             candidate.drift_p_value = within.drift_p_value;
-            let (best, level) = if within.p_value <= between.p_value {
-                (within, "within activations")
-            } else {
-                (between, "between activations")
+            // The level and share are the shuffle test's (below); the p-value and coefficient
+            // are read at that level.
+            let (share, level) = null
+                .observed
+                .get(name)
+                .copied()
+                .unwrap_or((0.0, Level::Within));
+            let (best, level) = match level {
+                Level::Within => (within, "within activations"),
+                Level::Between => (between, "between activations"),
             };
-            stable.insert(name.clone(), best.stable);
-            (
-                candidate.explained,
-                candidate.p_value,
-                candidate.coefficient,
-                candidate.level,
-            ) = (best.explained, best.p_value, best.coefficient, level);
+            candidate.stable = best.stable;
+            candidate.explained = share;
+            candidate.family_p_value = null.p_value(share);
+            (candidate.p_value, candidate.coefficient, candidate.level) =
+                (best.p_value, best.coefficient, level);
             candidate
         })
         .collect();
-    let bonferroni = alpha / (2 * ranking.len()).max(1) as f64;
     for c in &mut ranking {
-        // The drift's p-value is reported, not tested: in the null case the paper's own gap (the
-        // element lagging the sensor) passes it on many axes, and the element's heating rate is
-        // offered to the guard on every axis anyway (`TermPlan::choose`). The whole residual's
-        // test guards against a candidate that matches the tables' own lookup error in shape
-        // while a term in it leaves the whole error no smaller; a candidate that explains most of
-        // the residual out of sample, with the same sign in every fold, has shown what that test
-        // asks for and passes without it.
-        let whole = c.whole_p_value < bonferroni || c.explained >= EXPLAINS_MOST;
-        c.significant = c.p_value < bonferroni
-            && whole
-            && c.explained > 0.0
-            && stable.get(&c.name).copied().unwrap_or(false);
+        // Family-wise by shuffling (crate::permutation): the share must beat what the best of
+        // every candidate reaches by chance on these activations in all but `alpha` of the
+        // shuffles. The per-activation p-values and the whole residual's are reported beside it,
+        // not gated on: each measures something else than whether this relation is there.
+        c.significant = c.explained > 0.0 && c.family_p_value <= alpha;
     }
     // Significant first, then by explained share.
     ranking.sort_by(|a, b| {
@@ -520,6 +570,7 @@ pub fn diagnose_axis(
         axis: AXES[axis],
         activations: activations.len(),
         residual_rms_dps: rms,
+        detectable_share: null.detectable(alpha),
         ranking,
     }
 }

@@ -15,6 +15,7 @@ pub mod closing;
 pub mod diagnose;
 pub mod extend;
 pub mod keying;
+pub mod permutation;
 pub mod roles;
 pub mod statistics;
 pub mod switch_on_rate;

@@ -55,10 +55,13 @@ struct RankRecord<'a> {
     candidate: &'a str,
     level: &'static str,
     explained: f64,
+    family_p_value: f64,
     p_value: f64,
     whole_p_value: f64,
     drift_p_value: f64,
     significant: bool,
+    stable: bool,
+    detectable_share: f64,
     coefficient: f64,
     absorbed_by_model: f64,
 }
@@ -168,10 +171,12 @@ impl PyDiagnosis {
         &self.unit_id
     }
 
-    /// The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
-    /// whole_p_value, drift_p_value, significant, coefficient, absorbed_by_model): a new list of
-    /// dicts. `drift_p_value` (the held-out drift's reduction) is reported, not part of
-    /// `significant`.
+    /// The ranking of every axis as records (axis, rank, candidate, level, explained,
+    /// family_p_value, p_value, whole_p_value, drift_p_value, significant, stable,
+    /// detectable_share, coefficient, absorbed_by_model): a new list of dicts. `significant` is
+    /// `family_p_value` ≤ 0.05 (shuffle test, family-wise over the axis's candidates);
+    /// `detectable_share` is the explained share a candidate on that axis must exceed to be
+    /// significant with these activations. The t-tests' p-values are reported, not gated on.
     #[getter]
     fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &records(&self.axes))
@@ -206,8 +211,8 @@ impl PyDiagnosis {
             .collect()
     }
 
-    /// The terms proposed for the extended model: the diagnosis's significant candidates and the
-    /// element's heating rate, which is offered on every unit.
+    /// The terms proposed for the extended model: the diagnosis's significant candidates that
+    /// drift-core can compute.
     #[getter]
     fn proposed_terms(&self) -> Vec<String> {
         self.proposed.clone()
@@ -328,10 +333,13 @@ fn records(axes: &[AxisDiagnosis; 3]) -> Vec<RankRecord<'_>> {
                 candidate: &c.name,
                 level: c.level,
                 explained: c.explained,
+                family_p_value: c.family_p_value,
                 p_value: c.p_value,
                 whole_p_value: c.whole_p_value,
                 drift_p_value: c.drift_p_value,
                 significant: c.significant,
+                stable: c.stable,
+                detectable_share: axis.detectable_share,
                 coefficient: c.coefficient,
                 absorbed_by_model: c.absorbed_by_model,
             })

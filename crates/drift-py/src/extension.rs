@@ -11,7 +11,13 @@ use crate::args;
 use crate::errors::Error;
 
 /// The kinds' Python names, in `drift_core::Term`'s order.
-const KINDS: [&str; 4] = ["temperature_rate", "aux", "axis_rise", "rise_squared"];
+const KINDS: [&str; 5] = [
+    "temperature_rate",
+    "aux",
+    "axis_rise",
+    "rise_squared",
+    "aux_times_rise",
+];
 
 /// One extra term: kind and parameter (`drift_core::Term`), per-axis centre and coefficient.
 #[pyclass(module = "gyrodrift", name = "ExtraTerm", frozen, eq)]
@@ -39,9 +45,9 @@ fn term(
     time_constant_ms: Option<&Bound<'_, PyAny>>,
 ) -> Result<Term, Error> {
     let time_constant_ms = time_constant_ms.filter(|value| !value.is_none());
-    if let Some(value) = time_constant_ms.filter(|_| kind != "aux") {
+    if let Some(value) = time_constant_ms.filter(|_| kind != "aux" && kind != "aux_times_rise") {
         return Err(Error::Input(format!(
-            "`time_constant_ms` is only for kind 'aux' (a rate term's time constant is its \
+            "`time_constant_ms` is only for kinds 'aux' and 'aux_times_rise' (a rate term's time constant is its \
              `parameter`), got {} for kind {kind:?}",
             args::shown(value)
         )));
@@ -56,6 +62,22 @@ fn term(
             )?,
         },
         "aux" => Term::Aux {
+            input: required(
+                kind,
+                "the auxiliary input's index",
+                "an integer in 0..=255 (an auxiliary input's index)",
+                parameter,
+            )?,
+            time_constant_ms: match time_constant_ms {
+                Some(value) => args::value(
+                    "time_constant_ms",
+                    "an integer in 0..=4294967295 (ms)",
+                    value,
+                )?,
+                None => 0,
+            },
+        },
+        "aux_times_rise" => Term::AuxTimesRise {
             input: required(
                 kind,
                 "the auxiliary input's index",
@@ -98,19 +120,20 @@ fn term(
 }
 
 fn kind_name(term: Term) -> &'static str {
-    let [rate, aux, axis_rise, rise_squared] = KINDS;
+    let [rate, aux, axis_rise, rise_squared, aux_times_rise] = KINDS;
     match term {
         Term::TemperatureRate { .. } => rate,
         Term::Aux { .. } => aux,
         Term::AxisRise { .. } => axis_rise,
         Term::RiseSquared => rise_squared,
+        Term::AuxTimesRise { .. } => aux_times_rise,
     }
 }
 
 fn parameter(term: Term) -> Option<u32> {
     match term {
         Term::TemperatureRate { time_constant_ms } => Some(time_constant_ms),
-        Term::Aux { input, .. } => Some(u32::from(input)),
+        Term::Aux { input, .. } | Term::AuxTimesRise { input, .. } => Some(u32::from(input)),
         Term::AxisRise { axis } => Some(u32::from(axis)),
         Term::RiseSquared => None,
     }
@@ -121,6 +144,9 @@ fn time_constant(term: Term) -> Option<u32> {
     match term {
         Term::TemperatureRate { time_constant_ms }
         | Term::Aux {
+            time_constant_ms, ..
+        }
+        | Term::AuxTimesRise {
             time_constant_ms, ..
         } => Some(time_constant_ms),
         Term::AxisRise { .. } | Term::RiseSquared => None,
@@ -153,7 +179,8 @@ impl PyExtraTerm {
         }))
     }
 
-    /// What the term measures: 'temperature_rate', 'aux', 'axis_rise' or 'rise_squared'.
+    /// What the term measures: 'temperature_rate', 'aux', 'axis_rise', 'rise_squared' or
+    /// 'aux_times_rise'.
     #[getter]
     fn kind(&self) -> &'static str {
         kind_name(self.0.term)
@@ -166,8 +193,8 @@ impl PyExtraTerm {
         parameter(self.0.term)
     }
 
-    /// The low-pass time constant, ms: an 'aux' term's (0: unfiltered), a 'temperature_rate'
-    /// term's (its `parameter`); `None` for the other kinds.
+    /// The low-pass time constant, ms: an 'aux' or 'aux_times_rise' term's (0: unfiltered), a
+    /// 'temperature_rate' term's (its `parameter`); `None` for the other kinds.
     #[getter]
     fn time_constant_ms(&self) -> Option<u32> {
         time_constant(self.0.term)

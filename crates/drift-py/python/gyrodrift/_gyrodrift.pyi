@@ -76,7 +76,7 @@ _Previous: TypeAlias = NDArray[np.floating] | Sequence[Sequence[float]]
 _FloatRows: TypeAlias = NDArray[np.floating] | Sequence[Sequence[float]]
 _Floats: TypeAlias = NDArray[np.float32] | NDArray[np.float64]
 _Floats4: TypeAlias = Sequence[float] | NDArray[np.floating]
-_TermKind: TypeAlias = Literal["temperature_rate", "aux", "axis_rise", "rise_squared"]
+_TermKind: TypeAlias = Literal["temperature_rate", "aux", "axis_rise", "rise_squared", "aux_times_rise"]
 _Source: TypeAlias = _Path | Recording | Segment | Sequence[_Path | Recording | Segment]
 _Record: TypeAlias = dict[str, Any]
 
@@ -267,7 +267,9 @@ class ExtraTerm:
       first-order low-pass of time constant `time_constant_ms` (default 0: unfiltered; the
       closed loop fits 1000 ms, so a recorded channel's sample noise stays out of the correction);
     - `'axis_rise'`: the rise since switch-on of axis `parameter` (0 = X, 1 = Y, 2 = Z), °C;
-    - `'rise_squared'`: the axis's own rise squared, °C²; `parameter` is None.
+    - `'rise_squared'`: the axis's own rise squared, °C²; `parameter` is None;
+    - `'aux_times_rise'`: auxiliary input `parameter`, low-passed as an `'aux'` term is, times the
+      axis's own rise since switch-on (input unit × °C).
 
     Only converted on construction (`InputError` for a wrong type or a missing parameter); the
     values are validated when the term becomes part of a model (`ModifiedTables.with_extension`).
@@ -284,14 +286,15 @@ class ExtraTerm:
     ) -> ExtraTerm: ...
     @property
     def kind(self) -> _TermKind:
-        """What the term measures: 'temperature_rate', 'aux', 'axis_rise' or 'rise_squared'."""
+        """What the term measures: 'temperature_rate', 'aux', 'axis_rise', 'rise_squared' or
+        'aux_times_rise'."""
     @property
     def parameter(self) -> int | None:
         """The time constant (ms), auxiliary input index or axis index; None for 'rise_squared'."""
     @property
     def time_constant_ms(self) -> int | None:
-        """The low-pass time constant, ms: an 'aux' term's (0: unfiltered) or a
-        'temperature_rate' term's (its `parameter`); None for the other kinds."""
+        """The low-pass time constant, ms: an 'aux' or 'aux_times_rise' term's (0: unfiltered)
+        or a 'temperature_rate' term's (its `parameter`); None for the other kinds."""
     @property
     def centre(self) -> tuple[float, float, float]:
         """Per axis, the value the term is measured from (its calibration mean), in its unit."""
@@ -793,10 +796,12 @@ class Diagnosis:
         """Unit id."""
     @property
     def ranking(self) -> list[dict[str, Any]]:
-        """The ranking of every axis as records (axis, rank, candidate, level, explained, p_value,
-        whole_p_value, drift_p_value, significant, coefficient, absorbed_by_model): a new list of
-        dicts. `drift_p_value` (the held-out drift's reduction) is reported, not part of
-        `significant`."""
+        """The ranking of every axis as records (axis, rank, candidate, level, explained,
+        family_p_value, p_value, whole_p_value, drift_p_value, significant, stable,
+        detectable_share, coefficient, absorbed_by_model): a new list of dicts. `significant` is
+        `family_p_value` ≤ 0.05 (shuffle test, family-wise over the axis's candidates);
+        `detectable_share` is the explained share a candidate on that axis must exceed to be
+        significant with these activations. The t-tests' p-values are reported, not gated on."""
     @property
     def paper_ranking(self) -> list[dict[str, Any]]:
         """The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's
@@ -811,8 +816,8 @@ class Diagnosis:
         systematic effect is left."""
     @property
     def proposed_terms(self) -> list[str]:
-        """The terms proposed for the extended model: the diagnosis's significant candidates and the
-        element's heating rate, which is offered on every unit."""
+        """The terms proposed for the extended model: the diagnosis's significant candidates that
+        drift-core can compute."""
     @property
     def admissions(self) -> list[dict[str, Any]]:
         """The guard's decision for every proposed term and axis (records: candidate, axis,
