@@ -9,6 +9,7 @@ pub mod diagnose;
 mod extend;
 pub mod fit;
 pub mod import;
+mod import_campaign;
 mod measured;
 mod progress;
 pub mod report;

@@ -1,0 +1,114 @@
+//! `gyrodrift import campaign`: a bench campaign kept as one CSV file per activation plus an
+//! activation sheet → a campaign folder that `fit`, `report`, `diagnose` and `check` read.
+//!
+//! Everything is read and validated first (errors name the sheet or the activation file, the row
+//! and the column); the recordings and `import.json` are then written into a temporary folder
+//! beside the output, which is renamed to the output at the end: a failed import leaves nothing.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use drift_recording::{read_sheet_campaign, write_recording, RECORDINGS_DIR};
+
+use super::import::CampaignArgs;
+
+/// The temporary folder beside `out` that becomes `out`.
+fn staging(out: &Path) -> PathBuf {
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "campaign".into());
+    out.with_file_name(format!(".{name}.importing-{}", std::process::id()))
+}
+
+/// Runs `gyrodrift import campaign`.
+pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
+    let options = args.reading.options()?;
+    if args.out.exists()
+        && std::fs::read_dir(&args.out)
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(true)
+    {
+        anyhow::bail!(
+            "{}: exists and is not an empty folder (an import writes a new campaign folder)",
+            args.out.display()
+        );
+    }
+    let recordings = read_sheet_campaign(&args.sheet, &options)?;
+    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("creating {}", parent.display()))?;
+    }
+    let stage = staging(&args.out);
+    let result = write_all(&stage, args, &recordings).and_then(|summary| {
+        std::fs::rename(&stage, &args.out)
+            .with_context(|| format!("renaming {} to {}", stage.display(), args.out.display()))?;
+        Ok(summary)
+    });
+    match result {
+        Ok(lines) => {
+            for line in lines {
+                println!("{line}");
+            }
+            Ok(())
+        }
+        Err(e) => {
+            // Best effort: the folder may not even exist.
+            let _ = std::fs::remove_dir_all(&stage);
+            Err(e)
+        }
+    }
+}
+
+fn write_all(
+    stage: &Path,
+    args: &CampaignArgs,
+    recordings: &[(String, drift_recording::Recording)],
+) -> anyhow::Result<Vec<String>> {
+    let folder = stage.join(RECORDINGS_DIR);
+    std::fs::create_dir_all(&folder).with_context(|| format!("creating {}", folder.display()))?;
+    let mut manifest = Vec::new();
+    let mut lines = Vec::new();
+    for (stem, recording) in recordings {
+        let name = format!("{stem}.mcap");
+        let bytes = write_recording(recording, &folder.join(&name))?;
+        let samples: usize = recording.segments.iter().map(|s| s.len()).sum();
+        let fs = f64::from(recording.sample_rate_hz);
+        lines.push(format!(
+            "{name}: {} activations, {samples} samples at {} Hz ({:.1} s), {bytes} bytes",
+            recording.segments.len(),
+            recording.sample_rate_hz,
+            samples as f64 / fs
+        ));
+        manifest.push(serde_json::json!({
+            "recording": format!("{RECORDINGS_DIR}/{name}"),
+            "unit_id": recording.unit_id,
+            "metadata": recording.metadata,
+            "activations": recording.segments.iter().map(|s| serde_json::json!({
+                "labels": s.labels,
+                "switch_on_s": s.power_on_ns as f64 / 1e9,
+                "samples": s.len(),
+                "duration_s": s.len() as f64 / fs,
+                "aux": s.aux.iter().map(|(k, c)| (k.clone(), c.values.len())).collect::<std::collections::BTreeMap<_, _>>(),
+            })).collect::<Vec<_>>(),
+        }));
+    }
+    let json = serde_json::json!({
+        "sheet": args.sheet.display().to_string(),
+        "sample_rate_hz": args.reading.rate_hz,
+        "timing": args.reading.timing,
+        "recordings": manifest,
+    });
+    std::fs::write(
+        stage.join("import.json"),
+        serde_json::to_string_pretty(&json)?,
+    )
+    .with_context(|| format!("writing {}", stage.join("import.json").display()))?;
+    lines.push(format!(
+        "{}: {} recordings → {}",
+        args.sheet.display(),
+        recordings.len(),
+        args.out.display()
+    ));
+    Ok(lines)
+}
