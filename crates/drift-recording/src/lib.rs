@@ -23,6 +23,7 @@ mod read;
 pub mod schema;
 mod segment;
 mod sheet;
+pub mod ulog;
 mod writable;
 mod write;
 pub mod writer;
