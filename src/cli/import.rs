@@ -31,6 +31,8 @@ pub enum Format {
     Csv(CsvArgs),
     /// A bench campaign: one CSV file (plain or `.gz`) per activation and an activation sheet.
     Campaign(CampaignArgs),
+    /// PX4 ULog files (`.ulg`): a file, or a folder of them as one series.
+    Ulog(super::import_ulog::UlogArgs),
 }
 
 /// Options of `gyrodrift import csv`.
@@ -254,6 +256,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     match &args.format {
         Format::Csv(csv) => run_csv(csv),
         Format::Campaign(campaign) => super::import_campaign::run(campaign),
+        Format::Ulog(ulog) => super::import_ulog::run(ulog),
     }
 }
 

@@ -21,53 +21,77 @@ fn staging(out: &Path) -> PathBuf {
     out.with_file_name(format!(".{name}.importing-{}", std::process::id()))
 }
 
-/// Runs `gyrodrift import campaign`.
-pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
-    let options = args.reading.options()?;
-    if args.out.exists()
-        && std::fs::read_dir(&args.out)
+/// Refuses an output that exists and is not an empty folder: an import writes a new folder.
+pub fn refuse_existing(out: &Path) -> anyhow::Result<()> {
+    if out.exists()
+        && std::fs::read_dir(out)
             .map(|mut d| d.next().is_some())
             .unwrap_or(true)
     {
         anyhow::bail!(
             "{}: exists and is not an empty folder (an import writes a new campaign folder)",
-            args.out.display()
+            out.display()
         );
     }
+    Ok(())
+}
+
+/// Runs `gyrodrift import campaign`.
+pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
+    let options = args.reading.options()?;
+    refuse_existing(&args.out)?;
     let recordings = read_sheet_campaign(&args.sheet, &options)?;
-    if let Some(parent) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+    let manifest = serde_json::json!({
+        "sheet": args.sheet.display().to_string(),
+        "sample_rate_hz": args.reading.rate_hz,
+        "timing": args.reading.timing,
+    });
+    let mut lines = write_campaign(&args.out, &recordings, &manifest)?;
+    lines.push(format!(
+        "{}: {} recordings → {}",
+        args.sheet.display(),
+        recordings.len(),
+        args.out.display()
+    ));
+    for line in lines {
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// Writes `recordings` (file stem, recording) and `import.json` (`manifest` with the recordings
+/// listed) into a temporary folder beside `out`, renamed to `out` at the end; on any error the
+/// temporary folder is removed and `out` is not made. Returns a line per recording.
+pub fn write_campaign(
+    out: &Path,
+    recordings: &[(String, drift_recording::Recording)],
+    manifest: &serde_json::Value,
+) -> anyhow::Result<Vec<String>> {
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)
             .with_context(|| format!("creating {}", parent.display()))?;
     }
-    let stage = staging(&args.out);
-    let result = write_all(&stage, args, &recordings).and_then(|summary| {
-        std::fs::rename(&stage, &args.out)
-            .with_context(|| format!("renaming {} to {}", stage.display(), args.out.display()))?;
-        Ok(summary)
+    let stage = staging(out);
+    let result = write_all(&stage, recordings, manifest).and_then(|lines| {
+        std::fs::rename(&stage, out)
+            .with_context(|| format!("renaming {} to {}", stage.display(), out.display()))?;
+        Ok(lines)
     });
-    match result {
-        Ok(lines) => {
-            for line in lines {
-                println!("{line}");
-            }
-            Ok(())
-        }
-        Err(e) => {
-            // Best effort: the folder may not even exist.
-            let _ = std::fs::remove_dir_all(&stage);
-            Err(e)
-        }
+    if result.is_err() {
+        // Best effort: the folder may not even exist.
+        let _ = std::fs::remove_dir_all(&stage);
     }
+    result
 }
 
 fn write_all(
     stage: &Path,
-    args: &CampaignArgs,
     recordings: &[(String, drift_recording::Recording)],
+    manifest: &serde_json::Value,
 ) -> anyhow::Result<Vec<String>> {
     let folder = stage.join(RECORDINGS_DIR);
     std::fs::create_dir_all(&folder).with_context(|| format!("creating {}", folder.display()))?;
-    let mut manifest = Vec::new();
+    let mut listed = Vec::new();
     let mut lines = Vec::new();
     for (stem, recording) in recordings {
         let name = format!("{stem}.mcap");
@@ -80,7 +104,7 @@ fn write_all(
             recording.sample_rate_hz,
             samples as f64 / fs
         ));
-        manifest.push(serde_json::json!({
+        listed.push(serde_json::json!({
             "recording": format!("{RECORDINGS_DIR}/{name}"),
             "unit_id": recording.unit_id,
             "metadata": recording.metadata,
@@ -93,22 +117,12 @@ fn write_all(
             })).collect::<Vec<_>>(),
         }));
     }
-    let json = serde_json::json!({
-        "sheet": args.sheet.display().to_string(),
-        "sample_rate_hz": args.reading.rate_hz,
-        "timing": args.reading.timing,
-        "recordings": manifest,
-    });
+    let mut json = manifest.clone();
+    json["recordings"] = serde_json::Value::Array(listed);
     std::fs::write(
         stage.join("import.json"),
         serde_json::to_string_pretty(&json)?,
     )
     .with_context(|| format!("writing {}", stage.join("import.json").display()))?;
-    lines.push(format!(
-        "{}: {} recordings → {}",
-        args.sheet.display(),
-        recordings.len(),
-        args.out.display()
-    ));
     Ok(lines)
 }

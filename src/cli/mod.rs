@@ -10,6 +10,7 @@ mod extend;
 pub mod fit;
 pub mod import;
 mod import_campaign;
+mod import_ulog;
 mod measured;
 mod progress;
 pub mod report;
