@@ -13,7 +13,12 @@ use drift_recording::paper;
 #[derive(Debug, clap::Args)]
 pub struct CampaignArgs {
     /// Campaign folder (with `recordings/`) or a folder of `.mcap` recordings.
-    pub campaign: PathBuf,
+    #[arg(required_unless_present = "calibration_data")]
+    pub campaign: Option<PathBuf>,
+    /// The recordings to fit on, instead of the positional campaign (with `report
+    /// --evaluation-data`: judged on another source).
+    #[arg(long, value_name = "DIR", conflicts_with = "campaign")]
+    pub calibration_data: Option<PathBuf>,
     /// Chamber set points to fit, °C (protocol activations only).
     #[arg(
         long,
@@ -31,6 +36,14 @@ pub struct CampaignArgs {
 }
 
 impl CampaignArgs {
+    /// The recordings fitted on: the campaign, or `--calibration-data`.
+    pub fn source(&self) -> &Path {
+        self.campaign
+            .as_deref()
+            .or(self.calibration_data.as_deref())
+            .unwrap_or(Path::new("."))
+    }
+
     /// Pipeline options: fit on the calibration set points, validate on `validation`.
     pub fn options(&self, validation: &[f64], evaluate: bool) -> anyhow::Result<Options> {
         Ok(Options {

@@ -352,7 +352,7 @@ fn residual_plots(
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
     let options = input.options(&[], false)?;
-    let files = pipeline::recording_files(&input.campaign)?;
+    let files = pipeline::recording_files(input.source())?;
     let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
         .map_err(|e| super::measured::explain(e, &files))?;

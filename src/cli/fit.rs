@@ -19,7 +19,7 @@ pub struct Args {
 
 /// Runs `gyrodrift fit`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let files = pipeline::recording_files(&args.input.campaign)?;
+    let files = pipeline::recording_files(args.input.source())?;
     let options = args.input.options(&[], false)?;
     let steps = Steps::new(args.input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))

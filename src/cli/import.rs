@@ -29,6 +29,10 @@ pub struct Args {
 pub enum Format {
     /// CSV with a header row (gzip-compressed if the name ends in `.gz`).
     Csv(CsvArgs),
+    /// A bench campaign: one CSV file (plain or `.gz`) per activation and an activation sheet.
+    Campaign(CampaignArgs),
+    /// PX4 ULog files (`.ulg`): a file, or a folder of them as one series.
+    Ulog(super::import_ulog::UlogArgs),
 }
 
 /// Options of `gyrodrift import csv`.
@@ -40,6 +44,34 @@ pub struct CsvArgs {
     /// `import.json`).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
+    /// Column mapping, units and timing.
+    #[command(flatten)]
+    pub reading: ReadingArgs,
+    /// Activation column: consecutive rows with one value are one activation.
+    #[arg(
+        long,
+        default_value = "segment_id",
+        conflicts_with = "no_segment_column"
+    )]
+    pub segment_column: String,
+    /// The whole file is one activation (no activation column).
+    #[arg(long)]
+    pub no_segment_column: bool,
+    /// Unit id written into the recording.
+    #[arg(long, default_value = "csv")]
+    pub unit_id: String,
+    /// Chamber set point of every activation, °C (default: each activation's first temperature).
+    #[arg(long, allow_hyphen_values = true)]
+    pub set_point: Option<f64>,
+    /// Series kind of every activation: `protocol` or `field`.
+    #[arg(long, default_value = "protocol")]
+    pub series_kind: String,
+}
+
+/// How the rows of a CSV file are read: column mapping, units and timing (shared by `import csv`
+/// and `import campaign`).
+#[derive(Debug, clap::Args)]
+pub struct ReadingArgs {
     /// Time column.
     #[arg(long, default_value = "t_s")]
     pub time_column: String,
@@ -55,16 +87,6 @@ pub struct CsvArgs {
     /// Temperature column(s), °C: one (a single die sensor for all axes) or three (X, Y, Z).
     #[arg(long, value_delimiter = ',', num_args = 1.., default_value = "temp_c")]
     pub temperature_columns: Vec<String>,
-    /// Activation column: consecutive rows with one value are one activation.
-    #[arg(
-        long,
-        default_value = "segment_id",
-        conflicts_with = "no_segment_column"
-    )]
-    pub segment_column: String,
-    /// The whole file is one activation (no activation column).
-    #[arg(long)]
-    pub no_segment_column: bool,
     /// Accelerometer columns X, Y, Z in g → the recording's `/aux/accel` channel (100 Hz).
     #[arg(long, value_delimiter = ',', num_args = 1..)]
     pub accel_columns: Option<Vec<String>>,
@@ -87,18 +109,25 @@ pub struct CsvArgs {
     /// a longer one is an error naming its row.
     #[arg(long, default_value_t = 0.5)]
     pub max_gap: f64,
-    /// Unit id written into the recording.
-    #[arg(long, default_value = "csv")]
-    pub unit_id: String,
-    /// Chamber set point of every activation, °C (default: each activation's first temperature).
-    #[arg(long, allow_hyphen_values = true)]
-    pub set_point: Option<f64>,
-    /// Series kind of every activation: `protocol` or `field`.
-    #[arg(long, default_value = "protocol")]
-    pub series_kind: String,
     /// Read an empty or NaN temperature cell as a sensor dropout instead of an error.
     #[arg(long)]
     pub temperature_dropouts: bool,
+}
+
+/// Options of `gyrodrift import campaign`.
+#[derive(Debug, clap::Args)]
+pub struct CampaignArgs {
+    /// The activation sheet (CSV: `file`, `unit`, `set_point_celsius`, `series`, `repeat`,
+    /// `activation`, `off_before_s`, `series_kind`, `switch_on_s`; optional `interval_min`,
+    /// `switch_on_ambient_celsius`). Its `file` cells are relative to its folder.
+    pub sheet: PathBuf,
+    /// Output: a new campaign folder (`recordings/<unit>_sp<set point>C_<kind>.mcap`,
+    /// `import.json`); it must not exist or be empty.
+    #[arg(long, short = 'o')]
+    pub out: PathBuf,
+    /// Column mapping, units and timing of every activation file.
+    #[command(flatten)]
+    pub reading: ReadingArgs,
 }
 
 fn three(option: &'static str, names: &[String]) -> anyhow::Result<[String; 3]> {
@@ -114,6 +143,24 @@ fn three(option: &'static str, names: &[String]) -> anyhow::Result<[String; 3]> 
 
 impl CsvArgs {
     /// The reader's options, with each bad value named by its option.
+    pub fn options(&self) -> anyhow::Result<CsvOptions> {
+        let mut options = self.reading.options()?;
+        options.columns.segment = (!self.no_segment_column).then(|| self.segment_column.clone());
+        options.unit_id = self.unit_id.clone();
+        options.set_point_celsius = self.set_point;
+        options.series_kind = SeriesKind::parse(&self.series_kind).ok_or_else(|| {
+            anyhow::anyhow!(
+                "option `--series-kind`: expected `protocol` or `field`, got `{}`",
+                self.series_kind
+            )
+        })?;
+        Ok(options)
+    }
+}
+
+impl ReadingArgs {
+    /// The reader's options for these columns, units and timing (unit id, set point, series kind
+    /// and activation column at their defaults), with each bad value named by its option.
     pub fn options(&self) -> anyhow::Result<CsvOptions> {
         let temperature = match self.temperature_columns.as_slice() {
             [one] => [one.clone(), one.clone(), one.clone()],
@@ -134,7 +181,7 @@ impl CsvArgs {
                 time_s: self.time_column.clone(),
                 rate_dps: three("rate-columns", &self.rate_columns)?,
                 temperature_celsius: temperature,
-                segment: (!self.no_segment_column).then(|| self.segment_column.clone()),
+                segment: None,
                 accel_g: self
                     .accel_columns
                     .as_deref()
@@ -152,14 +199,6 @@ impl CsvArgs {
             },
             sample_rate_hz: self.rate_hz,
             timing,
-            unit_id: self.unit_id.clone(),
-            set_point_celsius: self.set_point,
-            series_kind: SeriesKind::parse(&self.series_kind).ok_or_else(|| {
-                anyhow::anyhow!(
-                    "option `--series-kind`: expected `protocol` or `field`, got `{}`",
-                    self.series_kind
-                )
-            })?,
             temperature_dropouts: self.temperature_dropouts,
             rate_unit: RateUnit::parse(&self.rate_unit).ok_or_else(|| {
                 anyhow::anyhow!(
@@ -173,6 +212,7 @@ impl CsvArgs {
                     self.time_unit
                 )
             })?,
+            ..CsvOptions::default()
         })
     }
 }
@@ -215,6 +255,8 @@ pub fn destination(out: &Path, unit_id: &str, source: &Path) -> (PathBuf, Option
 pub fn run(args: &Args) -> anyhow::Result<()> {
     match &args.format {
         Format::Csv(csv) => run_csv(csv),
+        Format::Campaign(campaign) => super::import_campaign::run(campaign),
+        Format::Ulog(ulog) => super::import_ulog::run(ulog),
     }
 }
 

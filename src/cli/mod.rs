@@ -9,6 +9,8 @@ pub mod diagnose;
 mod extend;
 pub mod fit;
 pub mod import;
+mod import_campaign;
+mod import_ulog;
 mod measured;
 mod progress;
 pub mod report;

@@ -24,7 +24,15 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     pub validation: Vec<f64>,
-    /// Campaign folder of units with zero systematic drift: the noise floor.
+    /// Recordings to judge on, a source separate from the calibration data (the campaign or
+    /// `--calibration-data`): every activation of the fitted units, none of which reaches a fit
+    /// (protocol activations as validation at their set point, field sessions as field);
+    /// `--validation` is not used.
+    #[arg(long, value_name = "DIR")]
+    pub evaluation_data: Option<PathBuf>,
+    /// Campaign folder of units with zero systematic drift: the noise floor, measured at the
+    /// validation set points (with `--evaluation-data`: at the evaluation data's). A twin with no
+    /// calibration activations of its own is corrected with the tables of the unit of its id.
     #[arg(long)]
     pub noise_floor: Option<PathBuf>,
     /// Output folder for the report, its figures and the fitted tables.
@@ -66,9 +74,12 @@ pub fn print_headline(outcome: &Outcome) {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
     let options = input.options(&args.validation, true)?;
-    let provenance = drift_report::provenance(&input.campaign.display().to_string(), &options);
+    if let Some(evaluation) = &args.evaluation_data {
+        return run_separate(args, evaluation, &options);
+    }
+    let provenance = drift_report::provenance(&input.source().display().to_string(), &options);
     let made = make(
-        &input.campaign,
+        input.source(),
         args.noise_floor.as_deref(),
         &options,
         &args.out,
@@ -90,7 +101,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     {
         return Err(error);
     }
-    let files = pipeline::recording_files(&input.campaign)?;
+    let files = pipeline::recording_files(input.source())?;
     let unfittable = measured::unfittable(&files)?;
     if unfittable.is_empty() {
         return Err(error);
@@ -123,5 +134,38 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "report (measured data, no tables fitted): {}",
         path.display()
     );
+    Ok(())
+}
+
+/// `gyrodrift report --calibration-data A --evaluation-data B`: fit on A, judge on B.
+fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Result<()> {
+    let input = &args.input;
+    let provenance = vec![format!(
+        "Calibration data: `{}` (calibration {:?} °C); evaluation data: `{}` (every activation of the fitted units; none reaches a fit).",
+        input.source().display(),
+        options.calibration_set_points,
+        evaluation.display()
+    )];
+    let steps = Steps::new(input.quiet);
+    let calibration = pipeline::recording_files(input.source())?;
+    let evaluated = pipeline::recording_files(evaluation)?;
+    let noise_files = args
+        .noise_floor
+        .as_deref()
+        .map(pipeline::recording_files)
+        .transpose()?;
+    let made = drift_report::make_separate(
+        &calibration,
+        &evaluated,
+        noise_files.as_deref(),
+        options,
+        &args.out,
+        provenance,
+        &|s, d, t| steps.update(s, d, t),
+    );
+    steps.finish();
+    let (path, outcome) = made?;
+    print_headline(&outcome);
+    println!("report: {}", path.display());
     Ok(())
 }

@@ -46,6 +46,23 @@ pub enum PipelineError {
     /// Analysing or fitting failed (the error names the unit and activation).
     #[error(transparent)]
     Fit(#[from] FitError),
+    /// No unit of the evaluation data was fitted on the calibration data.
+    #[error("no unit of the evaluation data ({evaluated}) was fitted on the calibration data (fitted: {fitted}): the evaluation data must be recordings of the fitted units")]
+    NoFittedUnit {
+        /// Unit ids of the evaluation data, comma-separated.
+        evaluated: String,
+        /// Unit ids fitted, comma-separated.
+        fitted: String,
+    },
+    /// A noise-floor unit has no calibration activations of its own, and no unit of its id was
+    /// fitted.
+    #[error("noise-floor unit {unit} has no protocol activations at the calibration set points {set_points:?} °C, and no unit of that id was fitted to take the tables from")]
+    NoiseFloorUnfitted {
+        /// The noise-floor unit.
+        unit: String,
+        /// The calibration set points asked for.
+        set_points: Vec<f64>,
+    },
     /// None of the recordings has protocol activations at the calibration set points.
     #[error("no protocol activations at the calibration set points {set_points:?} °C in {files} recordings")]
     NoCalibration {
@@ -175,25 +192,182 @@ pub fn run_with_noise_floor(
     options: &Options,
     progress: Progress<'_>,
 ) -> Result<(Outcome, Vec<String>), PipelineError> {
-    let mut outcome = run(files, options, false, progress)?;
-    let mut noise_units = Vec::new();
-    if let Some(noise_files) = noise_floor {
-        let noise = run(noise_files, options, true, progress)?;
-        for (split, mut result) in noise.results {
-            result.labels.unit_id = format!("{NOISE_FLOOR_PREFIX}{}", result.labels.unit_id);
-            if !noise_units.contains(&result.labels.unit_id) {
-                noise_units.push(result.labels.unit_id.clone());
-            }
-            outcome.results.push((split, result));
-        }
-        outcome.timings.extend(
-            noise
-                .timings
-                .into_iter()
-                .map(|(step, seconds)| (format!("noise floor: {step}"), seconds)),
-        );
+    let outcome = run(files, options, false, progress)?;
+    let validation = options.validation_set_points.clone();
+    add_noise_floor(outcome, noise_floor, options, &validation, progress)
+}
+
+/// Fits on the calibration activations of `calibration` (protocol activations at the calibration
+/// set points) and evaluates every activation of `evaluation`, a separate source none of which
+/// reaches a fit: protocol activations as [`Split::Validation`] at whatever set point, field
+/// sessions as [`Split::Field`]. Activations of units not fitted are skipped (at least one unit
+/// must match). With `noise_floor`, a campaign of zero-drift twins is evaluated at the set points
+/// of the evaluation data ([`run_with_noise_floor`]); a twin recorded only there is corrected with
+/// the tables fitted for the unit of its id. `options.validation_set_points` and
+/// `options.held_out_repeats` are not used.
+pub fn run_separate(
+    calibration: &[PathBuf],
+    evaluation: &[PathBuf],
+    noise_floor: Option<&[PathBuf]>,
+    options: &Options,
+    progress: Progress<'_>,
+) -> Result<(Outcome, Vec<String>), PipelineError> {
+    let fit_only = Options {
+        held_out_repeats: false,
+        evaluate: false,
+        ..options.clone()
+    };
+    let mut outcome = run(calibration, &fit_only, false, progress)?;
+    let started = Instant::now();
+    let mut evaluated_units = BTreeSet::new();
+    let fitted = &outcome.fitted;
+    let results = evaluate_files(evaluation, &options.fit, progress, |unit, segment| {
+        evaluated_units.insert(unit.to_owned());
+        let model = fitted.iter().find(|f| f.unit_id == unit)?;
+        let split = if segment.labels.series_kind == SeriesKind::Field {
+            Split::Field
+        } else {
+            Split::Validation
+        };
+        Some((split, model))
+    })?;
+    if results.is_empty() && !evaluated_units.is_empty() {
+        return Err(PipelineError::NoFittedUnit {
+            evaluated: evaluated_units.into_iter().collect::<Vec<_>>().join(", "),
+            fitted: fitted
+                .iter()
+                .map(|f| f.unit_id.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
     }
+    outcome.results = results;
+    outcome.timings.push((
+        "read the evaluation data, correct and evaluate".into(),
+        started.elapsed().as_secs_f64(),
+    ));
+    let mut set_points: Vec<f64> = Vec::new();
+    for (_, result) in &outcome.results {
+        let s = result.labels.nominal_set_point_celsius();
+        if !is_one_of(s, &set_points) {
+            set_points.push(s);
+        }
+    }
+    add_noise_floor(outcome, noise_floor, options, &set_points, progress)
+}
+
+/// Adds the noise-floor twins' results (every activation at one of `set_points`, nominal) to
+/// `outcome`, their unit ids prefixed by [`NOISE_FLOOR_PREFIX`]: each twin corrected with its own
+/// tables when its recordings have calibration activations, else with the tables of the fitted
+/// unit of its id.
+fn add_noise_floor(
+    mut outcome: Outcome,
+    noise_floor: Option<&[PathBuf]>,
+    options: &Options,
+    set_points: &[f64],
+    progress: Progress<'_>,
+) -> Result<(Outcome, Vec<String>), PipelineError> {
+    let mut noise_units = Vec::new();
+    let Some(noise_files) = noise_floor else {
+        return Ok((outcome, noise_units));
+    };
+    let own = Options {
+        held_out_repeats: false,
+        evaluate: false,
+        ..options.clone()
+    };
+    let noise = match run(noise_files, &own, true, progress) {
+        Ok(noise) => noise,
+        // Recorded at the evaluation set points only: the fitted units' tables.
+        Err(PipelineError::NoCalibration { .. }) => Outcome::default(),
+        Err(e) => return Err(e),
+    };
+    let started = Instant::now();
+    let mut missing = None;
+    let results = evaluate_files(noise_files, &options.fit, progress, |unit, segment| {
+        let model = noise
+            .fitted
+            .iter()
+            .chain(&outcome.fitted)
+            .find(|f| f.unit_id == unit);
+        if model.is_none() {
+            missing.get_or_insert_with(|| unit.to_owned());
+        }
+        is_one_of(segment.labels.nominal_set_point_celsius(), set_points)
+            .then_some((Split::NoiseFloor, model?))
+    })?;
+    if let Some(unit) = missing {
+        return Err(PipelineError::NoiseFloorUnfitted {
+            unit,
+            set_points: options.calibration_set_points.clone(),
+        });
+    }
+    for (split, mut result) in results {
+        result.labels.unit_id = format!("{NOISE_FLOOR_PREFIX}{}", result.labels.unit_id);
+        if !noise_units.contains(&result.labels.unit_id) {
+            noise_units.push(result.labels.unit_id.clone());
+        }
+        outcome.results.push((split, result));
+    }
+    outcome.timings.extend(
+        noise
+            .timings
+            .into_iter()
+            .map(|(step, seconds)| (format!("noise floor: {step}"), seconds)),
+    );
+    outcome.timings.push((
+        "noise floor: read again, correct and evaluate".into(),
+        started.elapsed().as_secs_f64(),
+    ));
     Ok((outcome, noise_units))
+}
+
+/// Reads `files` one at a time and evaluates the activations `choose` gives a split and tables
+/// for (by unit id and activation), each after what firmware kept of the activations before it in
+/// its recording; results in file and activation order.
+fn evaluate_files<'a>(
+    files: &[PathBuf],
+    settings: &FitSettings,
+    progress: Progress<'_>,
+    mut choose: impl FnMut(&str, &Segment) -> Option<(Split, &'a FittedUnit)>,
+) -> Result<Vec<(Split, ActivationResult)>, PipelineError> {
+    let mut out = Vec::new();
+    for (i, path) in files.iter().enumerate() {
+        progress("correcting and evaluating", i as u64, files.len() as u64);
+        let recording = read_recording(path)?;
+        let chosen: Vec<Option<(Split, &FittedUnit)>> = recording
+            .segments
+            .iter()
+            .map(|s| choose(&recording.unit_id, s))
+            .collect();
+        let Some(by_history) = chosen
+            .iter()
+            .flatten()
+            .map(|(_, f)| &f.by_history.settings)
+            .next()
+        else {
+            continue;
+        };
+        let segments: Vec<&Segment> = recording.segments.iter().collect();
+        let kept = kept_before(&segments, settings, by_history, true);
+        let results: Vec<(Split, ActivationResult)> = recording
+            .segments
+            .par_iter()
+            .zip(kept.par_iter())
+            .zip(chosen.par_iter())
+            .filter_map(|((segment, previous), chosen)| {
+                let (split, model) = (*chosen)?;
+                Some((split, evaluate_after(model, segment, settings, previous)))
+            })
+            .collect();
+        out.extend(results);
+    }
+    progress(
+        "correcting and evaluating",
+        files.len() as u64,
+        files.len() as u64,
+    );
+    Ok(out)
 }
 
 /// Fits every unit found in `files` and evaluates on everything the fits did not see.

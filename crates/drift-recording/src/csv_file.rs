@@ -758,7 +758,7 @@ fn to_segment(
                     return Err(timing_error(
                         i,
                         format!(
-                            "{what}: time {t} s is sample {position:.2} of the activation at {} Hz, expected sample {i}",
+                            "{what}: time {t} s is sample {position:.2} of the activation at {} Hz, expected sample {i} (host timestamps with jitter or pauses: read them with resampled timing, `CsvTiming::Resample`, on the command line `--timing resample --rate-hz <the logging rate>`)",
                             options.sample_rate_hz
                         ),
                     ));

@@ -7,7 +7,8 @@
 //! activation, with their protocol labels; it refuses simulator ground truth, so code that reads
 //! through it cannot see the truth.
 //! [`write_recording`] writes the same format from a real test bench's data, and [`read_csv`] reads
-//! measured data from CSV into the same segments.
+//! measured data from CSV into the same segments; [`read_sheet_campaign`] reads a bench campaign
+//! kept as one CSV file per activation plus an activation sheet.
 
 pub mod atomic;
 mod aux;
@@ -21,6 +22,8 @@ pub mod paper;
 mod read;
 pub mod schema;
 mod segment;
+mod sheet;
+pub mod ulog;
 mod writable;
 mod write;
 pub mod writer;
@@ -41,5 +44,8 @@ pub use read::{
 pub use segment::{
     temperature_reading, AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS,
     TEMPERATURE_MISSING_RAW,
+};
+pub use sheet::{
+    read_sheet, read_sheet_campaign, recording_stem, SheetError, SheetRow, SHEET_COLUMNS,
 };
 pub use write::{create_recording, write_recording};

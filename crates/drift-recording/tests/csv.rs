@@ -259,6 +259,7 @@ fn each_bad_row_is_named_by_column_and_row() {
                 "row 6 (line 7), column `t_s`",
                 "gap: time 0.08 s is sample 8.00",
                 "expected sample 5",
+                "`--timing resample --rate-hz",
             ],
         ),
         (

@@ -45,12 +45,37 @@ pub fn make(
 ) -> anyhow::Result<(PathBuf, Outcome)> {
     let (outcome, noise_units) =
         pipeline::run_with_noise_floor(files, noise_floor, options, progress)?;
+    write_outcome(outcome, &noise_units, out, provenance)
+}
+
+/// [`make`] with the data split by source: fits on the calibration activations of `calibration`
+/// and judges on every activation of `evaluation` ([`pipeline::run_separate`]).
+pub fn make_separate(
+    calibration: &[PathBuf],
+    evaluation: &[PathBuf],
+    noise_floor: Option<&[PathBuf]>,
+    options: &Options,
+    out: &Path,
+    provenance: Vec<String>,
+    progress: Progress<'_>,
+) -> anyhow::Result<(PathBuf, Outcome)> {
+    let (outcome, noise_units) =
+        pipeline::run_separate(calibration, evaluation, noise_floor, options, progress)?;
+    write_outcome(outcome, &noise_units, out, provenance)
+}
+
+fn write_outcome(
+    outcome: Outcome,
+    noise_units: &[String],
+    out: &Path,
+    provenance: Vec<String>,
+) -> anyhow::Result<(PathBuf, Outcome)> {
     tables_folder::write(&out.join("tables"), &outcome.fitted)?;
     let input = ReportInput {
         title: TITLE,
         provenance,
         fitted: &outcome.fitted,
-        noise_floor_units: &noise_units,
+        noise_floor_units: noise_units,
         calibration: &outcome.calibration,
         results: &outcome.results,
         timings: outcome.timings.clone(),
