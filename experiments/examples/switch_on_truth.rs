@@ -136,6 +136,7 @@ fn main() -> anyhow::Result<()> {
         &fitted,
         &segments,
         &plan.calibration,
+        &[],
         &settings,
         false,
         plan.clock,

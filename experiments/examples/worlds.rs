@@ -5,7 +5,7 @@
 //! ```sh
 //! cargo run --release -p experiments --example worlds -- [--families all|humidity,…] \
 //!     [--worlds-per-family 20] [--null-worlds 30] [--first-seed 10000] [--jobs 1] \
-//!     [--out table.md] [--json scores.jsonl] [--small]
+//!     [--out table.md] [--json scores.jsonl] [--small] [--select-on-validation]
 //! ```
 //!
 //! World k of every family (and null world k) is drawn from seed `first-seed + k`: the same unit
@@ -25,7 +25,8 @@ use experiments::worlds::{
 };
 
 const USAGE: &str = "worlds [--families all|accelerometer,humidity,…] [--worlds-per-family 20] \
-[--null-worlds 30] [--first-seed 10000] [--jobs 1] [--out table.md] [--json scores.jsonl] [--small]";
+[--null-worlds 30] [--first-seed 10000] [--jobs 1] [--out table.md] [--json scores.jsonl] [--small] \
+[--select-on-validation]";
 
 /// The value after `flag`.
 fn value(args: &[String], flag: &str) -> Option<String> {
@@ -61,9 +62,16 @@ fn child<T: serde::de::DeserializeOwned>(args: &[&str]) -> anyhow::Result<T> {
 }
 
 /// One world: recorded in one child, closed blind in another, scored here.
-fn one_world(kind: Kind, seed: u64, work: &Path, small: bool) -> anyhow::Result<WorldScore> {
+fn one_world(
+    kind: Kind,
+    seed: u64,
+    work: &Path,
+    small: bool,
+    select: bool,
+) -> anyhow::Result<WorldScore> {
     let paths = WorldPaths::new(work, kind, seed);
     let small_flag = if small { "yes" } else { "no" };
+    let select_flag = if select { "yes" } else { "no" };
     let seed_text = seed.to_string();
     let work_text = work.display().to_string();
     let recorded: anyhow::Result<Recorded> = child(&[
@@ -79,6 +87,7 @@ fn one_world(kind: Kind, seed: u64, work: &Path, small: bool) -> anyhow::Result<
             &paths.dir.display().to_string(),
             &paths.floor_dir.display().to_string(),
             small_flag,
+            select_flag,
         ]),
         Err(_) => Err(anyhow::anyhow!("not recorded")),
     };
@@ -92,7 +101,8 @@ fn one_world(kind: Kind, seed: u64, work: &Path, small: bool) -> anyhow::Result<
 }
 
 /// A child's part: `--child-record <kind> <seed> <work> <yes|no>` records one world;
-/// `--child-loop <world dir> <floor dir> <yes|no>` closes the loop on the two recordings folders.
+/// `--child-loop <world dir> <floor dir> <small: yes|no> <select on +33 °C: yes|no>` closes the
+/// loop on the two recordings folders.
 fn child_part(args: &[String]) -> anyhow::Result<()> {
     let small = |i: usize| args.get(i).is_some_and(|s| s == "yes");
     let arg = |i: usize| args.get(i).context("missing a child argument");
@@ -108,6 +118,7 @@ fn child_part(args: &[String]) -> anyhow::Result<()> {
             Path::new(arg(1)?),
             Path::new(arg(2)?),
             &settings,
+            small(4),
         )?)?
     };
     println!("{line}");
@@ -128,7 +139,12 @@ fn main() -> anyhow::Result<()> {
         return Ok(());
     }
     let small = args.iter().any(|a| a == "--small");
-    let rest: Vec<&String> = args.iter().filter(|a| *a != "--small").collect();
+    // The +33 °C protocol activations join the diagnosis (not the measurement).
+    let select = args.iter().any(|a| a == "--select-on-validation");
+    let rest: Vec<&String> = args
+        .iter()
+        .filter(|a| *a != "--small" && *a != "--select-on-validation")
+        .collect();
     const FLAGS: [&str; 7] = [
         "--families",
         "--worlds-per-family",
@@ -205,7 +221,7 @@ fn main() -> anyhow::Result<()> {
             s.spawn(|| loop {
                 let next = queue.lock().map(|mut q| q.next()).ok().flatten();
                 let Some((kind, seed)) = next else { break };
-                let result = one_world(kind, seed, work.path(), small);
+                let result = one_world(kind, seed, work.path(), small, select);
                 let mut guard = match results.lock() {
                     Ok(g) => g,
                     Err(p) => p.into_inner(),

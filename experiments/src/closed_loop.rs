@@ -401,7 +401,15 @@ pub fn run(
     for crossing in &base.crossings {
         eprintln!("  tables: {}", crossing.note());
     }
-    let closed = close(&base, &all, calibration, settings, true, plan_size.clock)?;
+    let closed = close(
+        &base,
+        &all,
+        calibration,
+        &[],
+        settings,
+        true,
+        plan_size.clock,
+    )?;
     eprintln!(
         "  {} field activations at the calibration set points inside the calibrated ambient range, {} outside held out",
         closed.roles.training.len(),

@@ -269,10 +269,13 @@ fn is(set_point: f64, value: f64) -> bool {
 
 /// Step 2: the loop, blind. Reads the world's recordings folder (`dir`) and the twin's
 /// (`floor_dir`) and nothing else.
+/// With `select_on_validation`, the +33 °C protocol activations join the diagnosis
+/// (`Roles::select`); the before/after is on the +33 °C field activations either way.
 pub fn close_blind(
     dir: &Path,
     floor_dir: &Path,
     settings: &FitSettings,
+    select_on_validation: bool,
 ) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let all = segments(&dir.join(RECORDINGS_DIR))?;
@@ -282,7 +285,12 @@ pub fn close_blind(
         .map(|s| analyse(s, settings))
         .collect::<Result<Vec<_>, _>>()?;
     let base = fit_unit(&analysed, settings)?;
-    let closed = close(&base, &all, &CALIBRATION, settings, true, true)?;
+    let selection: &[f64] = if select_on_validation {
+        &[VALIDATION]
+    } else {
+        &[]
+    };
+    let closed = close(&base, &all, &CALIBRATION, selection, settings, true, true)?;
     let measured: Vec<_> = closed
         .before_after(&base, settings)
         .into_iter()
@@ -551,7 +559,7 @@ pub fn run_world(kind: Kind, seed: u64, work: &Path, small: bool) -> anyhow::Res
     let outcome = recorded
         .as_ref()
         .ok()
-        .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(small)));
+        .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(small), false));
     paths.remove_recordings();
     let result = match (recorded, outcome) {
         (Ok(r), Some(Ok(o))) => score(kind, seed, &paths.truth, &r, &o),

@@ -42,6 +42,11 @@ pub struct Args {
     /// and after.
     #[arg(long, requires = "extend")]
     pub noise_floor: Option<PathBuf>,
+    /// Set points (not the calibration's) whose protocol activations the diagnosis also ranks
+    /// candidates on, e.g. the validation campaign: more activations to find an effect with, and
+    /// none of them measured on afterwards (the before/after uses the rest).
+    #[arg(long, value_delimiter = ',', value_name = "CELSIUS,...")]
+    pub select_on: Vec<f64>,
 }
 
 /// Where the tables' own history lookup fails, as Markdown: no per-sample candidate can carry it
@@ -383,6 +388,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             fitted,
             segments,
             &options.calibration_set_points,
+            &args.select_on,
             &options.fit,
             args.extend,
             true,
@@ -415,12 +421,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         {
             let _ = writeln!(
                 md,
-                "Diagnosed on {} activations the fit never saw ({}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are held out with the rest ({} held out in all).\n",
+                "Diagnosed on {} activations the fit never saw ({}{}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are held out with the rest ({} held out in all).\n",
                 activations.len(),
-                if roles.training.is_empty() {
+                if roles.training.is_empty() && roles.selection.is_empty() {
                     "every activation outside the calibration protocol"
                 } else {
                     "field-like activations at the calibration set points"
+                },
+                if roles.selection.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " and {} protocol activations at {:?} °C, not measured on afterwards",
+                        roles.selection.len(),
+                        args.select_on
+                    )
                 },
                 roles.outside_range,
                 roles.held_out.len()

@@ -251,23 +251,27 @@ fn choose_stage3(
 /// activations ([`Stage3Choice`]; `clock`: the firmware also knows when the unit cooled fully,
 /// [`drift_evaluate::evaluate::kept_before`]), diagnoses the chosen model on the training activations (or,
 /// without any, on every activation the fit did not see), and with `extend` fits the guarded
-/// extended model.
+/// extended model. The protocol activations at `selection_set_points` (set points the fit did not
+/// use) are diagnosed beside the training ones and not measured on ([`Roles::select`]).
 pub fn close<'a>(
     fitted: &FittedUnit,
     segments: impl IntoIterator<Item = &'a Segment>,
     calibration_set_points: &[f64],
+    selection_set_points: &[f64],
     settings: &FitSettings,
     extend_model: bool,
     clock: bool,
 ) -> Result<Closed<'a>, FitError> {
     let mut roles = Roles::split(segments, calibration_set_points);
     roles.hold_out_outside_range(fitted, settings);
+    roles.select(selection_set_points);
     // The unit's whole life in order, as its firmware would have lived it: every activation
     // passes what it kept on to the next.
     let life: Vec<&Segment> = roles
         .calibration
         .iter()
         .chain(&roles.training)
+        .chain(&roles.selection)
         .chain(&roles.held_out)
         .copied()
         .collect();

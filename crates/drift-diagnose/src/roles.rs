@@ -5,6 +5,9 @@
 //! - **training**: field-like activations at the calibration set points that switch on inside the
 //!   calibrated ambient range — the diagnosis ranks candidates on them, the guard admits terms on
 //!   them, the terms' coefficients are fitted on them;
+//! - **selection** (only when the analyst names set points for it): the protocol activations at
+//!   those set points, which the fit never saw — the diagnosis ranks candidates on them beside the
+//!   training ones, and nothing is measured on them;
 //! - **held out**: everything else (other set points, other sessions, and the training-like
 //!   activations outside the ambient range) — the before/after is measured on them.
 
@@ -23,6 +26,8 @@ pub struct Roles<'a> {
     /// Field-like activations at the calibration set points (inside the ambient range once
     /// [`Roles::hold_out_outside_range`] ran).
     pub training: Vec<&'a Segment>,
+    /// Protocol activations at set points named for the diagnosis ([`Roles::select`]).
+    pub selection: Vec<&'a Segment>,
     /// Everything else.
     pub held_out: Vec<&'a Segment>,
     /// How many field-like activations at the calibration set points were moved to `held_out`
@@ -69,14 +74,32 @@ impl<'a> Roles<'a> {
         self.held_out.extend(outside);
     }
 
-    /// The activations the diagnosis ranks candidates on: the training ones when there are any
-    /// (so the held-out ones stay unseen until the before/after), else every activation the fit
-    /// did not see.
-    pub fn diagnosed(&self) -> &[&'a Segment] {
-        if self.training.is_empty() {
-            &self.held_out
+    /// Moves the held-out protocol activations at `set_points` (none of them a calibration set
+    /// point: those are the fit's) to the selection: more activations to rank candidates on, at
+    /// the price of measuring nothing on them.
+    pub fn select(&mut self, set_points: &[f64]) {
+        let (selected, kept): (Vec<&Segment>, Vec<&Segment>) = std::mem::take(&mut self.held_out)
+            .into_iter()
+            .partition(|s| {
+                s.labels.series_kind == SeriesKind::Protocol
+                    && is_one_of(s.labels.nominal_set_point_celsius(), set_points)
+            });
+        self.selection.extend(selected);
+        self.held_out = kept;
+    }
+
+    /// The activations the diagnosis ranks candidates on: the training and selection ones when
+    /// there are any (so the held-out ones stay unseen until the before/after), else every
+    /// activation the fit did not see.
+    pub fn diagnosed(&self) -> Vec<&'a Segment> {
+        if self.training.is_empty() && self.selection.is_empty() {
+            self.held_out.clone()
         } else {
-            &self.training
+            self.training
+                .iter()
+                .chain(&self.selection)
+                .copied()
+                .collect()
         }
     }
 }

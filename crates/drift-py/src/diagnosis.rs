@@ -112,7 +112,7 @@ pub fn diagnose_unit(
                 all.len()
             )));
         }
-        let closed = close(unit, own, &set_points, settings, extend, true)?;
+        let closed = close(unit, own, &set_points, &[], settings, extend, true)?;
         if closed.series.is_empty() {
             return Err(Error::Input(format!(
                 "`segments` holds no activation of unit {} outside the calibration protocol at {set_points:?} °C to diagnose",
