@@ -99,6 +99,9 @@ pub struct CsvArgs {
     /// Read an empty or NaN temperature cell as a sensor dropout instead of an error.
     #[arg(long)]
     pub temperature_dropouts: bool,
+    /// Largest plausible |rate|, °/s: a row beyond it is an error naming the row and column.
+    #[arg(long, default_value_t = drift_recording::MAX_PLAUSIBLE_RATE_DPS)]
+    pub max_rate: f64,
 }
 
 fn three(option: &'static str, names: &[String]) -> anyhow::Result<[String; 3]> {
@@ -173,6 +176,7 @@ impl CsvArgs {
                     self.time_unit
                 )
             })?,
+            max_rate_dps: self.max_rate,
         })
     }
 }
