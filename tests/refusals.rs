@@ -554,25 +554,3 @@ fn long_numbers_are_shortened() {
     );
     assert!(text.len() < 300, "{text}");
 }
-
-#[test]
-fn tables_with_an_implausible_k_are_refused_naming_the_field() {
-    use drift_core::Model as _;
-    let dir = tempfile::tempdir().unwrap();
-    let tables = dir.path().join("tables");
-    common::ok(&["fit", s(campaign()), "-q", "-o", s(&tables)]);
-    let text = std::fs::read_to_string(tables.join("GIU-01/modified.json")).unwrap();
-    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
-    value["axes"][1]["ambients"][0]["curves"][0]["points"][2]["k_dps_per_celsius"] = 1e3.into();
-    let model: drift_core::ModifiedTables = serde_json::from_value(value).unwrap();
-    let error = model.validate().unwrap_err().to_string();
-    assert!(
-        error.starts_with(
-            "axes[1].ambients[0].curves[0].points[2].k_dps_per_celsius: beyond physical plausibility"
-        ),
-        "{error}"
-    );
-    // Nor can such tables become a firmware image.
-    let mut image = vec![0u8; 1 << 20];
-    assert!(drift_core::blob::encode(&model, &mut image).is_err());
-}

@@ -5,7 +5,6 @@ use drift_recording::{COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR};
 use drift_sim::campaign::TruthBias;
 use drift_sim::overrides::{parse_set_points, Overrides};
 use drift_sim::Campaign;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// A size in GB or TB, three significant digits.

@@ -97,12 +97,6 @@ pub enum Problem {
     },
     /// Differs from an earlier entry it must equal.
     Mismatch,
-    /// Finite, but beyond what any MEMS gyroscope's drift can be: its magnitude must not exceed
-    /// `limit` (in the field's unit).
-    Implausible {
-        /// The largest plausible magnitude.
-        limit: u16,
-    },
 }
 
 /// A table or settings value failed validation.
@@ -154,10 +148,6 @@ impl fmt::Display for Error {
             }
             Problem::OutOfRange { limit } => write!(f, ": must be less than {limit}"),
             Problem::Mismatch => f.write_str(": differs from the earlier entry it must equal"),
-            Problem::Implausible { limit } => write!(
-                f,
-                ": beyond physical plausibility (its magnitude must be at most {limit} in the field's unit)"
-            ),
         }
     }
 }

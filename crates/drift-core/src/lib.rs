@@ -51,10 +51,7 @@ pub use polynomial::{
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};
-pub use table::{
-    AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, MAX_BIAS_DPS,
-    MAX_K_DPS_PER_CELSIUS,
-};
+pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables};
 pub use warm_start::WarmStart;
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.

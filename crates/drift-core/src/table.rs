@@ -11,15 +11,6 @@ use crate::settings::Settings;
 use crate::warm_start::{self, WarmStart};
 use crate::AXES;
 
-/// Largest plausible drift coefficient `k = drift / rise`, (°/s)/°C. Fitted tables hold
-/// ~0.001–0.01 (0.0058 at most on a simulated unit); early in an activation the rise can be a tenth
-/// of a degree, so `k` gets room, but 10 (°/s)/°C over a 30 °C rise is 300 °/s of drift, no
-/// gyroscope's. A larger `k` is a unit or fitting error, refused by validation rather than applied.
-pub const MAX_K_DPS_PER_CELSIUS: f32 = 10.0;
-/// Largest plausible switch-on bias, °/s: 100 °/s is beyond any MEMS gyroscope's bias
-/// specification (typically ≤ 5 °/s).
-pub const MAX_BIAS_DPS: f32 = 100.0;
-
 /// One point of a heating-dynamics curve: where the curve stood at one reference time.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -188,15 +179,6 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
             if !ambient.initial_bias_dps.is_finite() {
                 return Err(Error::new("initial_bias_dps", at, Problem::NonFinite));
             }
-            if ambient.initial_bias_dps.abs() > MAX_BIAS_DPS {
-                return Err(Error::new(
-                    "initial_bias_dps",
-                    at,
-                    Problem::Implausible {
-                        limit: MAX_BIAS_DPS as u16,
-                    },
-                ));
-            }
             warm_start::validate(&ambient.warm_starts, at)?;
             if ambient.warm_starts.is_empty() && warm_started {
                 return Err(Error::new("warm_starts", at, Problem::Empty));
@@ -218,15 +200,6 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
                         if !value.is_finite() {
                             return Err(Error::new(field, at.point(j), Problem::NonFinite));
                         }
-                    }
-                    if point.k_dps_per_celsius.abs() > MAX_K_DPS_PER_CELSIUS {
-                        return Err(Error::new(
-                            "k_dps_per_celsius",
-                            at.point(j),
-                            Problem::Implausible {
-                                limit: MAX_K_DPS_PER_CELSIUS as u16,
-                            },
-                        ));
                     }
                 }
             }
