@@ -42,11 +42,8 @@ fn main() -> std::process::ExitCode {
             "cannot start the command's thread: {error}"
         )),
     };
-    match outcome {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(error) => {
-            eprintln!("error: {error:#}");
-            std::process::ExitCode::FAILURE
-        }
+    if let Err(error) = &outcome {
+        eprintln!("error: {}", gyrodrift::cli::message(error));
     }
+    std::process::ExitCode::from(gyrodrift::cli::exit_status(&outcome))
 }

@@ -122,13 +122,14 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     std::fs::remove_dir_all(swapped.join("GIU-02")).unwrap();
     let missing = dir.path().join("missing");
     let (out, text) = check(&campaign, &swapped, &missing, &[]);
-    assert!(!out.status.success());
+    // Exit status 2: check could not run, which is not "the calibration is invalid" (1).
+    assert_eq!(out.status.code(), Some(2), "{text}");
     assert!(text.contains("GIU-02/modified.bin"), "{text}");
     assert!(!missing.exists());
 
     // A limit that means nothing is refused before anything is read.
     let (out, text) = check(&campaign, &tables, &missing, &["--max-rms", "-1"]);
-    assert!(!out.status.success());
+    assert_eq!(out.status.code(), Some(2), "{text}");
     assert!(
         text.contains("--max-rms must be a finite number ≥ 0, got -1"),
         "{text}"

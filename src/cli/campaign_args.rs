@@ -27,7 +27,8 @@ pub struct CampaignArgs {
         allow_hyphen_values = true
     )]
     pub calibration: Vec<f64>,
-    /// Fit settings as JSON (fields of `drift_fit::FitSettings`; missing fields keep defaults).
+    /// Fit settings as JSON (fields of `drift_fit::FitSettings`; missing fields keep defaults,
+    /// unknown ones are an error).
     #[arg(long)]
     pub settings: Option<PathBuf>,
     /// No progress bars.

@@ -192,8 +192,9 @@ fn markdown(results: &[UnitResult], limits: &Limits) -> String {
     md
 }
 
-/// Runs `gyrodrift check`; fails (exit status 1) when any unit × axis misses a limit, after
-/// writing the report.
+/// Runs `gyrodrift check`; fails with [`super::LimitsMissed`] (exit status 1) when any unit × axis
+/// misses a limit, after writing the report; any other error (no tables, unreadable recordings,
+/// bad limits) exits with status 2.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let limits = Limits {
         max_drift_dps: args.max_drift,
@@ -206,7 +207,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "max_residual_rms_dps" => "--max-rms",
             _ => "--min-removed",
         };
-        bail!("{flag} must be a finite number ≥ 0, got {value}");
+        bail!("{flag} must be {}, got {value}", Limits::requirement(field));
     }
     let files = pipeline::recording_files(&args.recordings)?;
     let settings = load_settings(args.settings.as_deref())?;
@@ -239,12 +240,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         })
         .collect();
     if !failed.is_empty() {
-        bail!(
+        return Err(super::LimitsMissed(format!(
             "the calibration misses the limits on {} of {} unit × axis: {}",
             failed.len(),
             3 * results.len(),
             failed.join(", ")
-        );
+        ))
+        .into());
     }
     Ok(())
 }

@@ -57,6 +57,18 @@ pub fn campaigns(seed: u64) -> (Campaign, Campaign) {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let (paper, noise) = campaigns(args.seed);
+    let bytes: f64 = [&paper, &noise]
+        .iter()
+        .map(|c| super::simulate::estimate_bytes(c, drift_sim::simulate::total_samples(c)))
+        .sum();
+    if !args.quiet {
+        // Disk use, stated before the large writes start.
+        eprintln!(
+            "demo: simulating two campaigns, about {} of recordings and truth → {}",
+            super::simulate::gigabytes(bytes / 1e9),
+            args.out.display()
+        );
+    }
     let steps = Steps::new(args.quiet);
     let mut simulated = Vec::new();
     for (campaign, folder) in [(&paper, "campaign"), (&noise, "noise-floor")] {

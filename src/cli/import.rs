@@ -112,6 +112,9 @@ pub struct ReadingArgs {
     /// Read an empty or NaN temperature cell as a sensor dropout instead of an error.
     #[arg(long)]
     pub temperature_dropouts: bool,
+    /// Largest plausible |rate|, °/s: a row beyond it is an error naming the row and column.
+    #[arg(long, default_value_t = drift_recording::MAX_PLAUSIBLE_RATE_DPS)]
+    pub max_rate: f64,
 }
 
 /// Options of `gyrodrift import campaign`.
@@ -212,6 +215,7 @@ impl ReadingArgs {
                     self.time_unit
                 )
             })?,
+            max_rate_dps: self.max_rate,
             ..CsvOptions::default()
         })
     }

@@ -16,9 +16,87 @@ mod progress;
 pub mod report;
 pub mod simulate;
 
+/// Exit status of every command: 0 done (for `check`: every limit met), 1 `check` found a unit ×
+/// axis missing a limit (its report is written), 2 the command could not do its job (usage, input or
+/// output error; the message says what and where).
+pub const EXIT_CODES: &str = "Exit status: 0 done (check: every limit met); 1 check: a unit × axis misses a limit (report written); 2 usage, input or output error (the message says what and where).";
+
+/// `check` ran and a unit × axis missed a limit: exit status 1, unlike every other error (2).
+#[derive(Debug)]
+pub struct LimitsMissed(pub String);
+
+impl std::fmt::Display for LimitsMissed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for LimitsMissed {}
+
+/// The exit status for a command's outcome: see [`EXIT_CODES`].
+pub fn exit_status(outcome: &anyhow::Result<()>) -> u8 {
+    match outcome {
+        Ok(()) => 0,
+        Err(error) if error.downcast_ref::<LimitsMissed>().is_some() => 1,
+        Err(_) => 2,
+    }
+}
+
+/// An error as one line: its chain of causes joined by `: `, leaving out a cause the text already
+/// says (`thiserror` messages often embed their source: "x.mcap: invalid magic: invalid magic"
+/// would repeat it), with digit runs longer than 16 shortened to scientific notation (a 301-digit
+/// `1e300` is read as `1.000e300`).
+pub fn message(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let part = cause.to_string();
+        if text.contains(&part) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    shorten_numbers(&text)
+}
+
+/// Replaces every run of more than 16 digits (an integer part no f64 prints usefully) with
+/// `d.ddde<exponent>`; the fraction after it, if any, is dropped.
+fn shorten_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let chars: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let start = i;
+        while i < chars.len() && chars[i].is_ascii_digit() {
+            i += 1;
+        }
+        let run = &chars[start..i];
+        if run.len() > 16 {
+            let mantissa: String = run[1..4].iter().collect();
+            out.push_str(&format!("{}.{mantissa}e{}", run[0], run.len() - 1));
+            // A fraction of a shortened number says nothing more.
+            if i + 1 < chars.len() && chars[i] == '.' && chars[i + 1].is_ascii_digit() {
+                i += 1;
+                while i < chars.len() && chars[i].is_ascii_digit() {
+                    i += 1;
+                }
+            }
+        } else {
+            out.extend(run);
+        }
+        if i < chars.len() && start == i {
+            out.push(chars[i]);
+            i += 1;
+        }
+    }
+    out
+}
+
 /// Temperature-drift correction for MEMS gyroscopes.
 #[derive(Debug, Parser)]
-#[command(name = "gyrodrift", version, about)]
+#[command(name = "gyrodrift", version, about, after_help = EXIT_CODES)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -54,5 +132,29 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Check(args) => check::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
         Command::Import(args) => import::run(&args),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_say_each_cause_once_and_shorten_long_numbers() {
+        let io = std::io::Error::other("invalid magic");
+        let error = anyhow::Error::new(io).context("x.mcap: invalid magic");
+        assert_eq!(message(&error), "x.mcap: invalid magic");
+        let error = anyhow::anyhow!("inner").context("outer");
+        assert_eq!(message(&error), "outer: inner");
+        let long = format!("got {}", 1e300);
+        assert_eq!(shorten_numbers(&long), "got 1.000e300");
+        assert_eq!(
+            shorten_numbers("got -1e300 and 12.5"),
+            "got -1e300 and 12.5"
+        );
+        assert_eq!(
+            shorten_numbers(&format!("{} °/s", 123_456_789_012_345_678.9_f64)),
+            "1.234e17 °/s"
+        );
     }
 }

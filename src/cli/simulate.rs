@@ -1,9 +1,22 @@
 //! `gyrodrift simulate`: record a simulated calibration campaign as a folder of MCAP files.
 
-use anyhow::Context;
+use anyhow::{bail, Context};
+use drift_recording::{COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR};
+use drift_sim::campaign::TruthBias;
 use drift_sim::overrides::{parse_set_points, Overrides};
 use drift_sim::Campaign;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// A size in GB or TB, three significant digits.
+pub(crate) fn gigabytes(gb: f64) -> String {
+    if gb >= 1000.0 {
+        format!("{:.3} TB", gb / 1000.0)
+    } else if gb >= 1.0 {
+        format!("{gb:.2} GB")
+    } else {
+        format!("{:.0} MB", gb * 1000.0)
+    }
+}
 
 /// Options of `gyrodrift simulate`. Flags override the campaign file; without a file the
 /// paper's campaign is used (2 units; +30, +40, +33 °C; intervals 1…30 min; 3 repeats).
@@ -53,9 +66,83 @@ pub struct Args {
     /// Store the true bias at 100 Hz instead of every sample (smaller, faster sidecar).
     #[arg(long)]
     pub truth_at_aux_rate: bool,
+    /// Replace a campaign already in the output folder (its recordings/, truth/ and summary.json
+    /// are removed first); without it, a non-empty output folder is refused.
+    #[arg(long)]
+    pub force: bool,
+    /// Most the campaign may write, GB (estimated before anything is written).
+    #[arg(long, default_value_t = 20.0)]
+    pub max_gb: f64,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+}
+
+/// What `simulate` writes into its output folder, and so what `--force` replaces.
+const WRITTEN: [&str; 3] = [RECORDINGS_DIR, TRUTH_DIR, COMPLETION_MARKER];
+
+/// Bytes a campaign writes, estimated from its gyro samples: measured 11.5 B per sample of
+/// recording, 17.0 B of truth sidecar at every sample and 6.1 B at the auxiliary rate
+/// (`gyrodrift simulate --units 1 --set-points 30 --repeats 1 --seed 1`, with and without
+/// `--truth-at-aux-rate`: 48.5 MB + 71.5 or 25.6 MB for 4.2 M samples), rounded up.
+pub(crate) fn estimate_bytes(campaign: &Campaign, samples: u64) -> f64 {
+    let truth = match campaign.truth_bias {
+        TruthBias::EverySample => 17.5,
+        TruthBias::AuxRate => 6.5,
+    };
+    samples as f64 * (12.0 + truth)
+}
+
+/// Refuses an output folder holding anything, unless `force`: then removes what an earlier
+/// simulation wrote there, and refuses anything else it holds (it is not ours to delete).
+fn prepare(out: &Path, force: bool) -> anyhow::Result<()> {
+    let entries: Vec<String> = match std::fs::read_dir(out) {
+        Ok(entries) => entries
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", out.display())),
+    };
+    if entries.is_empty() {
+        return Ok(());
+    }
+    let mut listed = entries.clone();
+    listed.sort();
+    if !force {
+        bail!(
+            "{} is not empty ({}): simulating into it would mix two campaigns; pass --force to replace the campaign there, or choose a new folder",
+            out.display(),
+            listed.join(", ")
+        );
+    }
+    let foreign: Vec<&String> = listed
+        .iter()
+        .filter(|name| !WRITTEN.contains(&name.as_str()))
+        .collect();
+    if !foreign.is_empty() {
+        let names: Vec<&str> = foreign.iter().map(|s| s.as_str()).collect();
+        bail!(
+            "{} holds files `simulate` does not write ({}): --force replaces only a campaign; choose a new folder",
+            out.display(),
+            names.join(", ")
+        );
+    }
+    for name in WRITTEN {
+        let path = out.join(name);
+        let removed = if path.is_dir() {
+            std::fs::remove_dir_all(&path)
+        } else {
+            std::fs::remove_file(&path)
+        };
+        match removed {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(e).with_context(|| format!("removing {}", path.display()))
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// The campaign these flags describe: the file's (or the built-in paper campaign) with the flags
@@ -92,6 +179,30 @@ pub fn campaign_from(args: &Args) -> anyhow::Result<Campaign> {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let campaign = campaign_from(args)?;
     let total = drift_sim::simulate::total_samples(&campaign);
+    let estimate_gb = estimate_bytes(&campaign, total) / 1e9;
+    if !(args.max_gb.is_finite() && args.max_gb > 0.0) {
+        bail!("--max-gb must be > 0, got {}", args.max_gb);
+    }
+    if estimate_gb > args.max_gb {
+        bail!(
+            "campaign `{}` would write about {} ({} samples over {} units): above --max-gb {}; simulate fewer units, set points or repeats, or raise --max-gb",
+            campaign.name,
+            gigabytes(estimate_gb),
+            total,
+            campaign.units,
+            args.max_gb
+        );
+    }
+    prepare(&args.out, args.force)?;
+    if !args.quiet {
+        eprintln!(
+            "simulating `{}`: {} samples, about {} → {}",
+            campaign.name,
+            total,
+            gigabytes(estimate_gb),
+            args.out.display()
+        );
+    }
     let bar = if args.quiet {
         indicatif::ProgressBar::hidden()
     } else {
@@ -99,9 +210,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     bar.set_style(
         indicatif::ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {bar:40} {percent:>3}% {msg} ({per_sec}, eta {eta})",
+            "{spinner} [{elapsed_precise}] {bar:40} {percent:>3}% {msg} ({rate}, eta {eta})",
         )
-        .context("progress bar template")?,
+        .context("progress bar template")?
+        // Gyro samples per second, in millions: "1.5 M samples/s", not "1,538,355.8877/s".
+        .with_key(
+            "rate",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{:.1} M samples/s", state.per_sec() / 1e6);
+            },
+        ),
     );
     let summary = drift_sim::simulate_campaign(&campaign, &args.out, |p| {
         bar.set_position(p.samples_done);

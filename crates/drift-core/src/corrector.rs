@@ -11,6 +11,7 @@ use crate::AXES;
 /// One 3-axis sample as the firmware reads it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Sample {
     /// Time since switch-on, milliseconds (an integer, so hours of operation lose no resolution).
     pub since_power_on_ms: u32,
@@ -23,6 +24,7 @@ pub struct Sample {
 /// The corrector's answer for one sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Output {
     /// Rate with the estimated zero drift removed, °/s.
     pub corrected_dps: [f32; AXES],

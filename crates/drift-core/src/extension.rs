@@ -74,6 +74,7 @@ pub enum Term {
 /// The axis's bias gains `coefficient · (value − centre)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct ExtraTerm {
     /// What the term measures.
     pub term: Term,
@@ -99,6 +100,7 @@ pub struct ExtraTerm {
 /// needs no clock. A start with no history known is taken as cold: the heating alone.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct SwitchOnRate {
     /// The rate of a cold start at switch-on, °C/s.
     pub heating_celsius_per_s: f32,
@@ -153,6 +155,7 @@ impl SwitchOnRate {
 /// The extra terms of a model; empty for the paper's model as published.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Extension {
     /// At most [`MAX_TERMS`] terms.
     pub terms: Vec<ExtraTerm, MAX_TERMS>,

@@ -10,6 +10,7 @@
 /// [`crate::CorrectorState::keep`] records the switch-off temperature.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Previous {
     /// The ambient estimated for that activation, °C.
     pub ambient_celsius: f32,

@@ -23,6 +23,7 @@ pub const MAX_POLYNOMIAL_COEFFICIENTS: usize = 8;
 /// extrapolate badly.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct PolynomialAxis {
     /// Temperature range the polynomial was fitted over, `[low, high]`, °C.
     pub range_celsius: [f32; 2],
@@ -178,6 +179,7 @@ fn horner(coefficients: &[f32], x: f32) -> f32 {
 /// A polynomial baseline for a whole unit.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct PolynomialTables {
     /// Sensor conversion and envelope settings.
     pub settings: Settings,

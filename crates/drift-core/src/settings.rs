@@ -13,6 +13,7 @@ use crate::error::{Error, Location, Problem};
 /// | `stuck_after_samples` | identical raw readings in a row that count as a stuck sensor (0: never) | samples | 2000 |
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Settings {
     /// Temperature-sensor scale, raw units per °C (the paper's unit: 200).
     pub raw_per_celsius: f32,

@@ -14,6 +14,7 @@ use crate::AXES;
 /// One point of a heating-dynamics curve: where the curve stood at one reference time.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct CurvePoint {
     /// Temperature rise since switch-on that the curve had reached, °C.
     pub rise_celsius: f32,
@@ -27,6 +28,7 @@ pub struct CurvePoint {
 /// Rise and `k` sit side by side because the corrector always reads them together.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Curve<const R: usize> {
     /// The curve at each reference time.
     pub points: Vec<CurvePoint, R>,
@@ -35,6 +37,7 @@ pub struct Curve<const R: usize> {
 /// All curves of one axis at one calibration ambient, and the initial bias there.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct AmbientCurves<const R: usize, const C: usize> {
     /// Switch-on sensor temperature of this calibration point (fully cooled unit), °C.
     pub ambient_celsius: f32,
@@ -75,6 +78,7 @@ pub struct AmbientCurves<const R: usize, const C: usize> {
 /// used are the vectors' lengths.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct AxisTable<const R: usize, const A: usize, const C: usize> {
     /// Reference times since switch-on, milliseconds, strictly increasing, the first one > 0
     /// (where the rise is already measurable).
@@ -89,6 +93,7 @@ pub struct AxisTable<const R: usize, const A: usize, const C: usize> {
 /// firmware names its own, e.g. `ModifiedTables<8, 3, 16>`.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct ModifiedTables<const R: usize = 16, const A: usize = 12, const C: usize = 32> {
     /// Sensor conversion and envelope settings.
     pub settings: Settings,

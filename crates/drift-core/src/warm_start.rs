@@ -16,6 +16,7 @@ use crate::interp::{bracket, lerp, Bracket};
 /// less a cold start's at its switch-on temperature.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct WarmStart {
     /// How far the switch-on temperature stood above the ambient, °C (> 0).
     pub residual_heat_celsius: f32,

@@ -31,7 +31,9 @@ pub struct Limits {
 }
 
 impl Limits {
-    /// The first limit that means nothing (negative, NaN or infinite), as (field name, value).
+    /// The first limit that means nothing (negative, NaN or infinite; a share removed above 1,
+    /// which no correction can meet), as (field name, value); [`Limits::requirement`] says what
+    /// the field must be.
     pub fn invalid(&self) -> Option<(&'static str, f64)> {
         [
             ("max_drift_dps", self.max_drift_dps),
@@ -39,7 +41,18 @@ impl Limits {
             ("min_removed", self.min_removed),
         ]
         .into_iter()
-        .find(|(_, value)| !value.is_finite() || *value < 0.0)
+        .find(|(field, value)| {
+            !value.is_finite() || *value < 0.0 || (*field == "min_removed" && *value > 1.0)
+        })
+    }
+
+    /// What a valid value of `field` is, in words.
+    pub fn requirement(field: &str) -> &'static str {
+        if field == "min_removed" {
+            "a share 0…1 (0.5 = half the uncorrected drift)"
+        } else {
+            "a finite number ≥ 0"
+        }
     }
 }
 
@@ -342,6 +355,11 @@ mod tests {
             ..Limits::default()
         };
         assert_eq!(nan.invalid().map(|(name, _)| name), Some("min_removed"));
+        let above_one = Limits {
+            min_removed: 2.0,
+            ..Limits::default()
+        };
+        assert_eq!(above_one.invalid(), Some(("min_removed", 2.0)));
     }
 
     #[test]

@@ -12,7 +12,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use drift_recording::{
-    paper, read_metadata, read_recording, ReadError, Segment, SeriesKind, RECORDINGS_DIR,
+    paper, read_metadata, read_recording, ReadError, Segment, SeriesKind, COMPLETION_MARKER,
+    RECORDINGS_DIR, TRUTH_DIR,
 };
 use rayon::prelude::*;
 
@@ -33,6 +34,14 @@ pub enum PipelineError {
         path: PathBuf,
         /// The I/O error.
         source: std::io::Error,
+    },
+    /// A simulated campaign folder without the file its simulation writes last.
+    #[error("{path} is an incomplete simulated campaign (no {marker}, which `simulate` writes last): the simulation stopped part-way; simulate it again with --force")]
+    Incomplete {
+        /// The campaign folder.
+        path: PathBuf,
+        /// The completion marker's name.
+        marker: &'static str,
     },
     /// A folder holds no recordings.
     #[error("no .mcap recordings in {path}")]
@@ -63,6 +72,34 @@ pub enum PipelineError {
         /// The calibration set points asked for.
         set_points: Vec<f64>,
     },
+    /// A set point asked for both as calibration and as validation: its rows would be labelled
+    /// validation while the fit saw them.
+    #[error("{set_point:+} °C is both a calibration and a validation set point: its activations are in the fit, so they cannot validate it; choose a validation set point the calibration does not list")]
+    CalibrationIsValidation {
+        /// The set point in both lists, °C.
+        set_point: f64,
+    },
+    /// A unit lacks protocol activations at one of the calibration set points: its tables would
+    /// cover fewer ambients than asked for (a half-recorded or half-simulated campaign).
+    #[error("{unit}: no protocol activations at the calibration set point {set_point:+} °C (it has {}); record it, or leave it out of the calibration set points", list_set_points(found))]
+    MissingCalibration {
+        /// The unit.
+        unit: String,
+        /// The calibration set point without activations, °C.
+        set_point: f64,
+        /// The calibration set points the unit has, °C.
+        found: Vec<f64>,
+    },
+    /// A validation set point without a single activation: nothing would be validated there.
+    #[error("no activations at the validation set point {set_point:+} °C in {files} recordings (set points recorded: {}); choose validation set points from those", list_set_points(found))]
+    MissingValidation {
+        /// The validation set point without activations, °C.
+        set_point: f64,
+        /// The nominal set points of the recordings, °C.
+        found: Vec<f64>,
+        /// How many recordings were looked at.
+        files: usize,
+    },
     /// None of the recordings has protocol activations at the calibration set points.
     #[error("no protocol activations at the calibration set points {set_points:?} °C in {files} recordings")]
     NoCalibration {
@@ -71,6 +108,23 @@ pub enum PipelineError {
         /// How many recordings were looked at.
         files: usize,
     },
+}
+
+/// Set points as `+30, +40 °C`, or `none`.
+fn list_set_points(set_points: &[f64]) -> String {
+    if set_points.is_empty() {
+        return "none".into();
+    }
+    let list: Vec<String> = set_points.iter().map(|s| format!("{s:+}")).collect();
+    format!("{} °C", list.join(", "))
+}
+
+/// Adds `set_point` to `list` unless it is already one of them (to a micro-degree); keeps it sorted.
+fn note_set_point(list: &mut Vec<f64>, set_point: f64) {
+    if !is_one_of(set_point, list) {
+        list.push(set_point);
+        list.sort_by(f64::total_cmp);
+    }
 }
 
 /// What to fit on and what to evaluate on.
@@ -126,7 +180,16 @@ pub fn is_one_of(set_point: f64, list: &[f64]) -> bool {
 }
 
 /// The recordings of a campaign folder (or of a folder of `.mcap` files), sorted by name.
+///
+/// A simulated campaign (a folder with `truth/`) must have its completion marker
+/// ([`drift_recording::COMPLETION_MARKER`]): half a campaign is refused, not fitted.
 pub fn recording_files(dir: &Path) -> Result<Vec<PathBuf>, PipelineError> {
+    if dir.join(TRUTH_DIR).is_dir() && !dir.join(COMPLETION_MARKER).is_file() {
+        return Err(PipelineError::Incomplete {
+            path: dir.to_path_buf(),
+            marker: COMPLETION_MARKER,
+        });
+    }
     let folder = if dir.join(RECORDINGS_DIR).is_dir() {
         dir.join(RECORDINGS_DIR)
     } else {
@@ -381,6 +444,13 @@ pub fn run(
 ) -> Result<Outcome, PipelineError> {
     let mut outcome = Outcome::default();
     let settings = &options.fit;
+    if let Some(&set_point) = options
+        .validation_set_points
+        .iter()
+        .find(|s| is_one_of(**s, &options.calibration_set_points))
+    {
+        return Err(PipelineError::CalibrationIsValidation { set_point });
+    }
 
     // Pass 1: read, analyse calibration activations.
     let mut read_seconds = 0.0;
@@ -433,6 +503,26 @@ pub fn run(
         });
     }
 
+    // Every unit must have every calibration set point: tables fitted on fewer ambients than
+    // asked for would be extrapolated silently.
+    for (unit, analysed) in &by_unit {
+        let mut found = Vec::new();
+        for a in analysed {
+            note_set_point(&mut found, a.labels.set_point_celsius);
+        }
+        if let Some(&set_point) = options
+            .calibration_set_points
+            .iter()
+            .find(|s| !is_one_of(**s, &found))
+        {
+            return Err(PipelineError::MissingCalibration {
+                unit: unit.clone(),
+                set_point,
+                found,
+            });
+        }
+    }
+
     // Fits: all calibration data, and one per left-out repeat.
     let started = Instant::now();
     let mut held_out: BTreeMap<(String, u32), FittedUnit> = BTreeMap::new();
@@ -457,9 +547,16 @@ pub fn run(
     // Pass 2: evaluate everything no fit saw.
     let started = Instant::now();
     let evaluated = if options.evaluate { files } else { &[] };
+    let mut recorded_set_points = Vec::new();
     for (i, path) in evaluated.iter().enumerate() {
         progress("correcting and evaluating", i as u64, files.len() as u64);
         let recording = read_recording(path)?;
+        for segment in &recording.segments {
+            note_set_point(
+                &mut recorded_set_points,
+                segment.labels.nominal_set_point_celsius(),
+            );
+        }
         let Some(fitted) = outcome
             .fitted
             .iter()
@@ -514,6 +611,27 @@ pub fn run(
         files.len() as u64,
         files.len() as u64,
     );
+    // A validation set point asked for and never seen would vanish from the report silently
+    // (field sessions at it count: they are validated too, in their own table).
+    let validated = if noise_floor {
+        Split::NoiseFloor
+    } else {
+        Split::Validation
+    };
+    if options.evaluate {
+        if let Some(&set_point) = options.validation_set_points.iter().find(|s| {
+            !outcome.results.iter().any(|(split, r)| {
+                (*split == validated || *split == Split::Field)
+                    && is_one_of(r.labels.nominal_set_point_celsius(), &[**s])
+            })
+        }) {
+            return Err(PipelineError::MissingValidation {
+                set_point,
+                found: recorded_set_points,
+                files: files.len(),
+            });
+        }
+    }
     let evaluate_seconds = started.elapsed().as_secs_f64();
     outcome.calibration = by_unit.into_values().flatten().collect();
     outcome.timings = vec![
@@ -521,8 +639,9 @@ pub fn run(
         ("analyse calibration activations".into(), analyse_seconds),
         (
             format!(
-                "fit tables ({} units, with refits per left-out repeat)",
-                outcome.fitted.len()
+                "fit tables ({} unit{}, with refits per left-out repeat)",
+                outcome.fitted.len(),
+                if outcome.fitted.len() == 1 { "" } else { "s" }
             ),
             fit_seconds,
         ),

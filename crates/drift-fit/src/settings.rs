@@ -2,9 +2,10 @@
 
 use serde::{Deserialize, Serialize};
 
-/// How the tables are fitted. Every field has a unit in its name and a documented default.
+/// How the tables are fitted. Every field has a unit in its name and a documented default; a
+/// missing field keeps its default, an unknown (misspelt) one is an error.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct FitSettings {
     /// Low-pass: centred moving average of this many samples ("a window at the operating
     /// frequency (1000)": 1 s at 1000 Hz).

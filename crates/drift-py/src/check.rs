@@ -29,7 +29,8 @@ pub fn limits(max_drift: f64, max_rms: f64, min_removed: f64) -> Result<Limits, 
                 _ => "min_removed",
             };
             Err(Error::Input(format!(
-                "`{argument}` must be a finite number ≥ 0, got {value}"
+                "`{argument}` must be {}, got {value}",
+                Limits::requirement(field)
             )))
         }
     }

@@ -28,6 +28,9 @@ fn set_points(value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
             SetPointsError::EmptyRange(text) => {
                 Error::Input(format!("`set_points` range {text:?} is empty"))
             }
+            too_many @ SetPointsError::TooMany(..) => {
+                Error::Input(format!("`set_points`: {too_many}"))
+            }
             _ => bad(),
         });
     }

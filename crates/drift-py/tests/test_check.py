@@ -89,8 +89,10 @@ def test_bad_arguments_are_input_errors(campaign_dir: Path, evaluation: gyrodrif
     source = recording_path(campaign_dir, "+33.0")
     with pytest.raises(InputError, match=r"`max_drift` must be a finite number ≥ 0, got -1"):
         unit.modified.check(source, max_drift=-1.0)
-    with pytest.raises(InputError, match=r"`min_removed` must be a finite number ≥ 0, got NaN"):
+    with pytest.raises(InputError, match=r"`min_removed` must be a share 0…1 .*, got NaN"):
         unit.modified.check(source, min_removed=float("nan"))
+    with pytest.raises(InputError, match=r"`min_removed` must be a share 0…1 .*, got 2"):
+        unit.modified.check(source, min_removed=2.0)
     with pytest.raises(InputError, match="`source` must be"):
         unit.modified.check(42)  # type: ignore[arg-type]
     first = gyrodrift.Recording.load(source).segments[0]

@@ -159,7 +159,14 @@ pub struct CsvOptions {
     pub rate_unit: RateUnit,
     /// Unit of the time column.
     pub time_unit: TimeUnit,
+    /// Largest plausible |rate|, °/s: a row beyond it is an error naming the row and column (a
+    /// wrong unit, a corrupt cell), not a bias to fit. Default [`MAX_PLAUSIBLE_RATE_DPS`].
+    pub max_rate_dps: f64,
 }
+
+/// Default [`CsvOptions::max_rate_dps`], °/s: 2.5× the widest full-scale range of MEMS gyroscopes
+/// (±4000 °/s); anything beyond is not a gyroscope's rate.
+pub const MAX_PLAUSIBLE_RATE_DPS: f64 = 10_000.0;
 
 impl Default for CsvOptions {
     fn default() -> Self {
@@ -173,6 +180,7 @@ impl Default for CsvOptions {
             temperature_dropouts: false,
             rate_unit: RateUnit::DegPerSec,
             time_unit: TimeUnit::Seconds,
+            max_rate_dps: MAX_PLAUSIBLE_RATE_DPS,
         }
     }
 }
@@ -201,6 +209,16 @@ pub enum CsvError {
         path: PathBuf,
         /// The I/O error.
         source: std::io::Error,
+    },
+    /// A gzip-compressed file that does not decompress.
+    #[error("{path}: gzip: {reason} after {decompressed} decompressed bytes: the compressed file is corrupt or cut short")]
+    Gzip {
+        /// The file.
+        path: PathBuf,
+        /// The decompressor's error.
+        reason: String,
+        /// Bytes decompressed before it.
+        decompressed: usize,
     },
     /// The options cannot be used.
     #[error("{path}: option `{field}`: {reason}")]
@@ -253,14 +271,20 @@ pub fn read_csv(path: &Path, options: &CsvOptions) -> Result<Recording, CsvError
     };
     let file = std::fs::File::open(path).map_err(io)?;
     let gz = path.extension().is_some_and(|e| e == "gz");
-    let reader: Box<dyn Read> = if gz {
-        Box::new(flate2::read::MultiGzDecoder::new(std::io::BufReader::new(
-            file,
-        )))
-    } else {
-        Box::new(std::io::BufReader::new(file))
-    };
-    read_csv_from(path, reader, options)
+    if gz {
+        // Decompressed whole first, so a corrupt or cut-short gzip stream is reported as such,
+        // not as whatever CSV error the garbage before the gzip check happens to make.
+        let mut text = Vec::new();
+        flate2::read::MultiGzDecoder::new(std::io::BufReader::new(file))
+            .read_to_end(&mut text)
+            .map_err(|e| CsvError::Gzip {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+                decompressed: text.len(),
+            })?;
+        return read_csv_from(path, text.as_slice(), options);
+    }
+    read_csv_from(path, std::io::BufReader::new(file), options)
 }
 
 /// Reads CSV text held in memory (not compressed); `name` stands for the file in errors. The same
@@ -316,6 +340,24 @@ fn read_csv_from<R: Read>(
                 reason: format!("must be > 0 s, got {max_gap_s}"),
             });
         }
+    }
+    if let Some(set_point) = options.set_point_celsius {
+        // The reader refuses a recording whose set point is not a finite number: refuse it here,
+        // before anything is written.
+        if !set_point.is_finite() {
+            return Err(CsvError::Options {
+                path: path.to_path_buf(),
+                field: "set_point_celsius",
+                reason: format!("must be a finite number of °C, got {set_point}"),
+            });
+        }
+    }
+    if !(options.max_rate_dps.is_finite() && options.max_rate_dps > 0.0) {
+        return Err(CsvError::Options {
+            path: path.to_path_buf(),
+            field: "max_rate_dps",
+            reason: format!("must be > 0 °/s, got {}", options.max_rate_dps),
+        });
     }
     let mut reader = csv::ReaderBuilder::new().flexible(false).from_reader(input);
     let header = reader
@@ -459,7 +501,17 @@ fn read_csv_from<R: Read>(
             if !(rate as f32).is_finite() {
                 return Err(bad(
                     &c.rate_dps[axis],
-                    format!("rate {rate} °/s is beyond the f32 range of a segment"),
+                    format!("rate {rate:.3e} °/s is beyond the f32 range of a segment"),
+                ));
+            }
+            if rate.abs() > options.max_rate_dps {
+                return Err(bad(
+                    &c.rate_dps[axis],
+                    format!(
+                        "rate {rate:.3e} °/s is beyond the plausible {} °/s (a wrong unit or a \
+                         corrupt cell? raise the limit if the gyroscope really measures this)",
+                        options.max_rate_dps
+                    ),
                 ));
             }
             rows.rate[axis].push(rate);

@@ -71,6 +71,15 @@ pub enum ReadError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// An MCAP file cut short: it starts as one and lacks the closing magic (an interrupted
+    /// write or copy).
+    #[error("{path}: truncated: the MCAP file ends at byte {length} without its closing magic (an interrupted write or copy); record or copy it again")]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Its length in bytes: where it stops.
+        length: usize,
+    },
     /// The MCAP container itself is broken.
     #[error("{path}: MCAP: {source}")]
     Mcap {

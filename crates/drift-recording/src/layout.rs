@@ -4,6 +4,10 @@
 pub const RECORDINGS_DIR: &str = "recordings";
 /// Folder of a campaign holding simulator ground truth (never read by fitting or diagnosis).
 pub const TRUTH_DIR: &str = "truth";
+/// File a simulation writes last, in the campaign folder: a folder with [`TRUTH_DIR`] but
+/// without it is a simulation that stopped part-way (interrupted, or failed), which no reader
+/// accepts.
+pub const COMPLETION_MARKER: &str = "summary.json";
 /// File-name ending of ground-truth sidecars.
 pub const TRUTH_EXTENSION: &str = "truth.mcap";
 /// Rate of the auxiliary channels (accelerometer, supply voltage, chamber set point, named

@@ -33,9 +33,10 @@ pub use aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic, FIXED_AU
 pub use csv_aux::CsvAuxColumn;
 pub use csv_file::{
     read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming, RateUnit, TimeUnit,
+    MAX_PLAUSIBLE_RATE_DPS,
 };
 pub use error::{ReadError, WriteError};
-pub use layout::{AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+pub use layout::{AUX_RATE_HZ, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 pub use messages::RECORD_LENGTH_LIMIT;
 pub use read::{
     is_truth_path, read_campaign_dir, read_metadata, read_recording, read_recording_bytes,

@@ -23,6 +23,10 @@ pub(crate) struct ChannelInfo {
     /// Name of its schema; `None` for a channel without one (schema id 0) or whose schema record
     /// did not come before it.
     pub schema: Option<String>,
+    /// Encoding of its schema (`ros2msg` for the format's own); `None` with no schema.
+    pub schema_encoding: Option<String>,
+    /// Encoding of its messages (`cdr` for the format's own).
+    pub message_encoding: String,
     /// Channel metadata (e.g. `unit`).
     pub metadata: BTreeMap<String, String>,
 }
@@ -45,7 +49,7 @@ pub(crate) fn for_each_message<E>(
             .with_validate_data_section_crc(true),
     );
     let mut rest = buf;
-    let mut schemas: HashMap<u16, String> = HashMap::new();
+    let mut schemas: HashMap<u16, (String, String)> = HashMap::new();
     let mut channels: HashMap<u16, ChannelInfo> = HashMap::new();
     while let Some(event) = reader.next_event() {
         let (opcode, data) = match event.map_err(Ok)? {
@@ -60,7 +64,7 @@ pub(crate) fn for_each_message<E>(
         };
         match mcap::parse_record(opcode, data).map_err(Ok)? {
             Record::Schema { header, .. } => {
-                schemas.insert(header.id, header.name);
+                schemas.insert(header.id, (header.name, header.encoding));
             }
             Record::Channel(channel) => {
                 if let Some(known) = channels.get(&channel.id) {
@@ -68,8 +72,11 @@ pub(crate) fn for_each_message<E>(
                         return Err(Ok(McapError::ConflictingChannels(channel.topic)));
                     }
                 }
+                let schema = schemas.get(&channel.schema_id).cloned();
                 let info = ChannelInfo {
-                    schema: schemas.get(&channel.schema_id).cloned(),
+                    schema_encoding: schema.as_ref().map(|(_, encoding)| encoding.clone()),
+                    schema: schema.map(|(name, _)| name),
+                    message_encoding: channel.message_encoding,
                     topic: channel.topic,
                     metadata: channel.metadata,
                 };

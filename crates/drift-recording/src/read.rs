@@ -137,6 +137,14 @@ fn refuse_truth_name(path: &Path) -> Result<(), ReadError> {
 }
 
 fn open_bytes(path: &Path, buf: Vec<u8>) -> Result<Opened, ReadError> {
+    // A file that starts as MCAP and lacks the closing magic was cut short: say so, rather than
+    // the container's "bad magic" (which reads like the wrong kind of file).
+    if buf.starts_with(mcap::MAGIC) && !buf.ends_with(mcap::MAGIC) {
+        return Err(ReadError::Truncated {
+            path: path.to_path_buf(),
+            length: buf.len(),
+        });
+    }
     crate::messages::check_uncompressed_chunks(&buf).map_err(|e| ReadError::Mcap {
         path: path.to_path_buf(),
         source: e,
@@ -366,6 +374,10 @@ impl Reader<'_> {
             Some(name) => Some(name),
             None => return Ok(()), // Extra topics a bench may add are allowed and ignored.
         };
+        if let Some(reason) = foreign_encoding(channel) {
+            let index = self.topics.get(topic).map_or(0, |state| state.count);
+            return Err(self.err(topic, index, reason));
+        }
         let state = self.topics.entry(topic.to_owned()).or_default();
         let index = state.count;
         state.count += 1;
@@ -582,6 +594,49 @@ impl Reader<'_> {
         };
         check_batch(expected, batch, expected_rate)
     }
+}
+
+/// The schema each of the format's own topics is written with.
+fn own_schema(topic: &str) -> Option<&'static str> {
+    Some(match topic {
+        schema::TOPIC_RATE | schema::TOPIC_ACCEL => schema::SCHEMA_VECTOR3.0,
+        schema::TOPIC_TEMPERATURE_RAW => schema::SCHEMA_RAW_TEMPERATURE.0,
+        schema::TOPIC_SUPPLY | schema::TOPIC_SET_POINT => schema::SCHEMA_SCALAR.0,
+        schema::TOPIC_POWER => schema::SCHEMA_POWER.0,
+        _ => return None,
+    })
+}
+
+/// Why a channel of one of the format's own topics is not in the format's schema and encodings
+/// (a bench tool may reuse a topic name for its own messages: decoding them as ours would give
+/// plausible wrong numbers), or `None` when it is. Named channels' schema is checked by
+/// [`named_channel`]; their encodings here.
+fn foreign_encoding(channel: &ChannelInfo) -> Option<String> {
+    let expected = own_schema(&channel.topic);
+    let schema_ok = expected.is_none_or(|name| channel.schema.as_deref() == Some(name));
+    let encodings_ok = channel.message_encoding == "cdr"
+        && channel
+            .schema_encoding
+            .as_deref()
+            .is_none_or(|e| e == "ros2msg");
+    if schema_ok && encodings_ok {
+        return None;
+    }
+    let found = channel.schema.as_deref().map_or_else(
+        || "no schema".to_owned(),
+        |name| {
+            format!(
+                "schema `{name}` ({})",
+                channel.schema_encoding.as_deref().unwrap_or("?")
+            )
+        },
+    );
+    Some(format!(
+        "channel {} has {found} with {} messages, but the format writes it as {} (ros2msg) with cdr messages: not a gyrodrift recording's channel",
+        channel.topic,
+        channel.message_encoding,
+        expected.unwrap_or(schema::SCHEMA_SCALAR.0)
+    ))
 }
 
 /// The unit of a named auxiliary channel's topic (empty if its metadata has none), or why the

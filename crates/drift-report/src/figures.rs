@@ -101,13 +101,13 @@ pub fn write_all(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<Vec<(Str
     save(
         "fig-rise-per-interval.svg",
         format!("Temperature rise after 2 min per activation number against the off-time between activations ({where_}); cf. the paper's Fig. 3a"),
-        Chart { title: "Temperature rise at the end of each activation", x: "off-time between activations, min", y: "rise, °C" },
+        Chart { title: "Temperature rise at the end of each activation", x: "off-time between activations, min", y: "temperature rise since switch-on, °C" },
         by_activation(&|a| a.rise_celsius[AXIS].last().map(|&v| f64::from(v))),
     )?;
     save(
         "fig-drift-per-interval.svg",
         format!("Drift after 2 min per activation number against the off-time ({where_}); cf. the paper's Fig. 3b"),
-        Chart { title: "Drift at the end of each activation", x: "off-time between activations, min", y: "drift g, °/s" },
+        Chart { title: "Drift at the end of each activation", x: "off-time between activations, min", y: "bias drift since switch-on, °/s" },
         by_activation(&|a| a.drift_dps[AXIS].last().map(|&v| f64::from(v))),
     )?;
 
@@ -143,7 +143,7 @@ pub fn write_all(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<Vec<(Str
     save(
         "fig-correlation.svg",
         format!("Correlation k = drift / rise after switch-on, activations of the {shortest}-min series ({where_}); cf. the paper's Fig. 4"),
-        Chart { title: "Correlation curves", x: "time since switch-on, s", y: "k, (°/s)/°C" },
+        Chart { title: "Correlation curves", x: "time since switch-on, s", y: "correlation k = drift ÷ rise, (°/s)/°C" },
         series,
     )?;
 
@@ -167,7 +167,7 @@ pub fn write_all(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<Vec<(Str
     save(
         "fig-k-per-interval.svg",
         format!("k at 2, 5, 30, 60 and 119 s after switch-on against the off-time, 5th activation ({where_}); cf. the paper's Fig. 5"),
-        Chart { title: "Correlation at fixed times, 5th activation", x: "off-time between activations, min", y: "k, (°/s)/°C" },
+        Chart { title: "Correlation at fixed times, 5th activation", x: "off-time between activations, min", y: "correlation k = drift ÷ rise, (°/s)/°C" },
         series,
     )?;
 
@@ -207,7 +207,7 @@ pub fn write_all(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<Vec<(Str
         Chart {
             title: "Drift per validation activation",
             x: "activation (in recording order)",
-            y: "drift, °/s",
+            y: "drift (max − min within the activation), °/s",
         },
         series,
     )?;

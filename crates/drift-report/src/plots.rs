@@ -66,13 +66,35 @@ pub fn draw(chart: &Chart<'_>, series: &[Series]) -> anyhow::Result<String> {
     Ok(svg)
 }
 
+/// Decimals that tell ticks apart over `lo…hi` (about ten ticks), no more: `0.015` on a 0.03
+/// range, `4.4` on a 4-degree one, `10` on a count.
+fn decimals(lo: f64, hi: f64) -> usize {
+    let span = (hi - lo).abs();
+    if !(span.is_finite() && span > 0.0) {
+        return 0;
+    }
+    // Ticks sit ~span/10 apart: one significant digit of that step.
+    let digits = (-(span / 10.0).log10()).ceil();
+    digits.clamp(0.0, 9.0) as usize
+}
+
+/// Width of the plot; the legend gets a column to its right, off the data.
+const PLOT_WIDTH: u32 = 900;
+/// Width of the legend column.
+const LEGEND_WIDTH: u32 = 260;
+/// Height of the figure.
+const HEIGHT: u32 = 520;
+
 fn draw_into(svg: &mut String, chart: &Chart<'_>, series: &[Series]) -> anyhow::Result<()> {
     let fail = |e: &dyn std::fmt::Display| anyhow!("drawing \"{}\": {e}", chart.title);
     let (x0, x1) = bounds(series, |p| p.0);
     let (y0, y1) = bounds(series, |p| p.1);
-    let root = SVGBackend::with_string(svg, (900, 520)).into_drawing_area();
+    let (x_decimals, y_decimals) = (decimals(x0, x1), decimals(y0, y1));
+    let root =
+        SVGBackend::with_string(svg, (PLOT_WIDTH + LEGEND_WIDTH, HEIGHT)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
-    let mut plot = ChartBuilder::on(&root)
+    let (left, legend) = root.split_horizontally(PLOT_WIDTH);
+    let mut plot = ChartBuilder::on(&left)
         .caption(chart.title, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(45)
@@ -82,34 +104,54 @@ fn draw_into(svg: &mut String, chart: &Chart<'_>, series: &[Series]) -> anyhow::
     plot.configure_mesh()
         .x_desc(chart.x)
         .y_desc(chart.y)
-        .y_label_formatter(&|v| format!("{v:.4}"))
+        .x_label_formatter(&|v| format!("{v:.x_decimals$}"))
+        .y_label_formatter(&|v| format!("{v:.y_decimals$}"))
         .draw()
         .map_err(|e| fail(&e))?;
+    let text = ("sans-serif", 14).into_font().color(&BLACK);
     for (index, s) in series.iter().enumerate() {
         let color = Palette99::pick(index).to_rgba();
         if s.markers_only {
             plot.draw_series(s.points.iter().map(|&p| Circle::new(p, 3, color.filled())))
-                .map_err(|e| fail(&e))?
-                .label(s.name.clone())
-                .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+                .map_err(|e| fail(&e))?;
         } else {
             plot.draw_series(LineSeries::new(
                 s.points.iter().copied(),
                 color.stroke_width(2),
             ))
-            .map_err(|e| fail(&e))?
-            .label(s.name.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
+            .map_err(|e| fail(&e))?;
         }
+        // The legend, in its own column beside the plot: it never covers a point.
+        let y = 48 + 22 * index as i32;
+        if s.markers_only {
+            legend
+                .draw(&Circle::new((18, y), 4, color.filled()))
+                .map_err(|e| fail(&e))?;
+        } else {
+            legend
+                .draw(&PathElement::new(
+                    vec![(6, y), (30, y)],
+                    color.stroke_width(2),
+                ))
+                .map_err(|e| fail(&e))?;
+        }
+        legend
+            .draw(&Text::new(s.name.clone(), (38, y - 8), text.clone()))
+            .map_err(|e| fail(&e))?;
     }
-    plot.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| fail(&e))?;
     root.present().map_err(|e| fail(&e))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_carry_the_decimals_their_spacing_needs() {
+        assert_eq!(decimals(0.0, 0.03), 3);
+        assert_eq!(decimals(2.0, 6.4), 1);
+        assert_eq!(decimals(0.0, 40.0), 0);
+        assert_eq!(decimals(1.0, 1.0), 0);
+    }
 }

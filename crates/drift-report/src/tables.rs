@@ -91,8 +91,8 @@ pub fn headline(records: &[Record], fitted: &[FittedUnit], noise_units: &[String
     md.push_str("Mean drift (max − min of the 1-s low-frequency component over each 2-min activation) over ");
     let _ = writeln!(
         md,
-        "{} units × 3 axes, on activations the fit did not see:\n",
-        units.len()
+        "{} × 3 axes, on activations the fit did not see:\n",
+        count(units.len(), "unit", "units")
     );
     md.push_str("| set point | data | uncorrected | standard | 3rd-order | modified | standard / modified | modified, keyed by history | noise floor |\n|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for (set_point, split) in rows(records) {
@@ -178,8 +178,34 @@ pub fn paper_table(records: &[Record], fitted: &[FittedUnit]) -> String {
         }
         md.push('\n');
     }
-    md.push_str("\n°/s. +33 °C: validation set point, never used in the fit. Calibration set points: each repeat is left out in turn, the tables refitted on the other repeats, and evaluated on the left-out one.\n\n");
+    md.push_str("\n°/s. ");
+    md.push_str(&validation_note(records));
+    md.push_str(" Calibration set points: each repeat is left out in turn, the tables refitted on the other repeats, and evaluated on the left-out one.\n\n");
     md
+}
+
+/// `n` with the noun in its number: "1 unit", "2 units".
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+/// Which rows are validation: the set points that have validation results, as the data say.
+fn validation_note(records: &[Record]) -> String {
+    let validation: Vec<String> = set_points(records, Split::Validation)
+        .iter()
+        .map(|s| format!("{s:+} °C"))
+        .collect();
+    match validation.len() {
+        0 => "No validation set point had data: every row is a held-out repeat.".into(),
+        1 => format!(
+            "{}: validation set point, never used in the fit.",
+            validation[0]
+        ),
+        _ => format!(
+            "{}: validation set points, never used in the fit.",
+            validation.join(", ")
+        ),
+    }
 }
 
 /// Field-like use: off-times and ambients the calibration never had.

@@ -168,6 +168,12 @@ pub fn set_point_range(from: f64, to: f64, step: f64) -> Vec<f64> {
     (0..=n).map(|k| from + step * k as f64).collect()
 }
 
+/// Seconds in a (Julian) year.
+const SECONDS_PER_YEAR: f64 = 365.25 * 86_400.0;
+/// Longest recording the format's u64-ns clock holds with room to spare: 100 years (the clock
+/// wraps after 584).
+const MAX_RECORDING_S: f64 = 100.0 * SECONDS_PER_YEAR;
+
 impl Campaign {
     /// Reads a campaign file: `.json` as JSON, anything else as TOML.
     pub fn from_file(path: &Path) -> Result<Self, SimError> {
@@ -258,6 +264,30 @@ impl Campaign {
             check_duration("protocol.activation_s", p.activation_s)?;
             check_nonneg("protocol.rest_min", p.rest_min)?;
             check_fraction("protocol.heating_scatter", p.heating_scatter)?;
+            // A recording's clock is u64 ns, and the reader refuses one that wraps: a set point's
+            // file holds every series, so all of them must fit it.
+            let series_s: f64 = p
+                .intervals_min
+                .iter()
+                .map(|m| f64::from(p.activations) * (p.activation_s + 60.0 * (m + p.rest_min)))
+                .sum();
+            let file_s = f64::from(p.repeats) * series_s;
+            if file_s > MAX_RECORDING_S {
+                let (i, m) = p
+                    .intervals_min
+                    .iter()
+                    .enumerate()
+                    .max_by(|a, b| a.1.total_cmp(b.1))
+                    .map_or((0, 0.0), |(i, m)| (i, *m));
+                return Err(bad(
+                    &format!("protocol.intervals_min[{i}]"),
+                    &format!(
+                        "{m} min makes a recording {:.3e} years long; a recording's clock holds {} years",
+                        file_s / SECONDS_PER_YEAR,
+                        MAX_RECORDING_S / SECONDS_PER_YEAR
+                    ),
+                ));
+            }
         }
         if let Some(f) = &self.field {
             check_activations("field", f.activations, f.sessions)?;
@@ -266,6 +296,18 @@ impl Campaign {
             }
             check_ordered("field.activation_s", f.activation_s)?;
             check_ordered("field.off_min", f.off_min)?;
+            let session_s =
+                f64::from(f.activations) * (f.activation_s[1] + 60.0 * (f.off_min[1] + f.rest_min));
+            if session_s > MAX_RECORDING_S {
+                return Err(bad(
+                    "field.off_min",
+                    &format!(
+                        "makes a session up to {:.3e} years long; a recording's clock holds {} years",
+                        session_s / SECONDS_PER_YEAR,
+                        MAX_RECORDING_S / SECONDS_PER_YEAR
+                    ),
+                ));
+            }
             if f.off_min[0] <= 0.0 {
                 return Err(bad(
                     "field.off_min",

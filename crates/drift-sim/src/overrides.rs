@@ -60,7 +60,13 @@ pub enum SetPointsError {
     /// A range without set points.
     #[error("range `{0}` is empty")]
     EmptyRange(String),
+    /// A range with more set points than a chamber campaign can hold (refused before any is made).
+    #[error("range `{0}` makes {1:.3e} set points; at most {MAX_SET_POINTS} (a chamber needs hours per set point): use a larger step")]
+    TooMany(String, f64),
 }
+
+/// Most set points a range may make.
+pub const MAX_SET_POINTS: usize = 1000;
 
 /// Set points as text: a list `30,40,33` or a range `-40:60:10` (from:to:step, inclusive), °C.
 pub fn parse_set_points(text: &str) -> Result<Vec<f64>, SetPointsError> {
@@ -73,7 +79,12 @@ pub fn parse_set_points(text: &str) -> Result<Vec<f64>, SetPointsError> {
         let [from, to, step] = text.split(':').collect::<Vec<_>>()[..] else {
             return Err(SetPointsError::BadRange(text.to_owned()));
         };
-        let points = set_point_range(number(from)?, number(to)?, number(step)?);
+        let (from, to, step) = (number(from)?, number(to)?, number(step)?);
+        let count = (to - from) / step + 1.0;
+        if count > MAX_SET_POINTS as f64 {
+            return Err(SetPointsError::TooMany(text.to_owned(), count));
+        }
+        let points = set_point_range(from, to, step);
         if points.is_empty() {
             return Err(SetPointsError::EmptyRange(text.to_owned()));
         }

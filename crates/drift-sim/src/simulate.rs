@@ -14,7 +14,7 @@ use crate::error::SimError;
 use crate::schedule::{self, FilePlan};
 use crate::unit::UnitParams;
 use crate::world::runtime::{AuxActivation, Runtime};
-use drift_recording::{SeriesKind, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
+use drift_recording::{SeriesKind, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -126,6 +126,13 @@ pub(crate) fn record(
 ) -> Result<Summary, SimError> {
     let recordings = out_dir.join(RECORDINGS_DIR);
     let truth = out_dir.join(TRUTH_DIR);
+    // The completion marker is written last: a stale one from an earlier run would vouch for a
+    // folder this run may leave half-written.
+    let marker = out_dir.join(COMPLETION_MARKER);
+    match std::fs::remove_file(&marker) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(SimError::io(&marker, e)),
+        _ => {}
+    }
     for dir in [&recordings, &truth] {
         std::fs::create_dir_all(dir).map_err(|e| SimError::io(dir, e))?;
     }
@@ -195,6 +202,6 @@ pub(crate) fn record(
         files,
         wall_s: started.elapsed().as_secs_f64(),
     };
-    write_json(&out_dir.join("summary.json"), &summary)?;
+    write_json(&marker, &summary)?;
     Ok(summary)
 }

@@ -142,7 +142,7 @@ def rise_per_interval(
         ax,
         f"Rise at the end of each activation ({unit}, {axis}, {set_point:+g} °C)",
         "off-time, min",
-        "rise, °C",
+        "temperature rise since switch-on, °C",
     )
 
 
@@ -163,7 +163,7 @@ def drift_per_interval(
         ax,
         f"Drift at the end of each activation ({unit}, {axis}, {set_point:+g} °C)",
         "off-time, min",
-        "drift g, °/s",
+        "bias drift since switch-on, °/s",
     )
 
 
@@ -197,7 +197,7 @@ def correlation_curves(
         title = f"Correlation curves, {shortest:g}-min series ({unit}, {axis}, {set_point:+g} °C)"
     else:
         title = f"Correlation curves ({unit}, {axis}, {set_point:+g} °C)"
-    return _finish(ax, title, "time since switch-on, s", "k, (°/s)/°C")
+    return _finish(ax, title, "time since switch-on, s", "correlation k = drift ÷ rise, (°/s)/°C")
 
 
 def k_per_interval(
@@ -230,7 +230,7 @@ def k_per_interval(
         ax,
         f"k at fixed times, activation {activation} ({unit}, {axis}, {set_point:+g} °C)",
         "off-time, min",
-        "k, (°/s)/°C",
+        "correlation k = drift ÷ rise, (°/s)/°C",
     )
 
 

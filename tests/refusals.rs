@@ -1,0 +1,556 @@
+//! Inputs and requests the commands refuse rather than guess at: each case runs the binary and
+//! asserts its exit status and the message that names what is wrong and where.
+
+mod common;
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use common::gyrodrift;
+
+/// Exit status 2 (the command could not do its job) and a message containing every `needle`.
+fn refused(args: &[&str], needles: &[&str]) -> String {
+    let (out, text) = gyrodrift(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {text}");
+    for needle in needles {
+        assert!(text.contains(needle), "{args:?}: no `{needle}` in {text}");
+    }
+    text
+}
+
+fn s(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+/// A short campaign of one unit at +30, +40 and +33 °C, simulated once for every test here.
+fn campaign() -> &'static Path {
+    static CAMPAIGN: OnceLock<PathBuf> = OnceLock::new();
+    CAMPAIGN.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap().keep();
+        let file = dir.join("short.toml");
+        std::fs::write(&file, "[protocol]\nactivations = 3\nactivation_s = 30.0\n").unwrap();
+        let out = dir.join("campaign");
+        common::ok(&[
+            "simulate",
+            "-q",
+            "-c",
+            s(&file),
+            "-o",
+            s(&out),
+            "--units",
+            "1",
+            "--set-points",
+            "30,40,33",
+            "--intervals",
+            "1,30",
+            "--repeats",
+            "2",
+            "--seed",
+            "4",
+        ]);
+        out
+    })
+}
+
+/// A copy of the campaign's folder tree (files copied) in `to`.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
+
+fn first_recording(campaign: &Path) -> PathBuf {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(campaign.join("recordings"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    files.remove(0)
+}
+
+// --- exit codes -------------------------------------------------------------------------------
+
+#[test]
+fn check_without_recordings_exits_2_not_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = s(dir.path());
+    refused(
+        &["check", empty, "--tables", empty, "-o", empty],
+        &["no .mcap recordings in"],
+    );
+}
+
+#[test]
+fn check_refuses_a_share_removed_above_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = s(dir.path());
+    refused(
+        &["check", d, "--tables", d, "--min-removed", "2"],
+        &["--min-removed must be a share 0…1", "got 2"],
+    );
+}
+
+#[test]
+fn exit_codes_are_documented_in_help() {
+    let (out, text) = gyrodrift(&["--help"]);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("Exit status: 0 done") && text.contains("2 usage, input or output error"),
+        "{text}"
+    );
+}
+
+// --- mislabelled or partial results -----------------------------------------------------------
+
+#[test]
+fn report_refuses_a_validation_set_point_the_fit_sees() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &[
+            "report",
+            s(campaign()),
+            "-q",
+            "--calibration",
+            "30,40",
+            "--validation",
+            "30",
+            "-o",
+            s(&dir.path().join("report")),
+        ],
+        &["+30 °C is both a calibration and a validation set point"],
+    );
+    assert!(!dir.path().join("report").exists());
+}
+
+#[test]
+fn report_refuses_a_validation_set_point_without_data() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &[
+            "report",
+            s(campaign()),
+            "-q",
+            "--validation",
+            "99",
+            "-o",
+            s(&dir.path().join("report")),
+        ],
+        &[
+            "no activations at the validation set point +99 °C",
+            "set points recorded: +30, +33, +40 °C",
+        ],
+    );
+    assert!(!dir.path().join("report").exists());
+}
+
+#[test]
+fn report_footnote_names_the_validation_set_point_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    common::ok(&[
+        "report",
+        s(campaign()),
+        "-q",
+        "--calibration",
+        "30,33",
+        "--validation",
+        "40",
+        "-o",
+        s(&out),
+    ]);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("°/s. +40 °C: validation set point, never used in the fit."),
+        "{md}"
+    );
+    assert!(!md.contains("+33 °C: validation"), "{md}");
+}
+
+#[test]
+fn fit_refuses_a_calibration_set_point_without_data() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &[
+            "fit",
+            s(campaign()),
+            "-q",
+            "--calibration",
+            "30,35",
+            "-o",
+            s(&dir.path().join("tables")),
+        ],
+        &["GIU-01: no protocol activations at the calibration set point +35 °C (it has +30 °C)"],
+    );
+}
+
+#[test]
+fn fit_refuses_a_half_simulated_campaign() {
+    let dir = tempfile::tempdir().unwrap();
+    let half = dir.path().join("half");
+    copy_tree(campaign(), &half);
+    // What an interrupted `simulate` leaves: no summary.json (written last), a temporary file.
+    std::fs::remove_file(half.join("summary.json")).unwrap();
+    std::fs::write(half.join("recordings/.GIU-01_x.mcap.99.tmp"), b"partial").unwrap();
+    refused(
+        &["fit", s(&half), "-q", "-o", s(&dir.path().join("tables"))],
+        &["is an incomplete simulated campaign (no summary.json"],
+    );
+}
+
+#[test]
+fn simulate_refuses_a_non_empty_folder_and_force_replaces_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    copy_tree(campaign(), &out);
+    let stale = out.join("recordings/GIU-09_stale.mcap");
+    std::fs::copy(first_recording(&out), &stale).unwrap();
+    let file = dir.path().join("short.toml");
+    std::fs::write(&file, "[protocol]\nactivations = 2\nactivation_s = 3.0\n").unwrap();
+    let args = |force: bool| {
+        let mut args = vec![
+            "simulate",
+            "-q",
+            "-c",
+            s(&file),
+            "-o",
+            s(&out),
+            "--units",
+            "1",
+            "--set-points",
+            "30",
+            "--intervals",
+            "1",
+            "--repeats",
+            "1",
+        ];
+        if force {
+            args.push("--force");
+        }
+        args
+    };
+    refused(
+        &args(false),
+        &[
+            "is not empty (recordings, summary.json, truth)",
+            "pass --force to replace the campaign there, or choose a new folder",
+        ],
+    );
+    assert!(stale.exists(), "nothing removed without --force");
+    common::ok(&args(true));
+    assert!(!stale.exists(), "--force clears what it replaces");
+    let recordings = std::fs::read_dir(out.join("recordings")).unwrap().count();
+    assert_eq!(recordings, 1);
+    // --force replaces a campaign, nothing else.
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    refused(
+        &args(true),
+        &["holds files `simulate` does not write (notes.txt)"],
+    );
+    assert!(out.join("notes.txt").exists());
+}
+
+// --- writers validate with the reader's rules ---------------------------------------------------
+
+const CSV: &str = "segment_id,t_s,gx,gy,gz,temp\n0,0.000,0.1,0.2,0.3,30.0\n0,0.001,0.1,0.2,0.3,30.0\n0,0.002,0.1,0.2,0.3,30.0\n";
+
+fn csv_args<'a>(csv: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "import",
+        "csv",
+        csv,
+        "-o",
+        out,
+        "--rate-columns",
+        "gx,gy,gz",
+        "--temperature-columns",
+        "temp",
+    ];
+    args.extend_from_slice(extra);
+    args
+}
+
+#[test]
+fn import_refuses_a_set_point_the_reader_would_refuse() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    std::fs::write(&csv, CSV).unwrap();
+    let out = dir.path().join("measured");
+    refused(
+        &csv_args(s(&csv), s(&out), &["--set-point", "nan"]),
+        &["bench.csv: option `set_point_celsius`: must be a finite number of °C, got NaN"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn simulate_refuses_intervals_the_recording_clock_cannot_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    refused(
+        &[
+            "simulate",
+            "-q",
+            "-o",
+            s(&out),
+            "--units",
+            "1",
+            "--set-points",
+            "30",
+            "--intervals",
+            "1e9",
+            "--repeats",
+            "1",
+        ],
+        &["protocol.intervals_min[0]"],
+    );
+    assert!(!out.exists());
+}
+
+// --- foreign channels, unknown fields ------------------------------------------------------------
+
+/// A recording whose `/gyro/rate` channel carries `schema` (name, encoding) and
+/// `message_encoding`: everything else as the format writes it.
+fn foreign_rate_channel(path: &Path, schema: (&str, &str), message_encoding: &str) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut w = mcap::WriteOptions::new()
+        .profile("gyrodrift")
+        .create(file)
+        .unwrap();
+    let metadata = [("unit_id", "GIU-01"), ("sample_rate_hz", "1000")]
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v.to_owned()))
+        .collect();
+    w.write_metadata(&mcap::records::Metadata {
+        name: "gyrodrift.recording".into(),
+        metadata,
+    })
+    .unwrap();
+    let own = [
+        (
+            "/gyro/temperature_raw",
+            "gyrodrift_msgs/msg/RawTemperatureBatch",
+        ),
+        ("/aux/accel", "gyrodrift_msgs/msg/Vector3Batch"),
+        ("/aux/supply_voltage", "gyrodrift_msgs/msg/ScalarBatch"),
+        ("/aux/chamber_set_point", "gyrodrift_msgs/msg/ScalarBatch"),
+        ("/power/state", "gyrodrift_msgs/msg/PowerEvent"),
+    ];
+    for (topic, name) in own {
+        let id = w.add_schema(name, "ros2msg", b"").unwrap();
+        w.add_channel(id, topic, "cdr", &Default::default())
+            .unwrap();
+    }
+    let id = w.add_schema(schema.0, schema.1, b"").unwrap();
+    let rate = w
+        .add_channel(id, "/gyro/rate", message_encoding, &Default::default())
+        .unwrap();
+    w.write_to_known_channel(
+        &mcap::records::MessageHeader {
+            channel_id: rate,
+            sequence: 1,
+            log_time: 1,
+            publish_time: 1,
+        },
+        b"{\"x\": 1}",
+    )
+    .unwrap();
+    w.finish().unwrap();
+}
+
+#[test]
+fn a_rate_channel_in_another_schema_is_refused_with_the_channel_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let recordings = dir.path().join("recordings");
+    std::fs::create_dir_all(&recordings).unwrap();
+    foreign_rate_channel(
+        &recordings.join("imu.mcap"),
+        ("sensor_msgs/msg/Imu", "ros2msg"),
+        "cdr",
+    );
+    refused(
+        &["fit", s(dir.path()), "-q", "-o", s(&dir.path().join("t"))],
+        &[
+            "imu.mcap",
+            "channel /gyro/rate has schema `sensor_msgs/msg/Imu` (ros2msg)",
+            "the format writes it as gyrodrift_msgs/msg/Vector3Batch",
+        ],
+    );
+    // The right schema name in another encoding is not ours either.
+    foreign_rate_channel(
+        &recordings.join("imu.mcap"),
+        ("gyrodrift_msgs/msg/Vector3Batch", "jsonschema"),
+        "json",
+    );
+    refused(
+        &["fit", s(dir.path()), "-q", "-o", s(&dir.path().join("t"))],
+        &["channel /gyro/rate has schema `gyrodrift_msgs/msg/Vector3Batch` (jsonschema) with json messages"],
+    );
+}
+
+#[test]
+fn fit_settings_with_a_misspelt_field_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let settings = dir.path().join("settings.json");
+    std::fs::write(&settings, "{\"lowpass_window_sample\": 500}").unwrap();
+    refused(
+        &[
+            "fit",
+            s(campaign()),
+            "-q",
+            "--settings",
+            s(&settings),
+            "-o",
+            s(&dir.path().join("t")),
+        ],
+        &[
+            "settings.json: not valid fit settings",
+            "unknown field `lowpass_window_sample`",
+        ],
+    );
+}
+
+#[test]
+fn table_json_with_an_unknown_field_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let tables = dir.path().join("tables");
+    common::ok(&["fit", s(campaign()), "-q", "-o", s(&tables)]);
+    for name in ["modified", "standard"] {
+        let path = tables.join(format!("GIU-01/{name}.json"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        let misspelt = text.replacen('{', "{\"setings\": {},", 1);
+        let error = match name {
+            "modified" => serde_json::from_str::<drift_core::ModifiedTables>(&misspelt)
+                .map(|_| ())
+                .unwrap_err(),
+            _ => serde_json::from_str::<drift_core::PolynomialTables>(&misspelt)
+                .map(|_| ())
+                .unwrap_err(),
+        };
+        assert!(
+            error.to_string().contains("unknown field `setings`"),
+            "{name}: {error}"
+        );
+    }
+}
+
+// --- implausible magnitudes and sizes ------------------------------------------------------------
+
+#[test]
+fn import_refuses_an_implausible_rate_naming_row_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    std::fs::write(
+        &csv,
+        CSV.replacen("0.1,0.2,0.3,30.0\n0,0.002", "0.1,1e30,0.3,30.0\n0,0.002", 1),
+    )
+    .unwrap();
+    let out = dir.path().join("measured");
+    refused(
+        &csv_args(s(&csv), s(&out), &[]),
+        &[
+            "bench.csv: row 2 (line 3), column `gy`",
+            "rate 1.000e30 °/s is beyond the plausible 10000 °/s",
+        ],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn simulate_refuses_a_set_point_range_too_large_before_making_it() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &[
+            "simulate",
+            "-q",
+            "-o",
+            s(&dir.path().join("c")),
+            "--set-points",
+            "0:1e9:1e-9",
+        ],
+        &["--set-points: range `0:1e9:1e-9` makes 1.000e18 set points; at most 1000"],
+    );
+}
+
+#[test]
+fn simulate_refuses_a_campaign_too_large_with_its_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c");
+    refused(
+        &["simulate", "-q", "-o", s(&out), "--units", "100000"],
+        &["would write about", "TB", "above --max-gb 20"],
+    );
+    assert!(!out.exists());
+}
+
+// --- messages ------------------------------------------------------------------------------------
+
+#[test]
+fn a_truncated_recording_says_truncated_with_the_offset() {
+    let dir = tempfile::tempdir().unwrap();
+    let recordings = dir.path().join("recordings");
+    std::fs::create_dir_all(&recordings).unwrap();
+    let bytes = std::fs::read(first_recording(campaign())).unwrap();
+    let cut = bytes.len() / 2;
+    std::fs::write(recordings.join("cut.mcap"), &bytes[..cut]).unwrap();
+    refused(
+        &["fit", s(dir.path()), "-q", "-o", s(&dir.path().join("t"))],
+        &[&format!(
+            "cut.mcap: truncated: the MCAP file ends at byte {cut}"
+        )],
+    );
+}
+
+#[test]
+fn a_corrupt_gzip_file_says_gzip() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    gz.write_all(CSV.repeat(50).as_bytes()).unwrap();
+    let mut bytes = gz.finish().unwrap();
+    let middle = bytes.len() / 2;
+    for b in &mut bytes[middle..middle + 8] {
+        *b ^= 0x5A;
+    }
+    let csv = dir.path().join("bench.csv.gz");
+    std::fs::write(&csv, &bytes).unwrap();
+    refused(
+        &csv_args(s(&csv), s(&dir.path().join("m")), &[]),
+        &[
+            "bench.csv.gz: gzip:",
+            "the compressed file is corrupt or cut short",
+        ],
+    );
+}
+
+#[test]
+fn an_error_says_each_cause_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nowhere");
+    let text = refused(
+        &["fit", s(&missing), "-q", "-o", s(&dir.path().join("t"))],
+        &["listing recordings in"],
+    );
+    assert_eq!(
+        text.matches("No such file or directory").count(),
+        1,
+        "{text}"
+    );
+}
+
+#[test]
+fn long_numbers_are_shortened() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = s(dir.path());
+    let text = refused(
+        &["check", d, "--tables", d, "--max-rms", "-1e300"],
+        &["--max-rms must be a finite number ≥ 0, got -1.000e300"],
+    );
+    assert!(text.len() < 300, "{text}");
+}
