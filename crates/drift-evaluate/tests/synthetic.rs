@@ -175,7 +175,7 @@ fn a_stuck_or_saturated_sensor_is_a_documented_degradation() {
     let score = |f: &drift_fit::FittedUnit| {
         [(1.0, 5), (5.0, 2), (30.0, 1)]
             .iter()
-            .map(|&(i, a)| evaluate(f, &segment(33.0, i, a), &settings).models[3].drift_dps[0])
+            .map(|&(i, a)| evaluate(f, &segment(33.0, i, a), &settings).models[4].drift_dps[0])
             .sum::<f64>()
     };
     let clean = score(&calibration_with(&|_| {}).unwrap());
@@ -205,12 +205,12 @@ fn a_stuck_or_saturated_sensor_is_a_documented_degradation() {
     let mut s = segment(33.0, 30.0, 1);
     s.temperature_raw[0].iter_mut().for_each(|r| *r = i16::MAX);
     let result = evaluate(&fitted, &s, &settings);
-    let flags = drift_core::Flags(result.models[3].flags[0]);
+    let flags = drift_core::Flags(result.models[4].flags[0]);
     assert!(
         flags.contains(
             drift_core::Flags::AMBIENT_OUT_OF_RANGE | drift_core::Flags::TEMPERATURE_STUCK
         ),
         "{flags:?}"
     );
-    assert!(!drift_core::Flags(result.models[3].flags[1]).intersects(drift_core::Flags::FAULTS));
+    assert!(!drift_core::Flags(result.models[4].flags[1]).intersects(drift_core::Flags::FAULTS));
 }
