@@ -121,7 +121,11 @@ impl ActivationClass {
 
     /// The class of an activation of `split`: warm when it was off less than
     /// `independent_after_min` minutes (the fit's cool-down).
-    pub fn of(split: Split, labels: &drift_recording::SegmentLabels, independent_after_min: f64) -> Self {
+    pub fn of(
+        split: Split,
+        labels: &drift_recording::SegmentLabels,
+        independent_after_min: f64,
+    ) -> Self {
         if split == Split::Field {
             return Self::Field;
         }
@@ -165,6 +169,8 @@ pub struct AbsoluteCell {
     pub activations: usize,
     /// The paper's model (`modified`).
     pub modified: BiasRms,
+    /// The paper's curves keyed by history, started from what firmware kept (`by-history`).
+    pub by_history: BiasRms,
     /// Every standard baseline, in report order.
     pub baselines: Vec<BiasRms>,
     /// The baseline with the smallest mean.
@@ -203,7 +209,11 @@ pub fn absolute_error(
     for (split, result) in results {
         let class = ActivationClass::of(*split, &result.labels, independent_after_min);
         if *split == Split::NoiseFloor {
-            if let Some(m) = result.models.iter().find(|m| m.model == ModelKind::Modified) {
+            if let Some(m) = result
+                .models
+                .iter()
+                .find(|m| m.model == ModelKind::Modified)
+            {
                 let entry = floor.entry(class).or_default();
                 for rms in m.residual_rms_dps {
                     entry.0 += rms;
@@ -262,6 +272,7 @@ pub fn absolute_error(
         .into_iter()
         .map(|((unit, set_point, class, axis), members)| {
             let modified = rms_of(&members, ModelKind::Modified, axis);
+            let by_history = rms_of(&members, ModelKind::ByHistory, axis);
             let baselines: Vec<BiasRms> = ModelKind::BASELINES
                 .iter()
                 .map(|&b| rms_of(&members, b, axis))
@@ -278,6 +289,7 @@ pub fn absolute_error(
                 class,
                 activations: members.len(),
                 modified,
+                by_history,
                 baselines,
                 best_baseline: best.0,
                 ratio,
@@ -339,7 +351,11 @@ mod tests {
     }
 
     /// A protocol activation after `off_before_s`, with the given residual RMS per model on X.
-    fn protocol(off_before_s: f64, activation: u32, rms: &[(ModelKind, f64)]) -> (Split, ActivationResult) {
+    fn protocol(
+        off_before_s: f64,
+        activation: u32,
+        rms: &[(ModelKind, f64)],
+    ) -> (Split, ActivationResult) {
         let labels = SegmentLabels {
             unit_id: "U".into(),
             set_point_celsius: 40.0,
@@ -375,22 +391,58 @@ mod tests {
     fn the_absolute_error_flags_a_class_where_the_model_is_worse_than_the_best_baseline() {
         use ModelKind::*;
         let results = [
-            protocol(3600.0, 1, &[(Standard, 0.010), (ThirdOrder, 0.004), (Relative, 0.005), (Modified, 0.004)]),
-            protocol(60.0, 2, &[(Standard, 0.010), (ThirdOrder, 0.004), (Relative, 0.006), (Modified, 0.020)]),
-            protocol(60.0, 3, &[(Standard, 0.010), (ThirdOrder, 0.006), (Relative, 0.004), (Modified, 0.030)]),
+            protocol(
+                3600.0,
+                1,
+                &[
+                    (Standard, 0.010),
+                    (ThirdOrder, 0.004),
+                    (Relative, 0.005),
+                    (Modified, 0.004),
+                ],
+            ),
+            protocol(
+                60.0,
+                2,
+                &[
+                    (Standard, 0.010),
+                    (ThirdOrder, 0.004),
+                    (Relative, 0.006),
+                    (Modified, 0.020),
+                ],
+            ),
+            protocol(
+                60.0,
+                3,
+                &[
+                    (Standard, 0.010),
+                    (ThirdOrder, 0.006),
+                    (Relative, 0.004),
+                    (Modified, 0.030),
+                ],
+            ),
         ];
         let cells = absolute_error(&results, 15.0);
         let x: Vec<&AbsoluteCell> = cells.iter().filter(|c| c.axis == "X").collect();
         assert_eq!(x.len(), 2, "{cells:?}");
         let (cold, warm) = (x[0], x[1]);
-        assert_eq!((cold.class, cold.activations, cold.worse), (ActivationClass::ColdStart, 1, false));
-        assert_eq!((warm.class, warm.activations), (ActivationClass::WarmRestart, 2));
+        assert_eq!(
+            (cold.class, cold.activations, cold.worse),
+            (ActivationClass::ColdStart, 1, false)
+        );
+        assert_eq!(
+            (warm.class, warm.activations),
+            (ActivationClass::WarmRestart, 2)
+        );
         // Best baseline on the warm restarts: 3rd-order and relative both average 0.005; the
         // first in report order wins the tie.
         assert_eq!(warm.best_baseline, "3rd-order");
         assert!(warm.worse && (warm.ratio - 5.0).abs() < 1e-9, "{warm:?}");
         assert_eq!(warm.modified.worst_dps, 0.030);
-        assert_eq!(warm.modified.worst_activation, "series 1, repeat 2, activation 3");
+        assert_eq!(
+            warm.modified.worst_activation,
+            "series 1, repeat 2, activation 3"
+        );
         assert_eq!(warm.modified.outside_envelope, 2);
         assert!(warm.noise_floor_dps.is_nan());
     }

@@ -266,9 +266,8 @@ impl Gram {
 
     /// The least-squares coefficients of the first `columns` basis functions (None if singular).
     fn solve(&self, columns: usize) -> Option<Vec<f64>> {
-        let normal = DMatrix::<f64>::from_fn(columns, columns, |r, c| {
-            self.phi_phi[r.min(c)][r.max(c)]
-        });
+        let normal =
+            DMatrix::<f64>::from_fn(columns, columns, |r, c| self.phi_phi[r.min(c)][r.max(c)]);
         let rhs = DVector::<f64>::from_column_slice(&self.phi_y[..columns]);
         crate::regression::solve(normal, &rhs).filter(|c| c.iter().all(|v| v.is_finite()))
     }
@@ -383,8 +382,7 @@ pub fn relative_polynomial(
         let (drift_columns, drift) =
             cross_validated(&drift_groups, 1, MAX_RELATIVE_DRIFT_DEGREE).unwrap_or((1, vec![0.0]));
         let (turn_on_columns, turn_on) =
-            cross_validated(&turn_on_groups, 1, MAX_TURN_ON_DEGREE + 1)
-                .unwrap_or((1, vec![0.0]));
+            cross_validated(&turn_on_groups, 1, MAX_TURN_ON_DEGREE + 1).unwrap_or((1, vec![0.0]));
         // p's constant term cancels in p(T) − p(T_on): stored as 0.
         let mut p = vec![0.0];
         p.extend(drift);
@@ -441,7 +439,11 @@ mod tests {
             for series in 1..=3u32 {
                 for activation in 1..=3u32 {
                     let on = set_point + f64::from(activation - 1) * 1.5;
-                    let jitter = if (series + activation) % 2 == 0 { 0.004 } else { -0.004 };
+                    let jitter = if (series + activation) % 2 == 0 {
+                        0.004
+                    } else {
+                        -0.004
+                    };
                     let rise: Vec<f32> = (0..200).map(|i| i as f32 * 0.025).collect();
                     let drift: Vec<f32> = rise
                         .iter()

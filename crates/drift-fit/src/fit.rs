@@ -4,8 +4,7 @@ use std::collections::BTreeSet;
 
 use drift_core::{
     AmbientCurves, AxisTable, Curve, CurvePoint, Model, ModifiedTables, PolynomialTables,
-    RelativePolynomialTables, Settings,
-    WarmStart,
+    RelativePolynomialTables, Settings, WarmStart,
 };
 use nalgebra::{Matrix2, Vector2};
 

@@ -359,7 +359,7 @@ pub fn absolute_error(cells: &[AbsoluteCell]) -> String {
     if cells.is_empty() {
         return String::new();
     }
-    let mut md = String::from("## Absolute error\n\nResidual bias RMS (RMS of the corrected 1-s low-frequency rate; the unit is static, so the true rate is zero) per unit × axis × set point × activation class, on held-out activations, °/s: mean over the class's activations, and its worst activation. Unlike the drift it includes the error of the offset at switch-on. *Cold start*: off at least the calibration's cool-down before it (or first in its series); *warm restart*: off less (residual heat at switch-on); *field*: field-like sessions. *Noise floor*: what the paper's model leaves on the zero-drift unit's activations of the class (turn-on repeatability and noise). Flagged (**bold ratio**) where the paper's model leaves more than 1.25× the best baseline; `outside` counts activations switched on outside the model's calibrated envelope (clamped). The same as data: `absolute_error.json`.\n\n| unit | axis | set point | activations | n | modified (worst, where) | outside | standard | 3rd-order | relative | best | modified / best | noise floor |\n|---|---|---|---|---:|---|---:|---:|---:|---:|---|---:|---:|\n");
+    let mut md = String::from("## Absolute error\n\nResidual bias RMS (RMS of the corrected 1-s low-frequency rate; the unit is static, so the true rate is zero) per unit × axis × set point × activation class, on held-out activations, °/s: mean over the class's activations, and its worst activation. Unlike the drift it includes the error of the offset at switch-on. *Cold start*: off at least the calibration's cool-down before it (or first in its series); *warm restart*: off less (residual heat at switch-on); *field*: field-like sessions. *By-history*: the paper's curves keyed by history, started from what firmware kept of the previous activation (mean). *Noise floor*: what the paper's model leaves on the zero-drift unit's activations of the class (turn-on repeatability and noise). Flagged (**bold ratio**) where the paper's model leaves more than 1.25× the best baseline; `outside` counts activations switched on outside the model's calibrated envelope (clamped). The same as data: `absolute_error.json`.\n\n| unit | axis | set point | activations | n | modified (worst, where) | outside | by-history | standard | 3rd-order | relative | best | modified / best | noise floor |\n|---|---|---|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|\n");
     for c in cells {
         let baseline = |name: &str| {
             c.baselines
@@ -379,7 +379,7 @@ pub fn absolute_error(cells: &[AbsoluteCell]) -> String {
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {:+} °C | {} | {} | {:.4} ({:.4}, {}) | {} | {} | {} | {} | {} | {ratio} | {floor} |",
+            "| {} | {} | {:+} °C | {} | {} | {:.4} ({:.4}, {}) | {} | {:.4} | {} | {} | {} | {} | {ratio} | {floor} |",
             c.unit,
             c.axis,
             c.set_point_celsius,
@@ -389,6 +389,7 @@ pub fn absolute_error(cells: &[AbsoluteCell]) -> String {
             c.modified.worst_dps,
             c.modified.worst_activation,
             c.modified.outside_envelope,
+            c.by_history.mean_dps,
             baseline("standard"),
             baseline("3rd-order"),
             baseline("relative"),
