@@ -94,13 +94,19 @@ fn simulate_fit_and_report_from_the_command_line() {
     let flags = md
         .find("## Absolute error: where the paper's model is worse")
         .expect("absolute-error flags");
-    assert!(flags < md.find("## Drift per unit and axis").unwrap(), "{md}");
+    assert!(
+        flags < md.find("## Drift per unit and axis").unwrap(),
+        "{md}"
+    );
     assert!(md.contains("## Absolute error\n"), "{md}");
     let cells: serde_json::Value =
         serde_json::from_slice(&std::fs::read(report.join("absolute_error.json")).unwrap())
             .unwrap();
     let cell = &cells[0];
-    assert!(cell["modified"]["mean_dps"].as_f64().unwrap() > 0.0, "{cell}");
+    assert!(
+        cell["modified"]["mean_dps"].as_f64().unwrap() > 0.0,
+        "{cell}"
+    );
     assert!(cell["best_baseline"].is_string(), "{cell}");
     let diagnosis = dir.path().join("diagnosis");
     let text = run(&["diagnose", c, "-q", "-o", diagnosis.to_str().unwrap()]);
