@@ -76,6 +76,8 @@ fn simulate_fit_and_report_from_the_command_line() {
         let bytes = std::fs::read(tables.join(format!("GIU-01/{name}.bin"))).unwrap();
         assert!(decode::<PolynomialTables>(&bytes).is_ok(), "{name}");
     }
+    let bytes = std::fs::read(tables.join("GIU-01/relative.bin")).unwrap();
+    assert!(decode::<drift_core::RelativePolynomialTables>(&bytes).is_ok());
     let report = dir.path().join("report");
     let text = run(&["report", c, "-q", "-o", report.to_str().unwrap()]);
     assert!(text.contains("| +33 °C | validation |"), "{text}");
@@ -86,6 +88,26 @@ fn simulate_fit_and_report_from_the_command_line() {
         "{md}"
     );
     assert!(report.join("fig-correlation.svg").exists() && report.join("report.json").exists());
+    // The headline names the best baseline; the absolute error stands beside the drift, its
+    // flags on the first page, before the paper's table.
+    assert!(md.contains("best baseline / modified"), "{md}");
+    let flags = md
+        .find("## Absolute error: where the paper's model is worse")
+        .expect("absolute-error flags");
+    assert!(
+        flags < md.find("## Drift per unit and axis").unwrap(),
+        "{md}"
+    );
+    assert!(md.contains("## Absolute error\n"), "{md}");
+    let cells: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report.join("absolute_error.json")).unwrap())
+            .unwrap();
+    let cell = &cells[0];
+    assert!(
+        cell["modified"]["mean_dps"].as_f64().unwrap() > 0.0,
+        "{cell}"
+    );
+    assert!(cell["best_baseline"].is_string(), "{cell}");
     let diagnosis = dir.path().join("diagnosis");
     let text = run(&["diagnose", c, "-q", "-o", diagnosis.to_str().unwrap()]);
     assert!(text.contains("GIU-01:") && text.contains("  X: "), "{text}");

@@ -22,7 +22,7 @@ use serde::{de::DeserializeOwned, Serialize};
 
 use crate::error::Error;
 use crate::model::Model;
-use crate::polynomial::PolynomialTables;
+use crate::polynomial::{PolynomialTables, RelativePolynomialTables};
 use crate::table::ModifiedTables;
 
 /// First four bytes of every image.
@@ -45,6 +45,8 @@ pub enum Kind {
     Modified = 1,
     /// [`PolynomialTables`]: a polynomial baseline.
     Polynomial = 2,
+    /// [`RelativePolynomialTables`]: the polynomial baseline relative to the switch-on.
+    RelativePolynomial = 3,
 }
 
 /// A model that can be stored as a firmware image.
@@ -59,6 +61,10 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
 
 impl Image for PolynomialTables {
     const KIND: Kind = Kind::Polynomial;
+}
+
+impl Image for RelativePolynomialTables {
+    const KIND: Kind = Kind::RelativePolynomial;
 }
 
 /// The model of a payload that holds exactly one, validated. Out of line: the model is built,

@@ -46,7 +46,8 @@ pub use history::{Previous, SwitchOn};
 pub use model::{AxisModel, Model};
 pub use modified::ModifiedAxisState;
 pub use polynomial::{
-    PolynomialAxis, PolynomialAxisState, PolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
+    PolynomialAxis, PolynomialAxisState, PolynomialTables, RelativePolynomialAxis,
+    RelativePolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
 };
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;

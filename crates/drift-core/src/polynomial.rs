@@ -1,8 +1,14 @@
 //! Baselines: bias as a polynomial of the absolute sensor temperature, with no heating dynamics.
 //!
-//! One type serves both baselines the project compares against: the paper's "standard" calibration
-//! (a Lagrange polynomial through the bias at the calibration temperatures, converted by the fitter
-//! to this form) and the PX4/ArduPilot practice (a least-squares 3rd-order polynomial per axis).
+//! Two forms, as practitioners use them:
+//!
+//! - absolute ([`PolynomialTables`]): `bias = p(T)`. The paper's "standard" calibration (a Lagrange
+//!   polynomial through the bias at the calibration temperatures) and the PX4/ArduPilot practice (a
+//!   least-squares 3rd-order polynomial per axis).
+//! - relative to the switch-on ([`RelativePolynomialTables`]): `bias = q(T_on) + p(T) − p(T_on)`,
+//!   the turn-on bias `q(T_on)` registered at switch-on from the calibration (as the paper's model
+//!   takes its initial bias) and the drift after it from a polynomial fitted on the drift since
+//!   switch-on, so each activation's random turn-on bias does not bend `p`.
 
 use heapless::Vec;
 
@@ -213,5 +219,123 @@ impl Model for PolynomialTables {
             polynomial.validate(Location::axis(axis))?;
         }
         Ok(())
+    }
+}
+
+/// One axis of the baseline relative to the switch-on: `bias = q(T_on) + p(T) − p(T_on)`.
+#[derive(Clone, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct RelativePolynomialAxis {
+    /// `p`: the drift since switch-on is `p(T) − p(T_on)` (its constant term cancels).
+    pub drift: PolynomialAxis,
+    /// `q`: the turn-on bias as a polynomial of the switch-on temperature.
+    pub turn_on: PolynomialAxis,
+}
+
+impl RelativePolynomialAxis {
+    /// Checks both polynomials; `at` names the axis in errors.
+    pub fn validate(&self, at: Location) -> Result<(), Error> {
+        self.drift.validate(at)?;
+        self.turn_on.validate(at)
+    }
+}
+
+impl AxisModel for RelativePolynomialAxis {
+    type State = PolynomialAxisState;
+
+    fn power_on(
+        &self,
+        settings: &Settings,
+        switch_on_celsius: f32,
+        state: &mut Self::State,
+    ) -> (f32, Flags) {
+        let margin = settings.ambient_margin_celsius;
+        let (bias, outside) = self.turn_on.evaluate(switch_on_celsius, margin);
+        state.at_switch_on_dps = self.drift.evaluate(switch_on_celsius, margin).0;
+        let flags = if outside {
+            Flags::TEMPERATURE_OUT_OF_RANGE
+        } else {
+            Flags::NONE
+        };
+        (bias, flags)
+    }
+
+    fn drift(
+        &self,
+        settings: &Settings,
+        state: &mut Self::State,
+        _since_power_on_ms: u32,
+        temperature_celsius: f32,
+        _rise_celsius: f32,
+    ) -> (f32, Flags) {
+        drift_at(
+            Span::new(self.drift.range_celsius, settings.ambient_margin_celsius),
+            state.at_switch_on_dps,
+            temperature_celsius,
+            &self.drift.coefficients,
+        )
+    }
+}
+
+/// The baseline relative to the switch-on for a whole unit.
+#[derive(Clone, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct RelativePolynomialTables {
+    /// Sensor conversion and envelope settings.
+    pub settings: Settings,
+    /// One pair of polynomials per axis (X, Y, Z).
+    pub axes: [RelativePolynomialAxis; AXES],
+}
+
+impl Model for RelativePolynomialTables {
+    type Axis = RelativePolynomialAxis;
+
+    fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    fn axes(&self) -> &[Self::Axis; AXES] {
+        &self.axes
+    }
+
+    fn validate(&self) -> Result<(), Error> {
+        self.settings.validate()?;
+        for (axis, pair) in self.axes.iter().enumerate() {
+            pair.validate(Location::axis(axis))?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn axis(range: [f32; 2], coefficients: &[f32]) -> PolynomialAxis {
+        PolynomialAxis {
+            range_celsius: range,
+            coefficients: Vec::from_slice(coefficients).unwrap_or_default(),
+        }
+    }
+
+    /// The turn-on bias comes from `q`, the drift after it from `p`: neither from the other.
+    #[test]
+    fn the_relative_form_takes_its_turn_on_bias_from_q_and_its_drift_from_p() {
+        let settings = Settings::default();
+        let pair = RelativePolynomialAxis {
+            // p(T) = 0.5 + 0.1·x over [20, 40]: x = (T − 30) / 10.
+            drift: axis([20.0, 40.0], &[0.5, 0.1]),
+            // q(T_on) = 0.02 everywhere.
+            turn_on: axis([20.0, 40.0], &[0.02]),
+        };
+        let mut state = PolynomialAxisState::default();
+        let (bias, flags) = pair.power_on(&settings, 30.0, &mut state);
+        assert_eq!((bias, flags), (0.02, Flags::NONE));
+        let (drift, flags) = pair.drift(&settings, &mut state, 0, 35.0, 5.0);
+        assert!((drift - 0.05).abs() < 1e-6, "{drift}");
+        assert_eq!(flags, Flags::NONE);
+        // Beyond q's range by more than the margin: flagged, clamped.
+        let (bias, flags) = pair.power_on(&settings, 45.0, &mut state);
+        assert_eq!((bias, flags), (0.02, Flags::TEMPERATURE_OUT_OF_RANGE));
     }
 }

@@ -22,6 +22,9 @@ pub enum ModelKind {
     Standard,
     /// The least-squares polynomial (PX4/ArduPilot practice).
     ThirdOrder,
+    /// The least-squares polynomial relative to the switch-on: the turn-on bias registered from
+    /// the calibration, the drift after it `p(T) − p(T_on)`.
+    Relative,
     /// The paper's modified method.
     Modified,
     /// The paper's tables with stage 3 keyed by heating history, fed what firmware would have
@@ -31,13 +34,18 @@ pub enum ModelKind {
 
 impl ModelKind {
     /// Every model, in report order.
-    pub const ALL: [ModelKind; 5] = [
+    pub const ALL: [ModelKind; 6] = [
         Self::Uncorrected,
         Self::Standard,
         Self::ThirdOrder,
+        Self::Relative,
         Self::Modified,
         Self::ByHistory,
     ];
+
+    /// The standard baselines the paper's model is compared against: the best of them on
+    /// held-out data is the headline's reference.
+    pub const BASELINES: [ModelKind; 3] = [Self::Standard, Self::ThirdOrder, Self::Relative];
 
     /// Name used in reports.
     pub fn name(self) -> &'static str {
@@ -45,6 +53,7 @@ impl ModelKind {
             Self::Uncorrected => "uncorrected",
             Self::Standard => "standard",
             Self::ThirdOrder => "3rd-order",
+            Self::Relative => "relative",
             Self::Modified => "modified",
             Self::ByHistory => "by-history",
         }
@@ -368,6 +377,7 @@ pub fn evaluate_after(
                 ModelKind::Uncorrected => (segment.rate_dps.clone(), [0; 3]),
                 ModelKind::Standard => correct_segment(&fitted.standard, segment, switch_on),
                 ModelKind::ThirdOrder => correct_segment(&fitted.third_order, segment, switch_on),
+                ModelKind::Relative => correct_segment(&fitted.relative, segment, switch_on),
                 ModelKind::Modified => correct_segment(&fitted.modified, segment, switch_on),
                 ModelKind::ByHistory => {
                     correct_segment_after(&fitted.by_history, segment, switch_on, Some(previous))

@@ -96,6 +96,210 @@ pub fn summarise(results: &[(Split, ActivationResult)]) -> Vec<Record> {
         .collect()
 }
 
+/// How an activation started, for the absolute error: the offset a model leaves depends on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ActivationClass {
+    /// A protocol activation after a full cool-down (off at least the calibration's cool-down,
+    /// or the first of its series).
+    ColdStart,
+    /// A protocol activation after a shorter off-time: residual heat at switch-on.
+    WarmRestart,
+    /// A field-like activation (random off-times, ambient ramps, ...).
+    Field,
+}
+
+impl ActivationClass {
+    /// Name used in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::ColdStart => "cold start",
+            Self::WarmRestart => "warm restart",
+            Self::Field => "field",
+        }
+    }
+
+    /// The class of an activation of `split`: warm when it was off less than
+    /// `independent_after_min` minutes (the fit's cool-down).
+    pub fn of(
+        split: Split,
+        labels: &drift_recording::SegmentLabels,
+        independent_after_min: f64,
+    ) -> Self {
+        if split == Split::Field {
+            return Self::Field;
+        }
+        match labels.off_before_s {
+            Some(s) if s < independent_after_min * 60.0 => Self::WarmRestart,
+            _ => Self::ColdStart,
+        }
+    }
+}
+
+/// A model's residual bias RMS over a cell's activations.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BiasRms {
+    /// Which model.
+    pub model: &'static str,
+    /// Mean over the cell's activations of the residual bias RMS, °/s.
+    pub mean_dps: f64,
+    /// The largest over them, °/s.
+    pub worst_dps: f64,
+    /// The activation it was measured on (`series S, repeat R, activation A`).
+    pub worst_activation: String,
+    /// How many of the cell's activations this model switched on outside its calibrated envelope
+    /// (clamped: ambient or temperature out of range).
+    pub outside_envelope: usize,
+}
+
+/// The absolute error of one unit × axis × set point × activation class on held-out data: the
+/// residual bias RMS of the paper's model and of every standard baseline, the best baseline, and
+/// the noise floor beside them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AbsoluteCell {
+    /// Unit id.
+    pub unit: String,
+    /// Axis: `X`, `Y` or `Z`.
+    pub axis: &'static str,
+    /// Nominal set point, °C.
+    pub set_point_celsius: f64,
+    /// How the activations started.
+    pub class: ActivationClass,
+    /// How many activations.
+    pub activations: usize,
+    /// The paper's model (`modified`).
+    pub modified: BiasRms,
+    /// The paper's curves keyed by history, started from what firmware kept (`by-history`).
+    pub by_history: BiasRms,
+    /// Every standard baseline, in report order.
+    pub baselines: Vec<BiasRms>,
+    /// The baseline with the smallest mean.
+    pub best_baseline: &'static str,
+    /// The paper's model's mean over the best baseline's.
+    pub ratio: f64,
+    /// Whether the paper's model is worse than [`WORSE_THAN_BASELINE`] × the best baseline.
+    pub worse: bool,
+    /// Mean residual bias RMS the paper's model leaves on the zero-drift unit's activations of
+    /// this class (turn-on repeatability and noise: what no model can remove), °/s; NaN without a
+    /// noise-floor unit.
+    pub noise_floor_dps: f64,
+}
+
+/// The paper's model is flagged where its residual bias RMS exceeds the best baseline's by more
+/// than this factor.
+pub const WORSE_THAN_BASELINE: f64 = 1.25;
+
+fn activation_name(labels: &drift_recording::SegmentLabels) -> String {
+    format!(
+        "series {}, repeat {}, activation {}",
+        labels.series, labels.repeat, labels.activation
+    )
+}
+
+/// The absolute error per unit × axis × set point × activation class, on every held-out
+/// activation of `results` (validation, held-out repeats, field); the noise floor from the
+/// [`Split::NoiseFloor`] results of the same class (any class if that one has none).
+pub fn absolute_error(
+    results: &[(Split, ActivationResult)],
+    independent_after_min: f64,
+) -> Vec<AbsoluteCell> {
+    type Key = (String, i64, ActivationClass, usize);
+    let mut cells: BTreeMap<Key, Vec<&ActivationResult>> = BTreeMap::new();
+    let mut floor: BTreeMap<ActivationClass, (f64, usize)> = BTreeMap::new();
+    for (split, result) in results {
+        let class = ActivationClass::of(*split, &result.labels, independent_after_min);
+        if *split == Split::NoiseFloor {
+            if let Some(m) = result
+                .models
+                .iter()
+                .find(|m| m.model == ModelKind::Modified)
+            {
+                let entry = floor.entry(class).or_default();
+                for rms in m.residual_rms_dps {
+                    entry.0 += rms;
+                    entry.1 += 1;
+                }
+            }
+            continue;
+        }
+        let set_point = (result.labels.nominal_set_point_celsius() * 1000.0).round() as i64;
+        for axis in 0..3 {
+            cells
+                .entry((result.labels.unit_id.clone(), set_point, class, axis))
+                .or_default()
+                .push(result);
+        }
+    }
+    let any_floor = floor
+        .values()
+        .fold((0.0, 0), |(s, n), (fs, fn_)| (s + fs, n + fn_));
+    let floor_of = |class| {
+        let (sum, n) = floor.get(&class).copied().unwrap_or(any_floor);
+        if n == 0 {
+            f64::NAN
+        } else {
+            sum / n as f64
+        }
+    };
+    let rms_of = |members: &[&ActivationResult], model: ModelKind, axis: usize| {
+        let mut sum = 0.0;
+        let mut worst = (f64::NEG_INFINITY, String::new());
+        let mut outside = 0;
+        let out_flags = drift_core::Flags::AMBIENT_OUT_OF_RANGE.0
+            | drift_core::Flags::TEMPERATURE_OUT_OF_RANGE.0;
+        for r in members {
+            let Some(m) = r.models.iter().find(|m| m.model == model) else {
+                continue;
+            };
+            let v = m.residual_rms_dps[axis];
+            sum += v;
+            if v > worst.0 {
+                worst = (v, activation_name(&r.labels));
+            }
+            if m.flags[axis] & out_flags != 0 {
+                outside += 1;
+            }
+        }
+        BiasRms {
+            model: model.name(),
+            mean_dps: sum / members.len().max(1) as f64,
+            worst_dps: worst.0,
+            worst_activation: worst.1,
+            outside_envelope: outside,
+        }
+    };
+    cells
+        .into_iter()
+        .map(|((unit, set_point, class, axis), members)| {
+            let modified = rms_of(&members, ModelKind::Modified, axis);
+            let by_history = rms_of(&members, ModelKind::ByHistory, axis);
+            let baselines: Vec<BiasRms> = ModelKind::BASELINES
+                .iter()
+                .map(|&b| rms_of(&members, b, axis))
+                .collect();
+            let best = baselines
+                .iter()
+                .min_by(|a, b| a.mean_dps.total_cmp(&b.mean_dps))
+                .map_or(("–", f64::NAN), |b| (b.model, b.mean_dps));
+            let ratio = modified.mean_dps / best.1;
+            AbsoluteCell {
+                unit,
+                axis: ["X", "Y", "Z"][axis],
+                set_point_celsius: set_point as f64 / 1000.0,
+                class,
+                activations: members.len(),
+                modified,
+                by_history,
+                baselines,
+                best_baseline: best.0,
+                ratio,
+                worse: ratio > WORSE_THAN_BASELINE,
+                noise_floor_dps: floor_of(class),
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use drift_recording::{SegmentLabels, SeriesKind};
@@ -144,5 +348,102 @@ mod tests {
         assert_eq!((rows[0].0, rows[0].1), (33.0, 3));
         assert!((rows[0].2 - 0.02).abs() < 1e-12, "{rows:?}");
         assert_eq!((rows[1].0, rows[1].1), (36.5, 1));
+    }
+
+    /// A protocol activation after `off_before_s`, with the given residual RMS per model on X.
+    fn protocol(
+        off_before_s: f64,
+        activation: u32,
+        rms: &[(ModelKind, f64)],
+    ) -> (Split, ActivationResult) {
+        let labels = SegmentLabels {
+            unit_id: "U".into(),
+            set_point_celsius: 40.0,
+            session_set_point_celsius: None,
+            series_kind: SeriesKind::Protocol,
+            series: 1,
+            repeat: 2,
+            activation,
+            interval_min: None,
+            off_before_s: Some(off_before_s),
+        };
+        let models = rms
+            .iter()
+            .map(|&(model, v)| ModelResult {
+                model,
+                drift_dps: [0.001; 3],
+                residual_rms_dps: [v, 0.001, 0.001],
+                flags: [
+                    if model == ModelKind::Modified && off_before_s < 900.0 {
+                        drift_core::Flags::AMBIENT_OUT_OF_RANGE.0
+                    } else {
+                        0
+                    },
+                    0,
+                    0,
+                ],
+            })
+            .collect();
+        (Split::HeldOutRepeat, ActivationResult { labels, models })
+    }
+
+    #[test]
+    fn the_absolute_error_flags_a_class_where_the_model_is_worse_than_the_best_baseline() {
+        use ModelKind::*;
+        let results = [
+            protocol(
+                3600.0,
+                1,
+                &[
+                    (Standard, 0.010),
+                    (ThirdOrder, 0.004),
+                    (Relative, 0.005),
+                    (Modified, 0.004),
+                ],
+            ),
+            protocol(
+                60.0,
+                2,
+                &[
+                    (Standard, 0.010),
+                    (ThirdOrder, 0.004),
+                    (Relative, 0.006),
+                    (Modified, 0.020),
+                ],
+            ),
+            protocol(
+                60.0,
+                3,
+                &[
+                    (Standard, 0.010),
+                    (ThirdOrder, 0.006),
+                    (Relative, 0.004),
+                    (Modified, 0.030),
+                ],
+            ),
+        ];
+        let cells = absolute_error(&results, 15.0);
+        let x: Vec<&AbsoluteCell> = cells.iter().filter(|c| c.axis == "X").collect();
+        assert_eq!(x.len(), 2, "{cells:?}");
+        let (cold, warm) = (x[0], x[1]);
+        assert_eq!(
+            (cold.class, cold.activations, cold.worse),
+            (ActivationClass::ColdStart, 1, false)
+        );
+        assert_eq!(
+            (warm.class, warm.activations),
+            (ActivationClass::WarmRestart, 2)
+        );
+        // Best baseline on the warm restarts: 3rd-order and relative both average 0.005; the
+        // first in report order wins the tie.
+        assert_eq!(warm.best_baseline, "3rd-order");
+        assert!(warm.worse && (warm.ratio - 5.0).abs() < 1e-9, "{warm:?}");
+        assert_eq!(warm.modified.worst_dps, 0.030);
+        assert_eq!(
+            warm.modified.worst_activation,
+            "series 1, repeat 2, activation 3"
+        );
+        assert_eq!(warm.modified.outside_envelope, 2);
+        assert!(warm.noise_floor_dps.is_nan());
     }
 }

@@ -64,24 +64,28 @@ pub enum StoredModel {
     Standard,
     /// The 3rd-order polynomial.
     ThirdOrder,
+    /// The least-squares polynomial relative to the switch-on.
+    Relative,
 }
 
 impl StoredModel {
     /// Every stored model, in the order files are written.
-    pub const ALL: [Self; 4] = [
+    pub const ALL: [Self; 5] = [
         Self::Modified,
         Self::ByHistory,
         Self::Standard,
         Self::ThirdOrder,
+        Self::Relative,
     ];
 
-    /// The files' stem: `modified`, `by_history`, `standard`, `third_order`.
+    /// The files' stem: `modified`, `by_history`, `standard`, `third_order`, `relative`.
     pub fn stem(self) -> &'static str {
         match self {
             Self::Modified => "modified",
             Self::ByHistory => "by_history",
             Self::Standard => "standard",
             Self::ThirdOrder => "third_order",
+            Self::Relative => "relative",
         }
     }
 
@@ -139,13 +143,15 @@ pub fn unit_files(
             StoredModel::ByHistory => model_files(&dir, stem, &unit.by_history)?,
             StoredModel::Standard => model_files(&dir, stem, &unit.standard)?,
             StoredModel::ThirdOrder => model_files(&dir, stem, &unit.third_order)?,
+            StoredModel::Relative => model_files(&dir, stem, &unit.relative)?,
         };
         files.extend(pair);
     }
     Ok(files)
 }
 
-/// Writes each unit's models as `<folder>/<unit>/{modified,by_history,standard,third_order}.{json,bin}`.
+/// Writes each unit's models as
+/// `<folder>/<unit>/{modified,by_history,standard,third_order,relative}.{json,bin}`.
 ///
 /// Every file is encoded in memory first, so an encoding error leaves the folder untouched; each
 /// file is then replaced atomically, so none is ever half-written.

@@ -1,7 +1,15 @@
-//! The two baselines, fitted on the same calibration activations as the paper's tables: bias as a
-//! polynomial of the absolute sensor temperature, no heating dynamics.
+//! The baselines, fitted on the same calibration activations as the paper's tables: bias as a
+//! polynomial of the sensor temperature, no heating dynamics. Absolute (`bias = p(T)`: the paper's
+//! standard calibration, the PX4/ArduPilot least-squares polynomial) and relative to the switch-on
+//! (`bias = q(T_on) + p(T) − p(T_on)`, orders chosen by cross-validation over the calibration's
+//! series).
 
-use drift_core::{PolynomialAxis, PolynomialTables, Settings, MAX_POLYNOMIAL_COEFFICIENTS};
+use std::collections::BTreeMap;
+
+use drift_core::{
+    PolynomialAxis, PolynomialTables, RelativePolynomialAxis, RelativePolynomialTables, Settings,
+    MAX_POLYNOMIAL_COEFFICIENTS,
+};
 use nalgebra::{DMatrix, DVector};
 
 use crate::analyse::Analysed;
@@ -207,6 +215,195 @@ pub fn least_squares_polynomial(
     PolynomialTables { settings, axes }
 }
 
+/// Highest order the relative baseline's cross-validation tries for the drift polynomial `p`.
+pub const MAX_RELATIVE_DRIFT_DEGREE: usize = 5;
+/// Highest order it tries for the turn-on polynomial `q`.
+pub const MAX_TURN_ON_DEGREE: usize = 3;
+
+/// Sums of a least-squares problem `y ≈ Σ_j c_j φ_j` over a group of points: `Σ φφᵀ`, `Σ φ y` and
+/// `Σ y²`, enough for the fit on any union of groups and the squared error on any group, for
+/// every leading subset of the basis (every lower order).
+#[derive(Clone, Copy)]
+struct Gram {
+    phi_phi: [[f64; MAX_POLYNOMIAL_COEFFICIENTS]; MAX_POLYNOMIAL_COEFFICIENTS],
+    phi_y: [f64; MAX_POLYNOMIAL_COEFFICIENTS],
+    y_y: f64,
+}
+
+impl Default for Gram {
+    fn default() -> Self {
+        Self {
+            phi_phi: [[0.0; MAX_POLYNOMIAL_COEFFICIENTS]; MAX_POLYNOMIAL_COEFFICIENTS],
+            phi_y: [0.0; MAX_POLYNOMIAL_COEFFICIENTS],
+            y_y: 0.0,
+        }
+    }
+}
+
+impl Gram {
+    fn add(&mut self, phi: &[f64], y: f64) {
+        for (r, &a) in phi.iter().enumerate() {
+            for (c, &b) in phi.iter().enumerate().skip(r) {
+                self.phi_phi[r][c] += a * b;
+            }
+            self.phi_y[r] += a * y;
+        }
+        self.y_y += y * y;
+    }
+
+    fn plus(mut self, other: &Gram, sign: f64) -> Gram {
+        for (row, other_row) in self.phi_phi.iter_mut().zip(&other.phi_phi) {
+            for (v, o) in row.iter_mut().zip(other_row) {
+                *v += sign * o;
+            }
+        }
+        for (v, o) in self.phi_y.iter_mut().zip(&other.phi_y) {
+            *v += sign * o;
+        }
+        self.y_y += sign * other.y_y;
+        self
+    }
+
+    /// The least-squares coefficients of the first `columns` basis functions (None if singular).
+    fn solve(&self, columns: usize) -> Option<Vec<f64>> {
+        let normal =
+            DMatrix::<f64>::from_fn(columns, columns, |r, c| self.phi_phi[r.min(c)][r.max(c)]);
+        let rhs = DVector::<f64>::from_column_slice(&self.phi_y[..columns]);
+        crate::regression::solve(normal, &rhs).filter(|c| c.iter().all(|v| v.is_finite()))
+    }
+
+    /// Σ (y − φ·c)² over this group's points for coefficients `c` of the leading basis.
+    fn squared_error(&self, c: &[f64]) -> f64 {
+        let mut error = self.y_y;
+        for (r, &a) in c.iter().enumerate() {
+            error -= 2.0 * a * self.phi_y[r];
+            for (k, &b) in c.iter().enumerate() {
+                error += a * b * self.phi_phi[r.min(k)][r.max(k)];
+            }
+        }
+        error
+    }
+}
+
+/// The order (number of leading basis functions, from `min_columns` to `max_columns`) whose fit
+/// on all groups but one predicts the left-out one best, summed over every group left out in
+/// turn; and its coefficients fitted on every group. One group only: the lowest order.
+fn cross_validated(
+    groups: &[Gram],
+    min_columns: usize,
+    max_columns: usize,
+) -> Option<(usize, Vec<f64>)> {
+    let total = groups
+        .iter()
+        .fold(Gram::default(), |sum, g| sum.plus(g, 1.0));
+    let mut best: Option<(f64, usize)> = None;
+    if groups.len() >= 2 {
+        for columns in min_columns..=max_columns {
+            let mut error = 0.0;
+            for group in groups {
+                match total.plus(group, -1.0).solve(columns) {
+                    Some(c) => error += group.squared_error(&c),
+                    None => {
+                        error = f64::INFINITY;
+                        break;
+                    }
+                }
+            }
+            if error.is_finite() && best.is_none_or(|(e, _)| error < e) {
+                best = Some((error, columns));
+            }
+        }
+    }
+    let columns = best.map_or(min_columns, |(_, c)| c);
+    total.solve(columns).map(|c| (columns, c))
+}
+
+/// The calibration series an activation belongs to: the group cross-validation leaves out whole,
+/// so an order is judged on series it did not see (activations within a series share their
+/// heating history and are not independent).
+fn series_key(a: &Analysed) -> (i64, u32, u32) {
+    (
+        (a.labels.set_point_celsius * 1000.0).round() as i64,
+        a.labels.series,
+        a.labels.repeat,
+    )
+}
+
+/// The orders the relative baseline chose, per axis: `p`'s and `q`'s degree.
+pub type RelativeOrders = [(usize, usize); 3];
+
+/// The baseline relative to the switch-on: per axis, `p` by least squares on every calibration
+/// grid point's drift since switch-on (`g = p(T) − p(T_on)`, the basis `x^k − x_on^k`, k ≥ 1),
+/// and `q` by least squares on each activation's initial bias against its switch-on temperature;
+/// each order chosen by leave-one-series-out cross-validation on the calibration activations
+/// (`p` up to [`MAX_RELATIVE_DRIFT_DEGREE`], `q` up to [`MAX_TURN_ON_DEGREE`]).
+pub fn relative_polynomial(
+    activations: &[&Analysed],
+    settings: Settings,
+) -> (RelativePolynomialTables, RelativeOrders) {
+    let fitted = per_axis(|axis| {
+        let range = range_of(activations, axis);
+        let normalise = Normalise::over(range);
+        let mut drift_groups: BTreeMap<(i64, u32, u32), Gram> = BTreeMap::new();
+        let mut turn_on_groups: BTreeMap<(i64, u32, u32), Gram> = BTreeMap::new();
+        let mut phi = [0.0; MAX_RELATIVE_DRIFT_DEGREE + 1];
+        for a in activations {
+            let on = a.switch_on_celsius[axis];
+            let x_on = normalise.apply(on);
+            let drift = drift_groups.entry(series_key(a)).or_default();
+            for (&rise, &g) in a.rise_celsius[axis].iter().zip(&a.drift_dps[axis]) {
+                let (x, g) = (normalise.apply(on + f64::from(rise)), f64::from(g));
+                if !(x.is_finite() && g.is_finite()) {
+                    continue;
+                }
+                let (mut power, mut power_on) = (1.0, 1.0);
+                for value in phi.iter_mut().take(MAX_RELATIVE_DRIFT_DEGREE) {
+                    power *= x;
+                    power_on *= x_on;
+                    *value = power - power_on;
+                }
+                drift.add(&phi[..MAX_RELATIVE_DRIFT_DEGREE], g);
+            }
+            let bias = a.initial_bias_dps[axis];
+            if x_on.is_finite() && bias.is_finite() {
+                let mut power = 1.0;
+                for value in phi.iter_mut().take(MAX_TURN_ON_DEGREE + 1) {
+                    *value = power;
+                    power *= x_on;
+                }
+                turn_on_groups
+                    .entry(series_key(a))
+                    .or_default()
+                    .add(&phi[..=MAX_TURN_ON_DEGREE], bias);
+            }
+        }
+        let drift_groups: Vec<Gram> = drift_groups.into_values().collect();
+        let turn_on_groups: Vec<Gram> = turn_on_groups.into_values().collect();
+        let (drift_columns, drift) =
+            cross_validated(&drift_groups, 1, MAX_RELATIVE_DRIFT_DEGREE).unwrap_or((1, vec![0.0]));
+        let (turn_on_columns, turn_on) =
+            cross_validated(&turn_on_groups, 1, MAX_TURN_ON_DEGREE + 1).unwrap_or((1, vec![0.0]));
+        // p's constant term cancels in p(T) − p(T_on): stored as 0.
+        let mut p = vec![0.0];
+        p.extend(drift);
+        (
+            RelativePolynomialAxis {
+                drift: axis_polynomial(range, &p),
+                turn_on: axis_polynomial(range, &turn_on),
+            },
+            (drift_columns, turn_on_columns - 1),
+        )
+    });
+    let [(x, ox), (y, oy), (z, oz)] = fitted;
+    (
+        RelativePolynomialTables {
+            settings,
+            axes: [x, y, z],
+        },
+        [ox, oy, oz],
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -226,5 +423,83 @@ mod tests {
         for (got, want) in c.iter().zip([0.5, -0.2, 0.1, 0.05]) {
             assert!((got - want).abs() < 1e-9, "{got} vs {want}");
         }
+    }
+
+    /// The drift's temperature law of the activations below: drift since switch-on
+    /// `truth(T) − truth(T_on)`.
+    fn truth(t: f64) -> f64 {
+        0.002 * (t - 30.0) + 0.0001 * (t - 30.0).powi(2)
+    }
+
+    /// Activations whose drift since switch-on follows [`truth`],
+    /// turned on with a bias of `0.01·(T_on − 30)` plus ±0.004 of turn-on jitter.
+    fn activations() -> Vec<Analysed> {
+        let mut out = Vec::new();
+        for (s, set_point) in [30.0, 40.0].into_iter().enumerate() {
+            for series in 1..=3u32 {
+                for activation in 1..=3u32 {
+                    let on = set_point + f64::from(activation - 1) * 1.5;
+                    let jitter = if (series + activation) % 2 == 0 {
+                        0.004
+                    } else {
+                        -0.004
+                    };
+                    let rise: Vec<f32> = (0..200).map(|i| i as f32 * 0.025).collect();
+                    let drift: Vec<f32> = rise
+                        .iter()
+                        .map(|&r| (truth(on + f64::from(r)) - truth(on)) as f32)
+                        .collect();
+                    out.push(Analysed {
+                        labels: drift_recording::SegmentLabels {
+                            unit_id: "U".into(),
+                            set_point_celsius: set_point,
+                            session_set_point_celsius: None,
+                            series_kind: drift_recording::SeriesKind::Protocol,
+                            series: series + 10 * s as u32,
+                            repeat: 1,
+                            activation,
+                            interval_min: Some(5.0),
+                            off_before_s: Some(300.0),
+                        },
+                        grid_ms: 10,
+                        switch_on_raw: [(on * 200.0) as f32; 3],
+                        switch_on_celsius: [on; 3],
+                        initial_bias_dps: [0.01 * (on - 30.0) + jitter; 3],
+                        drift_dps: [drift.clone(), drift.clone(), drift],
+                        rise_celsius: [rise.clone(), rise.clone(), rise],
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The relative form recovers the drift after switch-on and the turn-on bias's trend through
+    /// the jitter; the absolute least-squares polynomial, fitted on the same points, bends its
+    /// drift to the turn-on biases of the ambients.
+    #[test]
+    fn the_relative_baseline_fits_the_drift_since_switch_on_not_the_turn_on_bias() {
+        let data = activations();
+        let refs: Vec<&Analysed> = data.iter().collect();
+        let (relative, orders) = relative_polynomial(&refs, Settings::default());
+        assert!(orders[0].0 >= 2, "{orders:?}");
+        let axis = &relative.axes[0];
+        let settings = Settings::default();
+        let mut state = Default::default();
+        use drift_core::AxisModel;
+        let (bias, _) = axis.power_on(&settings, 35.0, &mut state);
+        assert!((bias - 0.05).abs() < 0.002, "turn-on bias {bias}");
+        let (drift, _) = axis.drift(&settings, &mut state, 0, 38.0, 3.0);
+        let want = (truth(38.0) - truth(35.0)) as f32;
+        assert!((drift - want).abs() < 2e-4, "drift {drift} vs {want}");
+        // The absolute cubic on the same activations: its slope is the ambients' turn-on trend.
+        let absolute = least_squares_polynomial(&refs, 3, settings);
+        let mut state = Default::default();
+        let (at_on, _) = absolute.axes[0].power_on(&settings, 35.0, &mut state);
+        let (drift_abs, _) = absolute.axes[0].drift(&settings, &mut state, 0, 38.0, 3.0);
+        assert!(
+            (drift_abs - want).abs() > 5.0 * (drift - want).abs(),
+            "absolute {drift_abs} (at switch-on {at_on}), relative {drift}, truth {want}"
+        );
     }
 }

@@ -3,8 +3,8 @@
 use std::collections::BTreeSet;
 
 use drift_core::{
-    AmbientCurves, AxisTable, Curve, CurvePoint, Model, ModifiedTables, PolynomialTables, Settings,
-    WarmStart,
+    AmbientCurves, AxisTable, Curve, CurvePoint, Model, ModifiedTables, PolynomialTables,
+    RelativePolynomialTables, Settings, WarmStart,
 };
 use nalgebra::{Matrix2, Vector2};
 
@@ -41,6 +41,9 @@ pub struct FittedUnit {
     pub standard: PolynomialTables,
     /// The least-squares polynomial baseline (3rd order by default).
     pub third_order: PolynomialTables,
+    /// The least-squares polynomial baseline relative to the switch-on (turn-on bias `q(T_on)`,
+    /// drift `p(T) − p(T_on)`), orders chosen by cross-validation over the calibration's series.
+    pub relative: RelativePolynomialTables,
     /// The averaged curves the tables were built from (for plots and diagnosis).
     pub set_points: Vec<SetPointCurves>,
     /// The curve keys kept, in table order before the per-reference-time sort.
@@ -417,7 +420,7 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
         .collect();
     let core_settings = Settings::default();
     // The axes' tables and the baselines are independent: all on rayon's threads at once.
-    let (tables, (standard, third_order)) = rayon::join(
+    let (tables, ((standard, third_order), (relative, relative_orders))) = rayon::join(
         || {
             per_axis(|axis| {
                 let by_rise = axis_table(&set_points, axis, first, settings, Stage3::ByRise)?;
@@ -427,14 +430,19 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
         },
         || {
             rayon::join(
-                || baselines::standard(&by_set_point, core_settings),
                 || {
-                    baselines::least_squares_polynomial(
-                        &protocol,
-                        settings.polynomial_degree,
-                        core_settings,
+                    rayon::join(
+                        || baselines::standard(&by_set_point, core_settings),
+                        || {
+                            baselines::least_squares_polynomial(
+                                &protocol,
+                                settings.polynomial_degree,
+                                core_settings,
+                            )
+                        },
                     )
                 },
+                || baselines::relative_polynomial(&protocol, core_settings),
             )
         },
     );
@@ -472,12 +480,31 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
             source,
         })?;
     }
+    relative.validate().map_err(|source| FitError::Table {
+        unit: unit_id.clone(),
+        model: "relative",
+        source,
+    })?;
+    notes.push(format!(
+        "relative baseline: orders by leave-one-series-out cross-validation on the calibration, drift p(T) of degree {} and turn-on bias q(T_on) of degree {} (X, Y, Z)",
+        relative_orders
+            .iter()
+            .map(|o| o.0.to_string())
+            .collect::<Vec<_>>()
+            .join("/"),
+        relative_orders
+            .iter()
+            .map(|o| o.1.to_string())
+            .collect::<Vec<_>>()
+            .join("/"),
+    ));
     Ok(FittedUnit {
         unit_id,
         modified,
         by_history,
         standard,
         third_order,
+        relative,
         curve_keys: common.into_iter().collect(),
         set_points,
         notes,

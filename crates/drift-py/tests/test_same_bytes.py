@@ -32,7 +32,7 @@ def test_fit_and_save_write_the_same_tables_folder(campaign_dir: Path, tmp_path:
     written = files(tmp_path / "cli")
     assert set(written) == {
         f"GIU-01/{model}.{ext}"
-        for model in ("modified", "by_history", "standard", "third_order")
+        for model in ("modified", "by_history", "standard", "third_order", "relative")
         for ext in ("json", "bin")
     }
     assert written == files(tmp_path / "py")
@@ -59,5 +59,5 @@ def test_report_writes_what_the_command_line_writes(campaign_dir: Path, tmp_path
     # How long each step took is the one thing that differs from run to run.
     assert set(from_cli) == set(from_python) and "timings.json" in from_cli
     del from_cli["timings.json"], from_python["timings.json"]
-    assert {"report.md", "report.json", "tables/GIU-01/modified.bin"} <= set(from_cli)
+    assert {"report.md", "report.json", "absolute_error.json", "tables/GIU-01/modified.bin"} <= set(from_cli)
     assert from_cli == from_python

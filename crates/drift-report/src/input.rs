@@ -19,6 +19,8 @@ pub struct ReportInput<'a> {
     pub calibration: &'a [Analysed],
     /// Evaluation results with the data split each was measured on.
     pub results: &'a [(Split, ActivationResult)],
+    /// The fit's cool-down, minutes: activations off at least this long count as cold starts.
+    pub independent_after_min: f64,
     /// Measured durations of the pipeline's steps, seconds.
     pub timings: Vec<(String, f64)>,
 }

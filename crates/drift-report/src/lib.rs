@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use drift_evaluate::pipeline::{self, Options, Outcome, Progress};
-use drift_evaluate::summary::{summarise, Record, Split};
+use drift_evaluate::summary::{absolute_error, summarise, Record, Split};
 use drift_evaluate::tables_folder;
 use drift_fit::FittedUnit;
 
@@ -78,6 +78,7 @@ fn write_outcome(
         noise_floor_units: noise_units,
         calibration: &outcome.calibration,
         results: &outcome.results,
+        independent_after_min: options.fit.independent_after_min,
         timings: outcome.timings.clone(),
     };
     let path = write_report(out, &input)?;
@@ -123,10 +124,13 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
         input.fitted,
         input.noise_floor_units,
     ));
+    let cells = absolute_error(input.results, input.independent_after_min);
+    md.push_str(&tables::absolute_error_flags(&cells));
     md.push_str(&tables::paper_table(&records, input.fitted));
     md.push_str(&tables::field_table(&records, input.fitted));
     md.push_str(&tables::noise_floor(&records, input.noise_floor_units));
     md.push_str(&tables::residual_rms(&records, input.fitted));
+    md.push_str(&tables::absolute_error(&cells));
     if !figures.is_empty() {
         writeln!(md, "## Figures\n")?;
         for (file, caption) in &figures {
@@ -162,6 +166,10 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
     write_atomic(
         &dir.join("report.json"),
         serde_json::to_string_pretty(&records)?.as_bytes(),
+    )?;
+    write_atomic(
+        &dir.join("absolute_error.json"),
+        serde_json::to_string_pretty(&cells)?.as_bytes(),
     )?;
     // Durations differ from run to run; kept apart so the report itself is the same bytes for
     // the same inputs.

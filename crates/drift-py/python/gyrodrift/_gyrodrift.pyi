@@ -777,7 +777,7 @@ class ActivationResult:
         """The activation's labels."""
     @property
     def drift_dps(self) -> dict[str, tuple[float, float, float]]:
-        """Per model ("uncorrected", "standard", "3rd-order", "modified", "by-history"): drift per
+        """Per model ("uncorrected", "standard", "3rd-order", "relative", "modified", "by-history"): drift per
         axis, °/s —
         max − min of the 1-s low-frequency rate over the activation (the paper's metric)."""
     @property
