@@ -45,7 +45,7 @@ pub fn make(
 ) -> anyhow::Result<(PathBuf, Outcome)> {
     let (outcome, noise_units) =
         pipeline::run_with_noise_floor(files, noise_floor, options, progress)?;
-    write_outcome(outcome, &noise_units, out, provenance)
+    write_outcome(outcome, &noise_units, options, out, provenance)
 }
 
 /// [`make`] with the data split by source: fits on the calibration activations of `calibration`
@@ -61,12 +61,13 @@ pub fn make_separate(
 ) -> anyhow::Result<(PathBuf, Outcome)> {
     let (outcome, noise_units) =
         pipeline::run_separate(calibration, evaluation, noise_floor, options, progress)?;
-    write_outcome(outcome, &noise_units, out, provenance)
+    write_outcome(outcome, &noise_units, options, out, provenance)
 }
 
 fn write_outcome(
     outcome: Outcome,
     noise_units: &[String],
+    options: &Options,
     out: &Path,
     provenance: Vec<String>,
 ) -> anyhow::Result<(PathBuf, Outcome)> {
