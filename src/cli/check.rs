@@ -16,6 +16,7 @@ use drift_fit::FitSettings;
 use drift_recording::read_recording;
 
 use super::campaign_args::load_settings;
+use super::exit::LimitsMissed;
 use super::progress::Steps;
 use drift_report::write_atomic;
 
@@ -192,7 +193,7 @@ fn markdown(results: &[UnitResult], limits: &Limits) -> String {
     md
 }
 
-/// Runs `gyrodrift check`; fails with [`super::LimitsMissed`] (exit status 1) when any unit × axis
+/// Runs `gyrodrift check`; fails with [`LimitsMissed`] (exit status 1) when any unit × axis
 /// misses a limit, after writing the report; any other error (no tables, unreadable recordings,
 /// bad limits) exits with status 2.
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -240,7 +241,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         })
         .collect();
     if !failed.is_empty() {
-        return Err(super::LimitsMissed(format!(
+        return Err(LimitsMissed(format!(
             "the calibration misses the limits on {} of {} unit × axis: {}",
             failed.len(),
             3 * results.len(),

@@ -10,7 +10,23 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use drift_recording::{read_sheet_campaign, write_recording, RECORDINGS_DIR};
 
-use super::import::CampaignArgs;
+use super::reading::ReadingArgs;
+
+/// Options of `gyrodrift import campaign`.
+#[derive(Debug, clap::Args)]
+pub struct CampaignArgs {
+    /// The activation sheet (CSV: `file`, `unit`, `set_point_celsius`, `series`, `repeat`,
+    /// `activation`, `off_before_s`, `series_kind`, `switch_on_s`; optional `interval_min`,
+    /// `switch_on_ambient_celsius`). Its `file` cells are relative to its folder.
+    pub sheet: PathBuf,
+    /// Output: a new campaign folder (`recordings/<unit>_sp<set point>C_<kind>.mcap`,
+    /// `import.json`); it must not exist or be empty.
+    #[arg(long, short = 'o')]
+    pub out: PathBuf,
+    /// Column mapping, units and timing of every activation file.
+    #[command(flatten)]
+    pub reading: ReadingArgs,
+}
 
 /// The temporary folder beside `out` that becomes `out`.
 fn staging(out: &Path) -> PathBuf {

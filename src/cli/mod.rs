@@ -6,13 +6,15 @@ mod campaign_args;
 pub mod check;
 pub mod demo;
 pub mod diagnose;
+mod exit;
 mod extend;
 pub mod fit;
 pub mod import;
-mod import_campaign;
-mod import_ulog;
+pub mod import_campaign;
+pub mod import_ulog;
 mod measured;
 mod progress;
+mod reading;
 pub mod report;
 pub mod simulate;
 
@@ -21,23 +23,11 @@ pub mod simulate;
 /// output error; the message says what and where).
 pub const EXIT_CODES: &str = "Exit status: 0 done (check: every limit met); 1 check: a unit × axis misses a limit (report written); 2 usage, input or output error (the message says what and where).";
 
-/// `check` ran and a unit × axis missed a limit: exit status 1, unlike every other error (2).
-#[derive(Debug)]
-pub struct LimitsMissed(pub String);
-
-impl std::fmt::Display for LimitsMissed {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for LimitsMissed {}
-
 /// The exit status for a command's outcome: see [`EXIT_CODES`].
 pub fn exit_status(outcome: &anyhow::Result<()>) -> u8 {
     match outcome {
         Ok(()) => 0,
-        Err(error) if error.downcast_ref::<LimitsMissed>().is_some() => 1,
+        Err(error) if error.downcast_ref::<exit::LimitsMissed>().is_some() => 1,
         Err(_) => 2,
     }
 }
