@@ -37,21 +37,25 @@ fn carrying(segment: &Segment, values: [Vec<f32>; 3]) -> Segment {
 
 impl Absorber {
     /// Fits the paper's tables to the quantity `values` gives on each calibration activation.
-    /// `values` returns `None` where the quantity does not exist; such activations are left out.
+    /// `values` returns `None` where the quantity does not exist; such activations are left out,
+    /// and a quantity no calibration activation has (an empty channel) has no absorber: `None`.
     pub fn fit(
         calibration: &[&Segment],
         values: impl Fn(&Segment) -> Option<[Vec<f32>; 3]> + Sync,
         settings: &FitSettings,
         keying: &Keying,
-    ) -> Result<Self, FitError> {
+    ) -> Result<Option<Self>, FitError> {
         let analysed = calibration
             .par_iter()
             .filter_map(|segment| values(segment).map(|v| analyse(&carrying(segment, v), settings)))
             .collect::<Result<Vec<_>, _>>()?;
+        if analysed.is_empty() {
+            return Ok(None);
+        }
         let fitted = fit_unit(&analysed, settings)?;
-        Ok(Self {
+        Ok(Some(Self {
             tables: keying.tables(&fitted.modified, &fitted.by_history),
-        })
+        }))
     }
 
     /// The part of `values` (the quantity on `segment`) that the tables do not predict, computed
@@ -67,5 +71,43 @@ impl Absorber {
         keying
             .correct(&self.tables, &carrying(segment, values), switch_on)
             .0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use drift_recording::{SegmentLabels, SeriesKind};
+
+    use super::*;
+
+    /// A quantity no calibration activation carries (an empty auxiliary channel, the residual heat
+    /// without a chamber set point) has nothing to absorb: no absorber, and no error that would
+    /// stop the whole diagnosis.
+    #[test]
+    fn a_quantity_no_calibration_activation_has_gets_no_absorber() {
+        let segment = Segment {
+            labels: SegmentLabels {
+                unit_id: "U".into(),
+                set_point_celsius: 30.0,
+                session_set_point_celsius: Some(30.0),
+                series_kind: SeriesKind::Protocol,
+                series: 1,
+                repeat: 1,
+                activation: 1,
+                interval_min: Some(1.0),
+                off_before_s: None,
+            },
+            sample_rate_hz: 1000,
+            power_on_ns: 0,
+            since_power_on: vec![0],
+            rate_dps: [vec![0.0], vec![0.0], vec![0.0]],
+            temperature_raw: [vec![6000], vec![6000], vec![6000]],
+            aux: BTreeMap::new(),
+        };
+        let keying = Keying::new([false; 3], &[&segment], &[drift_core::Previous::COOLED]);
+        let absorber = Absorber::fit(&[&segment], |_| None, &FitSettings::default(), &keying);
+        assert!(matches!(absorber, Ok(None)));
     }
 }

@@ -121,9 +121,10 @@ impl Diagnoser {
             let centre = sum / n.max(1) as f64;
             (c, centre)
         });
+        // A kind no calibration activation carries (an empty channel) is not offered.
         let kinds = Kind::all(centred, has_set_point)
             .into_iter()
-            .map(|kind| {
+            .filter_map(|kind| {
                 let absorber = Absorber::fit(
                     calibration,
                     |s| {
@@ -133,8 +134,8 @@ impl Diagnoser {
                     },
                     settings,
                     &keying,
-                )?;
-                Ok((kind, absorber))
+                );
+                absorber.transpose().map(|a| a.map(|a| (kind, a)))
             })
             .collect::<Result<Vec<_>, FitError>>()?;
         Ok(Self {

@@ -752,7 +752,14 @@ pub fn extend(
                 },
                 settings,
                 keying,
-            )
+            )?
+            .ok_or_else(|| FitError::Insufficient {
+                unit: base.unit_id.clone(),
+                what: format!(
+                    "no calibration activation carries the inputs of term `{}`",
+                    plan.terms[t].candidate
+                ),
+            })
         })
         .collect::<Result<Vec<_>, _>>()?;
     let base_tables = keying.tables(&base.modified, &base.by_history);
