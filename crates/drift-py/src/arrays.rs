@@ -72,12 +72,38 @@ pub enum Rows<'py> {
     F32(PyReadonlyArray2<'py, f32>),
     /// float64: read in place, rounded to f32 per value (as `astype(np.float32)` does).
     F64(PyReadonlyArray2<'py, f64>),
+    /// int16 (raw temperature readings as recordings hold them): exact in f32.
+    I16(PyReadonlyArray2<'py, i16>),
 }
 
 impl<'py> Rows<'py> {
     /// Checks and borrows an `(n, 3)` `value`, naming it `name` in errors.
     pub fn borrow(name: &str, value: &Bound<'py, PyAny>) -> Result<Self, Error> {
         Self::borrow_columns(name, value, 3)
+    }
+
+    /// Checks and borrows `(n, 3)` raw temperatures: float32, float64, or int16 as
+    /// `Segment.temperature_raw` returns them.
+    pub fn borrow_temperatures(name: &str, value: &Bound<'py, PyAny>) -> Result<Self, Error> {
+        let Ok(array) = value.cast::<PyArray2<i16>>() else {
+            return Self::borrow_columns(name, value, 3).map_err(|_| {
+                Error::Input(format!(
+                    "`{name}` must be a float32, float64 or int16 array of shape (n, 3), got {}",
+                    describe(value)
+                ))
+            });
+        };
+        if array.shape().get(1) != Some(&3) {
+            return Err(Error::Input(format!(
+                "`{name}` must be a float32, float64 or int16 array of shape (n, 3), got {}",
+                describe(value)
+            )));
+        }
+        not_empty(name, value, array.shape().first().copied().unwrap_or(0))?;
+        array
+            .try_readonly()
+            .map(Self::I16)
+            .map_err(|error| Error::Input(format!("`{name}` cannot be borrowed: {error}")))
     }
 
     /// Checks and borrows an `(n, columns)` `value`, naming it `name` in errors.
@@ -118,6 +144,7 @@ impl<'py> Rows<'py> {
         match self {
             Self::F32(array) => RowsView::F32(array.as_array()),
             Self::F64(array) => RowsView::F64(array.as_array()),
+            Self::I16(array) => RowsView::I16(array.as_array()),
         }
     }
 }
@@ -128,6 +155,8 @@ pub enum RowsView<'a> {
     F32(ArrayView2<'a, f32>),
     /// float64 rows.
     F64(ArrayView2<'a, f64>),
+    /// int16 rows (raw temperatures).
+    I16(ArrayView2<'a, i16>),
 }
 
 impl RowsView<'_> {
@@ -136,6 +165,7 @@ impl RowsView<'_> {
         match self {
             Self::F32(view) => view.shape(),
             Self::F64(view) => view.shape(),
+            Self::I16(view) => view.shape(),
         }
     }
 
@@ -153,6 +183,7 @@ impl RowsView<'_> {
         match self {
             Self::F32(view) => copy_rows(view, start, out),
             Self::F64(view) => copy_rows(view, start, out),
+            Self::I16(view) => copy_rows(view, start, out),
         }
     }
 }
@@ -165,6 +196,12 @@ trait AsF32: Copy {
 impl AsF32 for f32 {
     fn as_f32(self) -> f32 {
         self
+    }
+}
+
+impl AsF32 for i16 {
+    fn as_f32(self) -> f32 {
+        f32::from(self)
     }
 }
 
@@ -307,6 +344,7 @@ impl RowsView<'_> {
         match self {
             Self::F32(view) => find(view),
             Self::F64(view) => find(view),
+            Self::I16(_) => None,
         }
     }
 
@@ -315,6 +353,7 @@ impl RowsView<'_> {
         match self {
             Self::F32(view) => view.column(axis).to_vec(),
             Self::F64(view) => view.column(axis).iter().map(|v| v.as_f32()).collect(),
+            Self::I16(view) => view.column(axis).iter().map(|v| v.as_f32()).collect(),
         }
     }
 }
@@ -359,12 +398,13 @@ fn finite_1d<T: Copy + Into<f64> + std::fmt::Display>(
     from_f32: impl Fn(f32) -> T,
     from_f64: impl Fn(f64) -> T,
 ) -> Result<Vec<T>, Error> {
+    // Any layout: a column of a 2-D array or a strided view is copied through its strides.
     let values: Vec<T> = if let Ok(array) = value.cast::<PyArray1<f32>>() {
-        let values = array.to_vec().map_err(|e| borrow_error(name, e))?;
-        values.into_iter().map(from_f32).collect()
+        let view = array.try_readonly().map_err(|e| borrow_error(name, e))?;
+        view.as_array().iter().copied().map(from_f32).collect()
     } else if let Ok(array) = value.cast::<PyArray1<f64>>() {
-        let values = array.to_vec().map_err(|e| borrow_error(name, e))?;
-        values.into_iter().map(from_f64).collect()
+        let view = array.try_readonly().map_err(|e| borrow_error(name, e))?;
+        view.as_array().iter().copied().map(from_f64).collect()
     } else {
         return Err(Error::Input(format!(
             "`{name}` must be a float32 or float64 array of shape (n,), got {}",

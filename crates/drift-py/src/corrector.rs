@@ -441,7 +441,7 @@ impl PyCorrector {
     ) -> Result<BatchArrays<'py>, Error> {
         let times_array = times("since_power_on_ms", since_power_on_ms)?;
         let rates = Rows::borrow("rate_dps", rate_dps)?;
-        let temperatures = Rows::borrow("temperature_raw", temperature_raw)?;
+        let temperatures = Rows::borrow_temperatures("temperature_raw", temperature_raw)?;
         let aux = match aux {
             Some(aux) if !aux.is_none() => Some(Rows::borrow_columns("aux", aux, AUX_INPUTS)?),
             _ => None,

@@ -96,12 +96,12 @@ def test_hierarchy() -> None:
         (
             "temperature_raw",
             np.zeros((N, 3, 1), dtype=np.float32),
-            "`temperature_raw` must be a float32 or float64 array of shape (n, 3), got float32 array of shape (5, 3, 1)",
+            "`temperature_raw` must be a float32, float64 or int16 array of shape (n, 3), got float32 array of shape (5, 3, 1)",
         ),
         (
             "temperature_raw",
             np.zeros((N, 3), dtype=np.complex64),
-            "`temperature_raw` must be a float32 or float64 array of shape (n, 3), got complex64 array of shape (5, 3)",
+            "`temperature_raw` must be a float32, float64 or int16 array of shape (n, 3), got complex64 array of shape (5, 3)",
         ),
         (
             "since_power_on_ms",

@@ -132,6 +132,28 @@ def test_in_memory_segments_feed_the_corrector(campaign_dir: Path) -> None:
     )
     assert corrected.shape == segment.rate_dps.shape
     assert not (flags & gyrodrift.Flags.faults().value).any()
+    # The segment's own int16 temperatures go in as they are, with the same result.
+    corrector.power_on(segment.temperature_raw[:20].mean(axis=0))
+    from_int16, _, _ = corrector.correct_batch(
+        segment.since_power_on_ms, segment.rate_dps, segment.temperature_raw
+    )
+    assert np.array_equal(from_int16, corrected)
+
+
+def test_an_auxiliary_channel_may_be_any_numpy_view() -> None:
+    """A column of a 2-D table or a strided slice is copied, not refused as non-contiguous."""
+    table = np.random.default_rng(3).normal(3.3, 0.01, (200, 4))
+    column = table[:, 1]
+    assert not column.flags.c_contiguous
+    labels = gyrodrift.Labels(unit_id="U", set_point_celsius=30.0)
+    segment = gyrodrift.Segment(
+        labels,
+        np.zeros((2000, 3), dtype=np.float32),
+        np.zeros((2000, 3), dtype=np.int16),
+        aux={"supply": (column, "V", 100), "every_other": (table[::-1, 0], "V", 100)},
+    )
+    assert np.array_equal(segment.aux["supply"].values, column.astype(np.float32))
+    assert np.array_equal(segment.aux["every_other"].values, table[::-1, 0].astype(np.float32))
 
 
 def test_ramped_field_labels_give_the_sessions_nominal_set_point(tmp_path: Path) -> None:

@@ -442,7 +442,7 @@ class Corrector:
         self,
         since_power_on_ms: NDArray[np.uint32],
         rate_dps: NDArray[np.float32] | NDArray[np.float64],
-        temperature_raw: NDArray[np.float32] | NDArray[np.float64],
+        temperature_raw: NDArray[np.float32] | NDArray[np.float64] | NDArray[np.int16],
         *,
         aux: NDArray[np.float32] | NDArray[np.float64] | None = None,
         out: tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.uint16]] | None = None,
@@ -450,8 +450,9 @@ class Corrector:
         """Corrects n samples in order, continuing the current activation.
 
         Arguments: `since_power_on_ms` uint32 (n,); `rate_dps` and `temperature_raw` float32 or
-        float64 (n, 3); `aux` None or float32 or float64 (n, AUX_INPUTS), each sample's auxiliary
-        inputs as in `correct`. Any strides (read in place, not copied; float64 is rounded to f32
+        float64 (n, 3), `temperature_raw` also int16 as `Segment.temperature_raw` returns it;
+        `aux` None or float32 or float64 (n, AUX_INPUTS), each sample's auxiliary inputs as in
+        `correct`. Any strides (read in place, not copied; float64 is rounded to f32
         per value). Returns `(corrected_dps, bias_dps, flags)`: float32, float32 and uint16
         arrays of shape (n, 3) — new arrays, or the arrays given as `out` (C-contiguous,
         writeable, none of them an input), filled in place, which saves allocating for every
