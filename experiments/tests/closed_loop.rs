@@ -1,10 +1,9 @@
 //! The closed loop on data with an undeclared effect, end to end: a supply-voltage sensitivity the
 //! fitter is never told about is found by the diagnosis on field-like activations at the
 //! calibration set points, admitted by the guard, and cuts the error on +33 °C field activations
-//! nothing was fitted or chosen on; without a hidden effect nothing is significant, and the loop
-//! changes the paper's model only by reading the heating history (stage 3, the initial bias) and
-//! by the element's heating rate (offered on every unit) where the training activations chose
-//! them; a hidden thermal lag is closed by the warm starts' initial bias, and its rate, started
+//! nothing was fitted or chosen on; without a hidden effect only the physical unit's own element
+//! lag is found (a rate or rise², never a channel) and nothing the loop changes costs held-out
+//! error; a hidden thermal lag is closed by the warm starts' initial bias, and its rate, started
 //! where the unit is at switch-on, is what the paper's model lacks most; and a unit the paper's
 //! model represents exactly leaves the loop nothing to find or add.
 //! (experiments/README.md has the full table over every effect and many seeds.)
@@ -13,8 +12,8 @@ use drift_fit::FitSettings;
 use drift_sim::UnitModel;
 use experiments::closed_loop::{run, Plan, Row};
 
-/// Whether every admitted term is a temperature rate (the element's or the sensor's), the one term
-/// offered on every unit whether or not the diagnosis found anything.
+/// Whether every admitted term is a temperature rate (the element's or the sensor's): what the
+/// physical unit's element lag calls for.
 fn only_the_element_rate(r: &Row) -> bool {
     r.admitted.iter().all(|t| {
         t.starts_with("element rate (own axis") || t.starts_with("temperature rate (own axis")
@@ -69,10 +68,21 @@ fn a_hidden_supply_sensitivity_is_found_admitted_and_cuts_the_validation_error()
 }
 
 #[test]
-fn without_a_hidden_effect_nothing_is_significant_and_no_term_but_the_element_rate() {
+fn without_a_hidden_effect_only_the_element_lag_is_found_and_nothing_gets_worse() {
+    // The physical unit's sensing element lags its temperature sensor: a gap of the paper's model
+    // on every such unit, which the shuffle test may find (a rate, own or a neighbour's, or
+    // rise²). Nothing else is significant — no channel — and whatever the loop changes does not
+    // cost held-out drift or RMS beyond noise.
     let rows = rows("none", 3);
+    let thermal_shape = |name: &str| {
+        drift_diagnose::candidates::Kind::rate_time_constant_s(name).is_some()
+            || name.starts_with("rise²")
+            || name.starts_with("element rate")
+            || name.starts_with("temperature rate")
+    };
     for r in &rows {
-        assert!(only_the_element_rate(r) && !r.significant, "{r:#?}");
+        assert!(!r.significant || thermal_shape(&r.top), "{r:#?}");
+        assert!(r.admitted.iter().all(|t| thermal_shape(t)), "{r:#?}");
         if r.history_chosen || r.warm_start_chosen || !r.admitted.is_empty() {
             // Chosen on the training activations; on the held-out field ones it is measured, and
             // it must not cost drift (the paper's metric, °/s) or RMS beyond noise.
