@@ -429,13 +429,15 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
 }
 
 /// Scores every candidate on one axis of `activations` with `folds`-fold cross-validation by
-/// activation; `alpha` is the family-wise significance level for the axis.
+/// series ([`series_folds`]); `alpha` is the family-wise significance level for the axis, held by
+/// the shuffle test ([`crate::permutation`]).
 ///
 /// Each candidate is scored at two levels, because effects show in two ways: **within**
 /// activations (residual and candidate less their activation means: the shape that the drift
 /// metric sees, e.g. a temperature-rate term) and **between** activations (one point per activation,
 /// the means: offsets that change from one switch-on to the next, e.g. supply voltage or
-/// orientation). The better level is reported; Bonferroni covers both levels of every candidate.
+/// orientation). The better level is reported; the shuffles' winners are the best of both levels
+/// of every candidate, so the test covers both.
 pub fn diagnose_axis(
     activations: &[ActivationSeries],
     axis: usize,
@@ -461,9 +463,13 @@ pub fn diagnose_axis(
     )
     .sqrt();
     let (fold_of, folds) = series_folds(activations, folds);
+    let absorbed: BTreeMap<&String, f64> = names
+        .iter()
+        .map(|n| (n, absorbed_share(activations, axis, n)))
+        .collect();
     let scored_names: Vec<String> = names
         .iter()
-        .filter(|n| absorbed_share(activations, axis, n) <= ABSORBED)
+        .filter(|n| absorbed.get(n).is_some_and(|&a| a <= ABSORBED))
         .cloned()
         .collect();
     let residuals: Vec<&[f64]> = activations
@@ -487,7 +493,7 @@ pub fn diagnose_axis(
     let mut ranking: Vec<CandidateScore> = names
         .iter()
         .map(|name| {
-            let absorbed = absorbed_share(activations, axis, name);
+            let absorbed = absorbed.get(name).copied().unwrap_or(1.0);
             let mut candidate = CandidateScore {
                 name: name.clone(),
                 explained: 0.0,
