@@ -193,7 +193,7 @@ fn markdown(results: &[UnitResult], limits: &Limits) -> String {
     md
 }
 
-/// Runs `gyrodrift check`; fails with [`LimitsMissed`] (exit status 1) when any unit × axis
+/// Runs `gyrodrift check`; fails with `LimitsMissed` (exit status 1) when any unit × axis
 /// misses a limit, after writing the report; any other error (no tables, unreadable recordings,
 /// bad limits) exits with status 2.
 pub fn run(args: &Args) -> anyhow::Result<()> {
