@@ -86,11 +86,24 @@ impl<'py> Rows<'py> {
     /// `Segment.temperature_raw` returns them.
     pub fn borrow_temperatures(name: &str, value: &Bound<'py, PyAny>) -> Result<Self, Error> {
         let Ok(array) = value.cast::<PyArray2<i16>>() else {
-            return Self::borrow_columns(name, value, 3).map_err(|_| {
-                Error::Input(format!(
-                    "`{name}` must be a float32, float64 or int16 array of shape (n, 3), got {}",
-                    describe(value)
-                ))
+            // A float array of the right shape keeps its own error (empty, not borrowable); any
+            // other value is told every dtype it may have.
+            let columns = |shape: &[usize]| shape.get(1) == Some(&3);
+            let float_rows = value
+                .cast::<PyArray2<f32>>()
+                .is_ok_and(|a| columns(a.shape()))
+                || value
+                    .cast::<PyArray2<f64>>()
+                    .is_ok_and(|a| columns(a.shape()));
+            return Self::borrow_columns(name, value, 3).map_err(|error| {
+                if float_rows {
+                    error
+                } else {
+                    Error::Input(format!(
+                        "`{name}` must be a float32, float64 or int16 array of shape (n, 3), got {}",
+                        describe(value)
+                    ))
+                }
             });
         };
         if array.shape().get(1) != Some(&3) {

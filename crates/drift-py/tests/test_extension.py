@@ -203,7 +203,8 @@ def test_with_extension_rejects_what_is_not_a_list_of_terms(
         (
             ("humidity", 1),
             {},
-            "`kind` must be one of 'temperature_rate', 'aux', 'axis_rise', 'rise_squared', got \"humidity\"",
+            "`kind` must be one of 'temperature_rate', 'aux', 'axis_rise', 'rise_squared', "
+            "'aux_times_rise', got \"humidity\"",
         ),
         ((3, 1), {}, "`kind` must be a str, got int"),
         (("aux",), {}, "`parameter` is required for kind 'aux' (the auxiliary input's index), got None"),
@@ -229,8 +230,8 @@ def test_with_extension_rejects_what_is_not_a_list_of_terms(
         (
             ("temperature_rate", 2000),
             {"time_constant_ms": 2000},
-            "`time_constant_ms` is only for kind 'aux' (a rate term's time constant is its "
-            '`parameter`), got 2000 for kind "temperature_rate"',
+            "`time_constant_ms` is only for kinds 'aux' and 'aux_times_rise' (a rate term's time "
+            'constant is its `parameter`), got 2000 for kind "temperature_rate"',
         ),
         (
             ("aux", 0),

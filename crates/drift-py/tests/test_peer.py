@@ -148,7 +148,9 @@ def test_fit_matches_rust(campaign_dir: Path) -> None:
     (got,) = peer.fit(peer.Activation.of(s) for s in segments)
     assert got.unit_id == want.unit_id
     assert got.curve_names == want.curve_names
-    assert got.notes == want.notes
+    # The peer implements the paper's model and the absolute baselines; the relative baseline's
+    # note (its orders) is ours alone.
+    assert got.notes == [n for n in want.notes if not n.startswith("relative baseline")]
     assert_tables_match(got.modified, json.loads(want.modified.to_json()))
     assert_tables_match(got.standard, json.loads(want.standard.to_json()))
     assert_tables_match(got.third_order, json.loads(want.third_order.to_json()))
