@@ -22,7 +22,14 @@ def test_records_cover_every_split_model_and_axis(evaluation: gyrodrift.Evaluati
         ("held_out_repeat", 40.0),
         ("validation", 33.0),
     }
-    assert {r["model"] for r in records} == {"uncorrected", "standard", "3rd-order", "relative", "modified", "by-history"}
+    assert {r["model"] for r in records} == {
+        "uncorrected",
+        "standard",
+        "3rd-order",
+        "relative",
+        "modified",
+        "by-history",
+    }
     assert {r["axis"] for r in records} == {"X", "Y", "Z"}
     assert len(evaluation.fitted) == 1 and len(evaluation.calibration) == 24
     assert len(evaluation.results) == 36  # 12 activations per set point
@@ -45,7 +52,14 @@ def test_per_activation_evaluation_and_summarise_agree(
     validation = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0"))
     results = unit.evaluate_series(validation.segments)
     assert {r.split for r in results} == {"validation"}
-    assert set(results[0].drift_dps) == {"uncorrected", "standard", "3rd-order", "relative", "modified", "by-history"}
+    assert set(results[0].drift_dps) == {
+        "uncorrected",
+        "standard",
+        "3rd-order",
+        "relative",
+        "modified",
+        "by-history",
+    }
     expected = [r for r in evaluation.records if r["split"] == "validation"]
     assert gyrodrift.summarise(results) == expected
 
