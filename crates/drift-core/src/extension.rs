@@ -362,21 +362,17 @@ impl ExtensionState {
                 Term::Aux {
                     input,
                     time_constant_ms,
-                } => {
-                    let input = shared(&inputs.aux, input);
-                    let tau_ms = time_constant_ms.min(previous_ms);
-                    aux_value(held, term, input, tau_ms, elapsed_ms).0
                 }
-                Term::AxisRise { axis } => [shared(&inputs.rise_celsius, axis); AXES],
-                Term::RiseSquared => inputs.rise_celsius.map(|rise| rise * rise),
-                Term::AuxTimesRise {
+                | Term::AuxTimesRise {
                     input,
                     time_constant_ms,
                 } => {
                     let input = shared(&inputs.aux, input);
                     let tau_ms = time_constant_ms.min(previous_ms);
-                    aux_times_rise(held, term, input, tau_ms, elapsed_ms, &inputs.rise_celsius).0
+                    aux_value(held, term, input, tau_ms, elapsed_ms, &inputs.rise_celsius).0
                 }
+                Term::AxisRise { axis } => [shared(&inputs.rise_celsius, axis); AXES],
+                Term::RiseSquared => inputs.rise_celsius.map(|rise| rise * rise),
             };
             for ((axis_values, raw), centre) in values.iter_mut().zip(raw).zip(term.centre) {
                 if let Some(value) = axis_values.get_mut(t) {
@@ -432,12 +428,15 @@ impl ExtensionState {
                     time_constant_ms,
                 } => {
                     let tau_ms = time_constant_ms.min(previous_ms);
-                    let (mut value, ok) =
-                        aux_value(held, term, shared(aux, input), tau_ms, elapsed_ms);
+                    let (value, ok) = aux_value(
+                        held,
+                        term,
+                        shared(aux, input),
+                        tau_ms,
+                        elapsed_ms,
+                        rise_celsius,
+                    );
                     inputs_ok &= ok;
-                    if matches!(term.term, Term::AuxTimesRise { .. }) && !held.is_nan() {
-                        value = rise_celsius.map(|rise| *held * rise);
-                    }
                     add(value);
                 }
                 Term::AxisRise { axis } => add([shared(rise_celsius, axis); AXES]),
@@ -488,7 +487,8 @@ fn step_rates(
 /// and whether the input was finite. The filter is the backward Euler step of the first-order
 /// low-pass `f' = (u − f)/τ`: `f ← u + (f − u) · τ/(τ + Δt)` (τ = 0: `f ← u`); it starts at the
 /// first finite input and holds through non-finite ones. Before any, the value is the term's
-/// centre (the term adds 0). The callers pass `τ = min(τ_term, t_previous)`, the previous
+/// centre (the term adds 0). [`Term::AuxTimesRise`] multiplies the filtered input by each axis's
+/// `rise_celsius`. The callers pass `τ = min(τ_term, t_previous)`, the previous
 /// sample's time since switch-on: until `τ_term` has passed, the filter is the time-weighted mean
 /// of the inputs so far, so the first reading's noise does not linger for `τ`.
 #[inline(always)]
@@ -498,6 +498,7 @@ fn aux_value(
     input: f32,
     tau_ms: u32,
     elapsed_ms: u32,
+    rise_celsius: &[f32; AXES],
 ) -> ([f32; AXES], bool) {
     let ok = input.is_finite();
     if ok {
@@ -511,29 +512,10 @@ fn aux_value(
     let value = *held;
     let values = if value.is_nan() {
         term.centre
+    } else if matches!(term.term, Term::AuxTimesRise { .. }) {
+        rise_celsius.map(|rise| value * rise)
     } else {
         [value; AXES]
-    };
-    (values, ok)
-}
-
-/// [`Term::AuxTimesRise`]'s value for every axis: the input filtered as [`aux_value`] does, times
-/// each axis's rise; the term's centre (it adds 0) before the first finite input.
-#[inline(always)]
-fn aux_times_rise(
-    held: &mut f32,
-    term: &ExtraTerm,
-    input: f32,
-    tau_ms: u32,
-    elapsed_ms: u32,
-    rise_celsius: &[f32; AXES],
-) -> ([f32; AXES], bool) {
-    let (_, ok) = aux_value(held, term, input, tau_ms, elapsed_ms);
-    let filtered = *held;
-    let values = if filtered.is_nan() {
-        term.centre
-    } else {
-        rise_celsius.map(|rise| filtered * rise)
     };
     (values, ok)
 }

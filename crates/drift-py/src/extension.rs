@@ -61,38 +61,33 @@ fn term(
                 parameter,
             )?,
         },
-        "aux" => Term::Aux {
-            input: required(
+        "aux" | "aux_times_rise" => {
+            let input = required(
                 kind,
                 "the auxiliary input's index",
                 "an integer in 0..=255 (an auxiliary input's index)",
                 parameter,
-            )?,
-            time_constant_ms: match time_constant_ms {
+            )?;
+            let time_constant_ms = match time_constant_ms {
                 Some(value) => args::value(
                     "time_constant_ms",
                     "an integer in 0..=4294967295 (ms)",
                     value,
                 )?,
                 None => 0,
-            },
-        },
-        "aux_times_rise" => Term::AuxTimesRise {
-            input: required(
-                kind,
-                "the auxiliary input's index",
-                "an integer in 0..=255 (an auxiliary input's index)",
-                parameter,
-            )?,
-            time_constant_ms: match time_constant_ms {
-                Some(value) => args::value(
-                    "time_constant_ms",
-                    "an integer in 0..=4294967295 (ms)",
-                    value,
-                )?,
-                None => 0,
-            },
-        },
+            };
+            if kind == "aux" {
+                Term::Aux {
+                    input,
+                    time_constant_ms,
+                }
+            } else {
+                Term::AuxTimesRise {
+                    input,
+                    time_constant_ms,
+                }
+            }
+        }
         "axis_rise" => Term::AxisRise {
             axis: required(
                 kind,
