@@ -215,7 +215,6 @@ pub struct Ranked {
     /// Significant (family-wise by shuffling, `drift_diagnose::permutation`).
     pub significant: bool,
     /// Its family-wise p-value.
-    #[serde(default)]
     pub family_p_value: f64,
     /// Out-of-sample share of the residual's variance it explains.
     pub explained: f64,
@@ -237,7 +236,6 @@ pub struct AxisOutcome {
     /// Whether any candidate on the axis is significant.
     pub any_significant: bool,
     /// The explained share a candidate had to exceed to be significant on this axis.
-    #[serde(default)]
     pub detectable_share: f64,
     /// Terms the guard admitted on the axis.
     pub admitted: Vec<String>,
