@@ -2,14 +2,17 @@
 //!
 //! ```text
 //! b(t) = b₀ + j_k                                     offset + turn-on jitter of activation k
-//!      + s_age(t) · [ c₁ ΔT + c₂ ΔT² + c_p (p/p_ref − 1) ]    systematic thermal drift
+//!      + s_age(t) · [ c₁ ΔT_s + c₂ ΔT_s² + c_p (p/p_ref − 1) ]  systematic thermal drift
 //!      + (hidden effects)                              rate term, g-sensitivity, supply, ageing creep
 //!      + β(t) + w(t)                                    bias instability (Gauss–Markov) + white noise
-//! ΔT = T_e − 25 °C,   p/p_ref = (T_e + 273.15) / (25 + 273.15)   (sealed capsule: isochoric gas)
+//! ΔT_s = (1 − w) T_e + w T_c − 25 °C                   the structure's temperature: element and capsule
+//! p/p_ref = (T_c + 273.15) / (25 + 273.15)             sealed capsule: isochoric gas at the capsule's T
 //! ```
 //!
 //! `T_e` is the element temperature, not the sensor's: the sensor sits on the ASIC and the
-//! element lags it, which is what makes the drift/rise ratio depend on heating history.
+//! element lags it, which is what makes the drift/rise ratio depend on heating history. The
+//! capsule `T_c` lags the element again, so the bias is not a function of any one temperature
+//! the unit can measure: no table of the sensor's temperature represents it exactly.
 
 use crate::unit::{AxisParams, NOMINAL_SUPPLY_V, REFERENCE_CELSIUS};
 
@@ -21,6 +24,8 @@ pub const SECONDS_PER_DAY: f64 = 86_400.0;
 pub struct BiasInputs {
     /// Element temperature (°C).
     pub element_c: f64,
+    /// Capsule (glass and gas) temperature (°C).
+    pub capsule_c: f64,
     /// Element heating rate (°C/s); used only by the hidden thermal-lag term.
     pub element_rate_c_per_s: f64,
     /// True specific force in the body frame (g); used only by the hidden g-sensitivity.
@@ -31,11 +36,11 @@ pub struct BiasInputs {
     pub campaign_s: f64,
 }
 
-/// Capsule gas pressure relative to its value at 25 °C, for gas at the element temperature.
-pub fn relative_pressure(element_c: f64) -> f64 {
+/// Capsule gas pressure relative to its value at 25 °C, for gas at `gas_c`.
+pub fn relative_pressure(gas_c: f64) -> f64 {
     // Multiplying by the constant's inverse keeps a division out of the per-sample loop.
     const INV_REFERENCE_KELVIN: f64 = 1.0 / (REFERENCE_CELSIUS + 273.15);
-    (element_c + 273.15) * INV_REFERENCE_KELVIN
+    (gas_c + 273.15) * INV_REFERENCE_KELVIN
 }
 
 /// The noise-free bias of one axis (°/s), without the turn-on jitter.
@@ -43,10 +48,11 @@ pub fn relative_pressure(element_c: f64) -> f64 {
 pub fn systematic_dps(axis: &AxisParams, x: &BiasInputs) -> f64 {
     const DAYS_PER_SECOND: f64 = 1.0 / SECONDS_PER_DAY;
     let days = x.campaign_s * DAYS_PER_SECOND;
-    let dt = x.element_c - REFERENCE_CELSIUS;
+    let structure_c = x.element_c + axis.capsule_weight * (x.capsule_c - x.element_c);
+    let dt = structure_c - REFERENCE_CELSIUS;
     let thermal = axis.tempco_dps_per_c * dt
         + axis.tempco2_dps_per_c2 * dt * dt
-        + axis.pressure_dps * (relative_pressure(x.element_c) - 1.0);
+        + axis.pressure_dps * (relative_pressure(x.capsule_c) - 1.0);
     let ageing_scale = 1.0 + axis.ageing_tempco_per_day * days;
     let accel: f64 = axis
         .accel_dps_per_g

@@ -74,6 +74,11 @@ pub struct Protocol {
     pub rest_min: f64,
     /// Per-activation, per-axis 1σ relative scatter of the ASIC heating power.
     pub heating_scatter: f64,
+    /// Amplitude of the chamber's regulation cycle around the set point (°C): the air a real
+    /// chamber holds is not constant. Scaled by `noise_scale`.
+    pub chamber_ripple_c: f64,
+    /// Period range of the chamber's regulation cycle (min), drawn per recording, uniform.
+    pub chamber_period_min: [f64; 2],
 }
 
 impl Default for Protocol {
@@ -85,6 +90,9 @@ impl Default for Protocol {
             repeats: 3,
             rest_min: 60.0,
             heating_scatter: 0.005,
+            // Temperature chambers hold ±0.1–0.5 °C; compressor cycles take minutes.
+            chamber_ripple_c: 0.2,
+            chamber_period_min: [5.0, 20.0],
         }
     }
 }
@@ -264,6 +272,20 @@ impl Campaign {
             check_duration("protocol.activation_s", p.activation_s)?;
             check_nonneg("protocol.rest_min", p.rest_min)?;
             check_fraction("protocol.heating_scatter", p.heating_scatter)?;
+            check_nonneg("protocol.chamber_ripple_c", p.chamber_ripple_c)?;
+            if p.chamber_ripple_c > 10.0 {
+                return Err(bad(
+                    "protocol.chamber_ripple_c",
+                    &format!("must be ≤ 10 °C, got {}", p.chamber_ripple_c),
+                ));
+            }
+            check_ordered("protocol.chamber_period_min", p.chamber_period_min)?;
+            if !(p.chamber_period_min[0] > 0.0) {
+                return Err(bad(
+                    "protocol.chamber_period_min",
+                    &format!("must be > 0 min, got {:?}", p.chamber_period_min),
+                ));
+            }
             // A recording's clock is u64 ns, and the reader refuses one that wraps: a set point's
             // file holds every series, so all of them must fit it.
             let series_s: f64 = p

@@ -8,13 +8,13 @@ use crate::error::SimError;
 use crate::faults::{FaultEvent, Injector, FAULTS_METADATA};
 use crate::rng;
 use crate::schedule::{ActivationPlan, FilePlan};
-use crate::thermal::network::{asic, element, NODES};
+use crate::thermal::network::{asic, capsule, element, NODES};
 use crate::thermal::rc::{Discrete, RcNetwork};
 use crate::unit::{UnitModel, UnitParams, NOMINAL_SUPPLY_V, REFERENCE_CELSIUS};
 use crate::world::runtime::{AuxActivation, Inputs, Runtime};
 use drift_recording::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use drift_recording::writer::McapFile;
-use drift_recording::{AUX_RATE_HZ, RAW_PER_CELSIUS};
+use drift_recording::{SeriesKind, AUX_RATE_HZ, RAW_PER_CELSIUS};
 use rand::rngs::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use std::collections::BTreeMap;
@@ -333,6 +333,13 @@ impl FileSim<'_> {
     }
 
     fn event(&self, act: &ActivationPlan, powered: bool, ambient_c: f64) -> PowerEvent {
+        // A chamber bench logs its set point, not the air's regulation cycle around it; in the
+        // field the label is the ambient the user saw.
+        let labelled_c = if self.plan.kind == SeriesKind::Protocol {
+            self.plan.set_point_c
+        } else {
+            ambient_c
+        };
         PowerEvent {
             powered,
             series_kind: self.plan.kind.as_str().to_owned(),
@@ -341,7 +348,7 @@ impl FileSim<'_> {
             activation: act.activation,
             interval_min: act.interval_min.unwrap_or(f64::NAN),
             off_before_s: act.off_before_ms as f64 / 1000.0,
-            set_point_celsius: ambient_c,
+            set_point_celsius: labelled_c,
         }
     }
 
@@ -397,11 +404,22 @@ impl FileSim<'_> {
                 element(a)
             }
         };
+        let capsule_site = |a: usize| {
+            if sensor_site {
+                asic(a)
+            } else {
+                capsule(a)
+            }
+        };
         let lag_on = unit
             .axes
             .iter()
             .any(|a| a.thermal_lag_dps_per_c_per_s != 0.0);
         let nonlinear = unit.asic_power_per_c != 0.0;
+        // The chamber channel logs what the chamber was told: a bench's set point, not the
+        // regulation cycle of its air; in the field, the ramps the environment went through.
+        let protocol_bench = self.plan.kind == SeriesKind::Protocol;
+        let set_point_c = self.plan.set_point_c as f32;
         let every_sample_truth = c.truth_bias == TruthBias::EverySample;
         let ramp = act.ambient_ramp_c_per_s;
         let days_base_s = on_ms as f64 / 1000.0;
@@ -501,16 +519,22 @@ impl FileSim<'_> {
                 }
                 buf.supply
                     .push((act.supply_v + SUPPLY_NOISE_V * noise * normal(r)) as f32);
-                buf.set_point.push(ambient as f32);
+                buf.set_point.push(if protocol_bench {
+                    set_point_c
+                } else {
+                    ambient as f32
+                });
             }
             let frac = f64::from(phase) / f64::from(aux_every);
             for a in 0..3 {
                 let axis = &unit.axes[a];
-                let (e, s) = (biasing(a), asic(a));
+                let (e, s, k) = (biasing(a), asic(a), capsule_site(a));
                 let element_c = x[e] + frac * (next[e] - x[e]);
+                let capsule_c = x[k] + frac * (next[k] - x[k]);
                 let asic_c = x[s] + frac * (next[s] - x[s]);
                 let inputs = BiasInputs {
                     element_c,
+                    capsule_c,
                     // The exact mean heating rate over the grid step.
                     element_rate_c_per_s: if lag_on {
                         (next[e] - x[e]) / grid_s

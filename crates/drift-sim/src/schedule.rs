@@ -141,6 +141,9 @@ fn protocol(p: &Protocol, sp: f64, c: &Campaign, r: &mut ChaCha8Rng) -> Vec<Acti
     let mut out = Vec::new();
     let mut series = 0;
     let samples = samples_for(p.activation_s, c.sample_rate_hz);
+    let activation_s = f64::from(samples) / f64::from(c.sample_rate_hz);
+    let chamber = ChamberCycle::draw(p, c.noise_scale, r);
+    let mut clock_s = 0.0;
     for &interval in &p.intervals_min {
         for repeat in 1..=p.repeats {
             series += 1;
@@ -150,15 +153,23 @@ fn protocol(p: &Protocol, sp: f64, c: &Campaign, r: &mut ChaCha8Rng) -> Vec<Acti
                 } else {
                     interval
                 };
+                let off_s = off * 60.0;
+                // The off-time holds the air at its mid-off value (the exact cooling solution
+                // needs it constant); while powered it follows the cycle's chord.
+                let ambient_off = sp + chamber.at(clock_s + 0.5 * off_s);
+                clock_s += off_s;
+                let ambient_on = sp + chamber.at(clock_s);
+                let ambient_end = sp + chamber.at(clock_s + activation_s);
+                clock_s += activation_s;
                 out.push(ActivationPlan {
                     series,
                     repeat,
                     activation,
                     interval_min: Some(interval),
                     off_before_ms: minutes_to_ms(off),
-                    ambient_off_c: sp,
-                    ambient_on_c: sp,
-                    ambient_ramp_c_per_s: 0.0,
+                    ambient_off_c: ambient_off,
+                    ambient_on_c: ambient_on,
+                    ambient_ramp_c_per_s: (ambient_end - ambient_on) / activation_s,
                     samples,
                     supply_v: NOMINAL_SUPPLY_V,
                     gravity_body: Z_UP,
@@ -168,6 +179,30 @@ fn protocol(p: &Protocol, sp: f64, c: &Campaign, r: &mut ChaCha8Rng) -> Vec<Acti
         }
     }
     out
+}
+
+/// A chamber's regulation cycle around its set point: a sinusoid of drawn period and phase.
+struct ChamberCycle {
+    amplitude_c: f64,
+    radians_per_s: f64,
+    phase: f64,
+}
+
+impl ChamberCycle {
+    fn draw(p: &Protocol, noise_scale: f64, r: &mut ChaCha8Rng) -> Self {
+        let [low, high] = p.chamber_period_min;
+        let period_s = 60.0 * (low + (high - low) * r.random::<f64>());
+        Self {
+            amplitude_c: p.chamber_ripple_c * noise_scale,
+            radians_per_s: std::f64::consts::TAU / period_s,
+            phase: std::f64::consts::TAU * r.random::<f64>(),
+        }
+    }
+
+    /// Deviation from the set point (°C) at `t_s` into the recording.
+    fn at(&self, t_s: f64) -> f64 {
+        self.amplitude_c * (self.radians_per_s * t_s + self.phase).sin()
+    }
 }
 
 /// The six faces plus a small tilt: how a unit ends up when put down by hand.

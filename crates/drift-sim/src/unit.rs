@@ -44,8 +44,12 @@ pub struct AxisParams {
     pub tempco_dps_per_c: f64,
     /// Quadratic coefficient ((°/s)/°C²): makes the slope depend on the ambient.
     pub tempco2_dps_per_c2: f64,
-    /// Bias per relative change of capsule gas pressure ((°/s) per unit p/p_ref).
+    /// Bias per relative change of capsule gas pressure ((°/s) per unit p/p_ref); the gas is at
+    /// the capsule's temperature.
     pub pressure_dps: f64,
+    /// Share of the temperature coefficients that follows the capsule rather than the element
+    /// (packaging stress: the die is held by its capsule, which heats later).
+    pub capsule_weight: f64,
     /// Turn-on to turn-on repeatability of the bias, 1σ (°/s).
     pub turn_on_sigma_dps: f64,
     /// White rate noise density (angle random walk), (°/s)/√Hz.
@@ -123,6 +127,10 @@ pub const RANGES: &[(&str, f64, f64, &str)] = &[
     ("temperature_offset_c (uniform ±)", 0.0, 1.0, "°C"),
     ("temperature_noise_raw", 0.5, 1.5, "raw"),
     ("accel bias_g (uniform ±)", 0.0, 0.005, "g"),
+    ("capsule_j_per_k", 0.3, 0.6, "J/K"),
+    ("element_to_capsule_w_per_k", 0.002, 0.004, "W/K"),
+    ("capsule_to_housing_w_per_k", 0.002, 0.004, "W/K"),
+    ("capsule_weight", 0.1, 0.4, "–"),
 ];
 
 fn range(rng: &mut ChaCha8Rng, name: &str) -> f64 {
@@ -175,6 +183,11 @@ impl UnitParams {
             asic_to_board_w_per_k: per_axis(r, "asic_to_board_w_per_k"),
             asic_to_element_w_per_k: per_axis(r, "asic_to_element_w_per_k"),
             element_to_housing_w_per_k: per_axis(r, "element_to_housing_w_per_k"),
+            // Drawn below from a stream of their own, so the capsule leaves every other draw
+            // of a seed unchanged.
+            capsule_j_per_k: [0.0; 3],
+            element_to_capsule_w_per_k: [0.0; 3],
+            capsule_to_housing_w_per_k: [0.0; 3],
             cross_axis_w_per_k: 0.0,
             supply_power_w: range(r, "supply_power_w"),
             asic_power_w: per_axis(r, "asic_power_w"),
@@ -185,6 +198,7 @@ impl UnitParams {
             tempco_dps_per_c: signed(r, "tempco_dps_per_c (±)"),
             tempco2_dps_per_c2: signed(r, "tempco2_dps_per_c2 (±)"),
             pressure_dps: signed(r, "pressure_dps (±)"),
+            capsule_weight: 0.0,
             turn_on_sigma_dps: range(r, "turn_on_sigma_dps"),
             white_noise_dps_per_rt_hz: range(r, "white_noise_dps_per_rt_hz"),
             instability_sigma_dps: range(r, "instability_sigma_dps"),
@@ -198,6 +212,16 @@ impl UnitParams {
             ageing_tempco_per_day: 0.0,
         };
         let mut axes = [axis(r), axis(r), axis(r)];
+        let mut thermal = thermal;
+        let capsule = &mut rng::stream(seed, &[rng::tag("capsule"), u64::from(index)]);
+        thermal.capsule_j_per_k = per_axis(capsule, "capsule_j_per_k");
+        thermal.element_to_capsule_w_per_k = per_axis(capsule, "element_to_capsule_w_per_k");
+        thermal.capsule_to_housing_w_per_k = per_axis(capsule, "capsule_to_housing_w_per_k");
+        if model == UnitModel::Physical {
+            for a in &mut axes {
+                a.capsule_weight = range(capsule, "capsule_weight");
+            }
+        }
         let accel = AccelParams {
             bias_g: [
                 symmetric(r, "accel bias_g (uniform ±)"),
@@ -333,6 +357,9 @@ mod tests {
             inside("asic_to_board_w_per_k", &t.asic_to_board_w_per_k);
             inside("asic_to_element_w_per_k", &t.asic_to_element_w_per_k);
             inside("element_to_housing_w_per_k", &t.element_to_housing_w_per_k);
+            inside("capsule_j_per_k", &t.capsule_j_per_k);
+            inside("element_to_capsule_w_per_k", &t.element_to_capsule_w_per_k);
+            inside("capsule_to_housing_w_per_k", &t.capsule_to_housing_w_per_k);
             inside("supply_power_w", &[t.supply_power_w]);
             inside("asic_power_w", &t.asic_power_w);
             inside("accel bias_g (uniform ±)", &u.accel.bias_g);
@@ -341,6 +368,7 @@ mod tests {
                 inside("tempco_dps_per_c (±)", &[a.tempco_dps_per_c]);
                 inside("tempco2_dps_per_c2 (±)", &[a.tempco2_dps_per_c2]);
                 inside("pressure_dps (±)", &[a.pressure_dps]);
+                inside("capsule_weight", &[a.capsule_weight]);
                 inside("turn_on_sigma_dps", &[a.turn_on_sigma_dps]);
                 inside("white_noise_dps_per_rt_hz", &[a.white_noise_dps_per_rt_hz]);
                 inside("instability_sigma_dps", &[a.instability_sigma_dps]);

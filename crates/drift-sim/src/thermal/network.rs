@@ -4,14 +4,16 @@
 //!             P_supply                      P_asic,x (and y, z)
 //!                ↓                               ↓
 //!   ambient ── housing ──── board ──── ASIC_x (temperature sensor) ── element_x (in capsule)
-//!     g_ha       │   g_bh          g_ab                          g_ae        │
-//!                └───────────────────────────── g_eh ────────────────────────┘
+//!     g_ha       │ │ g_bh          g_ab                          g_ae        │   │
+//!                │ └─────────────────────────── g_eh ────────────────────────┘   │ g_ec
+//!                └───────────────── g_ch ──────────────────────────────── capsule_x (glass + gas)
 //! ```
 //!
 //! The supply on the board and each sensor's ASIC dissipate only while powered. The
 //! temperature sensor sits on the ASIC; the sensing element inside its glass capsule is
-//! heated through the ASIC and lags it. The housing carries the slow mode that decides how
-//! much heat is left after a short off-time.
+//! heated through the ASIC and lags it; the capsule (its glass and the gas it holds) is heated
+//! by the element and lags it again. The housing carries the slow mode that decides how much
+//! heat is left after a short off-time.
 
 use super::rc::RcNetwork;
 use serde::{Deserialize, Serialize};
@@ -28,8 +30,12 @@ pub const fn asic(a: usize) -> usize {
 pub const fn element(a: usize) -> usize {
     5 + a
 }
+/// Node index of the glass capsule (and the gas it holds) around element `a`.
+pub const fn capsule(a: usize) -> usize {
+    8 + a
+}
 /// Number of nodes.
-pub const NODES: usize = 8;
+pub const NODES: usize = 11;
 
 /// Heat capacities, conductances and heat sources of one unit (SI units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -52,6 +58,12 @@ pub struct ThermalParams {
     pub asic_to_element_w_per_k: [f64; 3],
     /// Element → housing conductance per axis (W/K).
     pub element_to_housing_w_per_k: [f64; 3],
+    /// Glass capsule + gas heat capacity per axis (J/K).
+    pub capsule_j_per_k: [f64; 3],
+    /// Element → capsule conductance per axis, through the gas (W/K).
+    pub element_to_capsule_w_per_k: [f64; 3],
+    /// Capsule → housing conductance per axis, through its mounting (W/K).
+    pub capsule_to_housing_w_per_k: [f64; 3],
     /// Element `i` → ASIC `j ≠ i` conductance (W/K); zero unless the hidden cross-axis effect is on.
     pub cross_axis_w_per_k: f64,
     /// Supply dissipation at nominal voltage while powered (W).
@@ -89,6 +101,9 @@ impl ThermalParams {
             link(asic(a), BOARD, self.asic_to_board_w_per_k[a]);
             link(asic(a), element(a), self.asic_to_element_w_per_k[a]);
             link(element(a), HOUSING, self.element_to_housing_w_per_k[a]);
+            capacity[capsule(a)] = self.capsule_j_per_k[a];
+            link(element(a), capsule(a), self.element_to_capsule_w_per_k[a]);
+            link(capsule(a), HOUSING, self.capsule_to_housing_w_per_k[a]);
             for b in 0..3 {
                 if b != a && self.cross_axis_w_per_k > 0.0 {
                     link(element(a), asic(b), self.cross_axis_w_per_k);
