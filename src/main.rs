@@ -19,6 +19,7 @@ fn broken_pipe(payload: &(dyn std::any::Any + Send)) -> bool {
 
 fn main() -> std::process::ExitCode {
     let cli = gyrodrift::cli::Cli::parse();
+    gyrodrift::cli::interrupt::install();
     let report = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         if !broken_pipe(info.payload()) {

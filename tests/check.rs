@@ -150,4 +150,17 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     ];
     let (out, text) = check(&campaign, &tables, &standard, &loose);
     assert!(out.status.success(), "{text}");
+    // The relative baseline runs its own image (kind 3), with the switch-on bias it registers.
+    let relative = dir.path().join("relative");
+    let mut relative_args = loose;
+    relative_args[1] = "relative";
+    let (out, text) = check(&campaign, &tables, &relative, &relative_args);
+    assert!(out.status.success(), "{text}");
+    let report = std::fs::read_to_string(relative.join("check.md")).unwrap();
+    assert!(report.contains("GIU-01"), "{report}");
+    assert_ne!(
+        std::fs::read(relative.join("check.json")).unwrap(),
+        std::fs::read(standard.join("check.json")).unwrap(),
+        "the relative baseline was checked with the standard one's image"
+    );
 }

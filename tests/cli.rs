@@ -170,7 +170,7 @@ fn simulate_fit_and_report_from_the_command_line() {
     );
     // Closing the loop on a campaign without field sessions: the section says what it could do.
     let extended = dir.path().join("extended");
-    run(&[
+    let text = run(&[
         "diagnose",
         c,
         "-q",
@@ -180,6 +180,21 @@ fn simulate_fit_and_report_from_the_command_line() {
     ]);
     let md = std::fs::read_to_string(extended.join("diagnosis.md")).unwrap();
     assert!(md.contains("## Extended model of unit GIU-01"), "{md}");
+    // The console says the outcome too, in one line, not only the file.
+    let verdict = text
+        .lines()
+        .find(|l| l.starts_with("  extended model: "))
+        .unwrap_or_else(|| panic!("no extended-model line in {text}"));
+    assert!(
+        verdict.ends_with("the paper's model unchanged")
+            || verdict.ends_with("keyed by history")
+            || verdict.contains("admitted "),
+        "{verdict}"
+    );
+    assert!(
+        !verdict.contains("admitted ") || md.contains("extended-GIU-01.bin"),
+        "{verdict}"
+    );
 }
 
 #[test]

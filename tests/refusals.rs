@@ -206,6 +206,56 @@ fn fit_refuses_a_half_simulated_campaign() {
 }
 
 #[test]
+fn an_interrupted_simulate_removes_its_partial_files_and_exits_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    // Long enough (10 units) that the interrupt lands while a file is being written.
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
+        .args(["simulate", "-q", "-o", s(&out), "--units", "10"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let partial = |dir: &Path| -> Vec<String> {
+        std::fs::read_dir(dir)
+            .map(|entries| {
+                entries
+                    .flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.ends_with(&format!(".{pid}.tmp")))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let recordings = out.join("recordings");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while partial(&recordings).is_empty() {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no partial file appeared"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let finished = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&finished.stderr);
+    assert_eq!(finished.status.code(), Some(130), "{text}");
+    assert!(text.contains("interrupted: removed"), "{text}");
+    assert_eq!(partial(&recordings), Vec::<String>::new());
+    assert_eq!(partial(&out.join("truth")), Vec::<String>::new());
+    assert!(!out.join("summary.json").exists());
+    // What is left is refused by the readers, by name.
+    refused(
+        &["fit", s(&out), "-q", "-o", s(&dir.path().join("tables"))],
+        &["is an incomplete simulated campaign (no summary.json"],
+    );
+}
+
+#[test]
 fn simulate_refuses_a_non_empty_folder_and_force_replaces_it() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("campaign");

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use drift_core::blob::Image;
-use drift_core::{Model, ModifiedTables, PolynomialTables};
+use drift_core::{Model, ModifiedTables, PolynomialTables, RelativePolynomialTables};
 use drift_evaluate::check::{AxisVerdict, CheckedActivation, Limits, UnitCheck};
 use drift_evaluate::pipeline;
 use drift_evaluate::tables_folder::{self, StoredModel, TablesError};
@@ -33,6 +33,8 @@ pub enum Stored {
     Standard,
     /// The 3rd-order polynomial (`third_order.bin`).
     ThirdOrder,
+    /// The least-squares polynomial relative to the switch-on (`relative.bin`).
+    Relative,
 }
 
 impl Stored {
@@ -42,6 +44,7 @@ impl Stored {
             Self::ByHistory => StoredModel::ByHistory,
             Self::Standard => StoredModel::Standard,
             Self::ThirdOrder => StoredModel::ThirdOrder,
+            Self::Relative => StoredModel::Relative,
         }
     }
 }
@@ -219,6 +222,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         Stored::Standard | Stored::ThirdOrder => {
             check_all::<PolynomialTables>(args, &files, &settings, &limits, &steps)?
+        }
+        Stored::Relative => {
+            check_all::<RelativePolynomialTables>(args, &files, &settings, &limits, &steps)?
         }
     };
     steps.finish();

@@ -374,9 +374,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for (n, (unit, segments)) in recorded.iter().enumerate() {
         steps.update(
             if args.extend {
-                "fitting the tables to every candidate, diagnosing, guarding the extended model"
+                "units: refitting on every candidate, shuffle test, guarding the extended model"
             } else {
-                "fitting the tables to every candidate, diagnosing"
+                "units: refitting on every candidate, shuffle test (99 reshuffles per axis)"
             },
             n as u64,
             recorded.len() as u64,
@@ -536,6 +536,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     if c.significant { "  *" } else { "" }
                 );
             }
+        }
+        if args.extend {
+            println!("  extended model: {}", super::extend::verdict(unit, closed));
         }
         let profiles = closed.profiles(fitted, &options.fit);
         md.push_str(&profile_markdown(&profiles));

@@ -67,6 +67,46 @@ pub fn run(
     Ok(md)
 }
 
+/// The extended model's outcome for one unit in one console line: what the Markdown section says
+/// at length, so nobody has to open the file to learn that nothing was extended, or why.
+pub fn verdict(unit: &str, closed: &Closed<'_>) -> String {
+    let keyed = closed.keying.any();
+    let kept = if keyed {
+        "the paper's tables with stage 3 or warm starts keyed by history"
+    } else {
+        "the paper's model unchanged"
+    };
+    if closed.proposed.terms.is_empty() {
+        return format!("no term proposed (nothing significant maps to a term the firmware can compute); {kept}");
+    }
+    let proposed = closed
+        .proposed
+        .terms
+        .iter()
+        .map(|t| t.candidate.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let Some(extended) = &closed.extended else {
+        return format!(
+            "proposed {proposed}, but no field-like activations at the calibration set points to guard and fit them (record some: `gyrodrift simulate --field`); {kept}"
+        );
+    };
+    let admitted: Vec<String> = extended
+        .admissions
+        .iter()
+        .filter(|a| a.admitted)
+        .map(|a| format!("{} on {}", a.candidate, a.axis))
+        .collect();
+    if admitted.is_empty() {
+        format!("proposed {proposed}; none lowers the held-out error; {kept}")
+    } else {
+        format!(
+            "admitted {} (firmware image `extended-{unit}.bin`)",
+            admitted.join(", ")
+        )
+    }
+}
+
 /// The guard's decisions and the admitted terms, as Markdown.
 fn terms_markdown(closed: &Closed<'_>) -> String {
     let (calibration, training) = (&closed.roles.calibration, &closed.roles.training);

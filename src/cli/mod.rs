@@ -12,6 +12,7 @@ pub mod fit;
 pub mod import;
 pub mod import_campaign;
 pub mod import_ulog;
+pub mod interrupt;
 mod measured;
 mod progress;
 mod reading;
@@ -20,8 +21,8 @@ pub mod simulate;
 
 /// Exit status of every command: 0 done (for `check`: every limit met), 1 `check` found a unit ×
 /// axis missing a limit (its report is written), 2 the command could not do its job (usage, input or
-/// output error; the message says what and where).
-pub const EXIT_CODES: &str = "Exit status: 0 done (check: every limit met); 1 check: a unit × axis misses a limit (report written); 2 usage, input or output error (the message says what and where).";
+/// output error; the message says what and where), 130 interrupted (Ctrl-C; partial files removed).
+pub const EXIT_CODES: &str = "Exit status: 0 done (check: every limit met); 1 check: a unit × axis misses a limit (report written); 2 usage, input or output error (the message says what and where); 130 interrupted by Ctrl-C (this run's partial files removed).";
 
 /// The exit status for a command's outcome: see [`EXIT_CODES`].
 pub fn exit_status(outcome: &anyhow::Result<()>) -> u8 {

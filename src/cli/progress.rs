@@ -1,6 +1,7 @@
 //! Progress bars for long steps.
 
 use std::sync::Mutex;
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -34,10 +35,22 @@ impl Steps {
                 ProgressBar::new(total)
             };
             if let Ok(style) = ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}",
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg} ({remaining})",
             ) {
-                bar.set_style(style);
+                // "left: –" until one item is done: an estimate from nothing is not one.
+                bar.set_style(style.with_key(
+                    "remaining",
+                    |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                        let _ = if state.pos() == 0 {
+                            write!(w, "left: –")
+                        } else {
+                            write!(w, "left: about {}", indicatif::HumanDuration(state.eta()))
+                        };
+                    },
+                ));
             }
+            // A step of one long item still shows that it runs, and for how long.
+            bar.enable_steady_tick(Duration::from_millis(200));
             bar.set_message(step.to_owned());
             *current = Some((step.to_owned(), bar));
         }

@@ -221,6 +221,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             },
         ),
     );
+    super::interrupt::watch(&args.out);
     let summary = drift_sim::simulate_campaign(&campaign, &args.out, |p| {
         bar.set_position(p.samples_done);
         bar.set_message(format!(

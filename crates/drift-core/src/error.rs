@@ -97,6 +97,11 @@ pub enum Problem {
     },
     /// Differs from an earlier entry it must equal.
     Mismatch,
+    /// Larger in magnitude than any physical unit gives (a unit or sign slip, or a broken fit).
+    Implausible {
+        /// The largest plausible magnitude, in the field's unit.
+        limit: u16,
+    },
 }
 
 /// A table or settings value failed validation.
@@ -148,6 +153,9 @@ impl fmt::Display for Error {
             }
             Problem::OutOfRange { limit } => write!(f, ": must be less than {limit}"),
             Problem::Mismatch => f.write_str(": differs from the earlier entry it must equal"),
+            Problem::Implausible { limit } => {
+                write!(f, ": magnitude beyond {limit}, implausible for a gyro")
+            }
         }
     }
 }

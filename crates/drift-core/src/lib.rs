@@ -52,7 +52,10 @@ pub use polynomial::{
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};
-pub use table::{AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables};
+pub use table::{
+    AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, MAX_PLAUSIBLE_K,
+    MAX_PLAUSIBLE_RISE_CELSIUS,
+};
 pub use warm_start::WarmStart;
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.

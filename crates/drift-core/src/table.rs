@@ -11,6 +11,13 @@ use crate::settings::Settings;
 use crate::warm_start::{self, WarmStart};
 use crate::AXES;
 
+/// The largest plausible |k|, (°/s) per °C: 100 °/s of drift for one degree of self-heating is
+/// beyond any gyro (MEMS parts give 0.001–0.1), so a larger value is a unit slip or a broken fit,
+/// refused when the tables are validated rather than corrected with at run time.
+pub const MAX_PLAUSIBLE_K: u16 = 100;
+/// The largest plausible |rise| since switch-on, °C (a unit's self-heating is a few to tens of °C).
+pub const MAX_PLAUSIBLE_RISE_CELSIUS: u16 = 500;
+
 /// One point of a heating-dynamics curve: where the curve stood at one reference time.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -193,12 +200,27 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
                 let at = at.curve(c);
                 check_len("points", at, references, curve.points.len())?;
                 for (j, point) in curve.points.iter().enumerate() {
-                    for (field, value) in [
-                        ("rise_celsius", point.rise_celsius),
-                        ("k_dps_per_celsius", point.k_dps_per_celsius),
+                    for (field, value, limit) in [
+                        (
+                            "rise_celsius",
+                            point.rise_celsius,
+                            MAX_PLAUSIBLE_RISE_CELSIUS,
+                        ),
+                        (
+                            "k_dps_per_celsius",
+                            point.k_dps_per_celsius,
+                            MAX_PLAUSIBLE_K,
+                        ),
                     ] {
                         if !value.is_finite() {
                             return Err(Error::new(field, at.point(j), Problem::NonFinite));
+                        }
+                        if value.abs() > f32::from(limit) {
+                            return Err(Error::new(
+                                field,
+                                at.point(j),
+                                Problem::Implausible { limit },
+                            ));
                         }
                     }
                 }

@@ -436,3 +436,30 @@ fn extended_images_round_trip_and_bad_terms_are_named() {
         "axes[2].switch_on_rate: must not be negative"
     );
 }
+
+#[test]
+fn implausible_correlations_are_refused_by_name() {
+    // A k of 1e3 (°/s)/°C would turn a 4 °C rise into a 4,000 °/s "bias".
+    let mut tables = fixture::modified();
+    tables.axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius = 1.0e3;
+    let error = tables.validate().unwrap_err();
+    assert_eq!(
+        error.problem,
+        Problem::Implausible {
+            limit: drift_core::MAX_PLAUSIBLE_K
+        }
+    );
+    assert_eq!(
+        error.to_string(),
+        "axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius: magnitude beyond 100, \
+         implausible for a gyro"
+    );
+    let mut buffer = vec![0; 64 * 1024];
+    assert!(matches!(
+        encode(&tables, &mut buffer),
+        Err(BlobError::Invalid(_))
+    ));
+    // At the limit it is still accepted: the bound refuses slips, not steep real units.
+    tables.axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius = 100.0;
+    assert!(tables.validate().is_ok());
+}

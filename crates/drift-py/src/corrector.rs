@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use drift_core::{
     AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialTables, Previous,
-    Sample, AUX_INPUTS,
+    RelativePolynomialTables, Sample, AUX_INPUTS,
 };
 use numpy::ndarray::{Array2, ArrayView1};
 use numpy::{IntoPyArray, PyArray2};
@@ -18,7 +18,7 @@ use crate::arrays::{
     copy_times, describe, rows_per_axis, times, BatchArrays, OutArrays, Rows, RowsView,
 };
 use crate::errors::Error;
-use crate::tables::{PyModifiedTables, PyPolynomialTables};
+use crate::tables::{PyModifiedTables, PyPolynomialTables, PyRelativePolynomialTables};
 
 /// Samples staged at a time between the caller's arrays and the corrector (on the stack).
 const BLOCK: usize = 512;
@@ -37,10 +37,15 @@ enum Engine {
         Arc<PolynomialTables>,
         CorrectorState<<PolynomialAxis as AxisModel>::State>,
     ),
+    Relative(
+        Arc<RelativePolynomialTables>,
+        CorrectorState<<RelativeAxis as AxisModel>::State>,
+    ),
 }
 
 type ModifiedAxis = <ModifiedTables as Model>::Axis;
 type PolynomialAxis = <PolynomialTables as Model>::Axis;
+type RelativeAxis = <RelativePolynomialTables as Model>::Axis;
 
 /// The batch's inputs, borrowed from the caller's arrays (no Python object inside, so they can be
 /// used without the GIL).
@@ -151,6 +156,7 @@ impl Engine {
         match self {
             Self::Modified(model, state) => state.power_on(&**model, raw),
             Self::Polynomial(model, state) => state.power_on(&**model, raw),
+            Self::Relative(model, state) => state.power_on(&**model, raw),
         }
     }
 
@@ -162,6 +168,7 @@ impl Engine {
         match self {
             Self::Modified(model, state) => state.power_on_after(&**model, raw, previous),
             Self::Polynomial(model, state) => state.power_on_after(&**model, raw, previous),
+            Self::Relative(model, state) => state.power_on_after(&**model, raw, previous),
         }
     }
 
@@ -169,6 +176,7 @@ impl Engine {
         match self {
             Self::Modified(model, state) => state.keep(&**model, previous),
             Self::Polynomial(model, state) => state.keep(&**model, previous),
+            Self::Relative(model, state) => state.keep(&**model, previous),
         }
     }
 
@@ -176,6 +184,7 @@ impl Engine {
         match self {
             Self::Modified(_, state) => state.power_off(),
             Self::Polynomial(_, state) => state.power_off(),
+            Self::Relative(_, state) => state.power_off(),
         }
     }
 
@@ -183,6 +192,7 @@ impl Engine {
         match self {
             Self::Modified(model, state) => correct_one(&**model, state, sample, aux),
             Self::Polynomial(model, state) => correct_one(&**model, state, sample, aux),
+            Self::Relative(model, state) => correct_one(&**model, state, sample, aux),
         }
     }
 
@@ -190,6 +200,7 @@ impl Engine {
         match self {
             Self::Modified(model, state) => correct_all(&**model, state, batch, out),
             Self::Polynomial(model, state) => correct_all(&**model, state, batch, out),
+            Self::Relative(model, state) => correct_all(&**model, state, batch, out),
         }
     }
 
@@ -197,6 +208,7 @@ impl Engine {
         match self {
             Self::Modified(_, state) => state.is_powered_on(),
             Self::Polynomial(_, state) => state.is_powered_on(),
+            Self::Relative(_, state) => state.is_powered_on(),
         }
     }
 
@@ -207,6 +219,9 @@ impl Engine {
                 .axes()
                 .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
             Self::Polynomial(_, state) => state
+                .axes()
+                .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
+            Self::Relative(_, state) => state
                 .axes()
                 .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
         }
@@ -300,16 +315,20 @@ fn to_array<'py, T: numpy::Element>(
 
 #[pymethods]
 impl PyCorrector {
-    /// A corrector for `model` (`ModifiedTables` or `PolynomialTables`), not yet powered on.
+    /// A corrector for `model` (`ModifiedTables`, `PolynomialTables` or `RelativePolynomialTables`),
+    /// not yet powered on.
     #[new]
     fn new(model: &Bound<'_, PyAny>) -> Result<Self, Error> {
         let engine = if let Ok(tables) = model.cast::<PyModifiedTables>() {
             Engine::Modified(Arc::clone(&tables.get().0), CorrectorState::new())
         } else if let Ok(tables) = model.cast::<PyPolynomialTables>() {
             Engine::Polynomial(Arc::clone(&tables.get().0), CorrectorState::new())
+        } else if let Ok(tables) = model.cast::<PyRelativePolynomialTables>() {
+            Engine::Relative(Arc::clone(&tables.get().0), CorrectorState::new())
         } else {
             return Err(Error::Input(format!(
-                "`model` must be a gyrodrift.ModifiedTables or gyrodrift.PolynomialTables, got {}",
+                "`model` must be a gyrodrift.ModifiedTables, PolynomialTables or \
+                 RelativePolynomialTables, got {}",
                 describe(model)
             )));
         };
@@ -325,6 +344,9 @@ impl PyCorrector {
             }
             Engine::Polynomial(model, _) => {
                 Py::new(py, PyPolynomialTables(Arc::clone(model)))?.into_any()
+            }
+            Engine::Relative(model, _) => {
+                Py::new(py, PyRelativePolynomialTables(Arc::clone(model)))?.into_any()
             }
         })
     }
@@ -506,6 +528,7 @@ impl PyCorrector {
         let model = match &self.engine {
             Engine::Modified(..) => "ModifiedTables",
             Engine::Polynomial(..) => "PolynomialTables",
+            Engine::Relative(..) => "RelativePolynomialTables",
         };
         let state = if self.engine.is_powered_on() {
             "powered on"

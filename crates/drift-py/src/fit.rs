@@ -21,7 +21,7 @@ use crate::fit_settings::{self, PyFitSettings};
 use crate::results::{split_from, PyActivationResult};
 use crate::segment::PySegment;
 use crate::sources::{self, Source};
-use crate::tables::{PyModifiedTables, PyPolynomialTables};
+use crate::tables::{PyModifiedTables, PyPolynomialTables, PyRelativePolynomialTables};
 use drift_evaluate::tables_folder;
 
 /// Everything fitted for one unit, with the settings it was fitted with.
@@ -156,6 +156,13 @@ impl PyFittedUnit {
     #[getter]
     fn third_order(&self) -> PyPolynomialTables {
         PyPolynomialTables(Arc::new(self.unit.third_order.clone()))
+    }
+
+    /// The least-squares baseline relative to the switch-on (bias = q(T_on) + p(T) − p(T_on)),
+    /// orders chosen by leave-one-series-out cross-validation on the calibration data.
+    #[getter]
+    fn relative(&self) -> PyRelativePolynomialTables {
+        PyRelativePolynomialTables(Arc::new(self.unit.relative.clone()))
     }
 
     /// The settings the unit was fitted with (used again by `evaluate`).

@@ -41,6 +41,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<tables::PyModifiedTables>()?;
     extension::register(module)?;
     module.add_class::<tables::PyPolynomialTables>()?;
+    module.add_class::<tables::PyRelativePolynomialTables>()?;
     module.add_class::<corrector::PyCorrector>()?;
     module.add_class::<corrector::PyOutput>()?;
     module.add_class::<labels::PyLabels>()?;

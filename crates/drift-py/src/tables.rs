@@ -1,13 +1,17 @@
-//! The model classes: `gyrodrift.ModifiedTables` (the paper's method) and
-//! `gyrodrift.PolynomialTables` (the standard and 3rd-order baselines).
+//! The model classes: `gyrodrift.ModifiedTables` (the paper's method),
+//! `gyrodrift.PolynomialTables` (the standard and 3rd-order baselines) and
+//! `gyrodrift.RelativePolynomialTables` (the baseline relative to the switch-on).
 //!
-//! Both are immutable, validated on construction, and share one API (generated below so it cannot
+//! All are immutable, validated on construction, and share one API (generated below so it cannot
 //! drift apart): JSON and firmware-image conversion, files, settings. `ModifiedTables` adds the
 //! extended model's extra terms (`extension`, `with_extension`).
 
 use std::sync::Arc;
 
-use drift_core::{Extension, Model, ModifiedTables, PolynomialTables, SwitchOnRate, MAX_TERMS};
+use drift_core::{
+    Extension, Model, ModifiedTables, PolynomialTables, RelativePolynomialTables, SwitchOnRate,
+    MAX_TERMS,
+};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
@@ -61,6 +65,23 @@ impl Summary for PolynomialTables {
                 format!(
                     "{} coefficients over [{low:?}, {high:?}] °C",
                     axis.coefficients.len()
+                )
+            })
+            .collect();
+        format!("per axis: {}", axes.join("; "))
+    }
+}
+
+impl Summary for RelativePolynomialTables {
+    fn summary(&self) -> String {
+        let axes: Vec<String> = self
+            .axes
+            .iter()
+            .map(|axis| {
+                format!(
+                    "drift {} + turn-on {} coefficients",
+                    axis.drift.coefficients.len(),
+                    axis.turn_on.coefficients.len()
                 )
             })
             .collect();
@@ -292,5 +313,14 @@ model_class!(
     PolynomialTables,
     "PolynomialTables",
     "A polynomial baseline, standard or 3rd order (`drift_core::PolynomialTables`).",
+    {}
+);
+
+model_class!(
+    PyRelativePolynomialTables,
+    RelativePolynomialTables,
+    "RelativePolynomialTables",
+    "The least-squares baseline relative to the switch-on, bias = q(T_on) + p(T) − p(T_on) \
+     (`drift_core::RelativePolynomialTables`).",
     {}
 );

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import gyrodrift
 from conftest import recording_path
@@ -80,3 +81,25 @@ def test_analyse_one_activation(campaign_dir: Path) -> None:
     assert np.allclose(analysed.time_s[:3], [0.0, 0.01, 0.02])
     assert (analysed.rise_celsius[-1] > 0.1).all()  # the unit warms up
     assert abs(analysed.switch_on_celsius[0] - 30.0) < 5.0
+
+
+def test_the_relative_baseline_is_fitted_saved_and_corrects(campaign_dir: Path, tmp_path: Path) -> None:
+    (unit,) = gyrodrift.fit(campaign_dir)
+    relative = unit.relative
+    assert isinstance(relative, gyrodrift.RelativePolynomialTables)
+    folder = unit.save(tmp_path)
+    assert gyrodrift.RelativePolynomialTables.load_image(folder / "relative.bin") == relative
+    assert gyrodrift.RelativePolynomialTables.from_json(relative.to_json()) == relative
+    # Its image is its own kind: read as another model, it is refused by name.
+    with pytest.raises(gyrodrift.ImageError, match="model kind 3"):
+        gyrodrift.PolynomialTables.load_image(folder / "relative.bin")
+    segment = gyrodrift.Recording.load(recording_path(campaign_dir)).segments[0]
+    corrector = gyrodrift.Corrector(relative)
+    assert corrector.model == relative
+    corrector.power_on(segment.temperature_raw[0])
+    corrected, bias, _ = corrector.correct_batch(segment.since_power_on_ms, segment.rate_dps, segment.temperature_raw)
+    # bias = q(T_on) + p(T) − p(T_on): at switch-on it is the registered turn-on bias alone.
+    assert np.allclose(bias[0], corrector.initial_bias_dps, atol=1e-6)
+    assert np.array_equal(corrected, segment.rate_dps - bias)
+    # On its own calibration data it leaves a small offset (the static unit's rate is its bias).
+    assert np.all(np.abs(corrected.mean(axis=0)) < 0.02)

@@ -233,6 +233,8 @@ impl World {
                 intervals_min: plan.intervals_min.clone(),
                 repeats: plan.repeats,
                 heating_scatter: s.protocol_heating_scatter,
+                // A world's chamber wanders by its own drawn structure (`chamber_wander_c_per_min`).
+                chamber_ripple_c: 0.0,
                 ..Protocol::default()
             }),
             field: Some(Field {
