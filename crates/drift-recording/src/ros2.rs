@@ -326,6 +326,9 @@ pub fn bag_files(path: &Path) -> Result<Vec<PathBuf>, BagError> {
 /// A field of a `.msg` definition: type (normalised) and name.
 type Field = (String, String);
 
+/// A parsed definition: the message's own fields, and the fields of each type it defines.
+type Definition = (Vec<Field>, HashMap<String, Vec<Field>>);
+
 const PRIMITIVES: [&str; 17] = [
     "bool", "byte", "char", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
     "uint64", "float32", "float64", "string", "wstring", "float", "double",
@@ -349,7 +352,7 @@ fn normalise_type(ty: &str) -> String {
 /// Parses a `ros2msg` definition as rosbag2 stores it: the message's fields, then, after each
 /// separator line of `=`, `MSG: <type>` and that type's fields. Comments, blank lines and
 /// constants (`TYPE NAME=value`) are skipped; default values after a field's name are ignored.
-fn parse_definition(text: &str) -> Result<(Vec<Field>, HashMap<String, Vec<Field>>), String> {
+fn parse_definition(text: &str) -> Result<Definition, String> {
     let mut main = Vec::new();
     let mut types: HashMap<String, Vec<Field>> = HashMap::new();
     let mut current: Option<String> = None;
