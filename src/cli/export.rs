@@ -81,13 +81,12 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
         let segments: Vec<_> = recording.segments.iter().collect();
         let bytes = write_ros2_bag(&args.out, &segments, frame, &topics)?;
         println!(
-            "{}: {} activations, {samples} samples → {} ({} messages per sample: {} and {} /y /z; {bytes} bytes)",
+            "{}: {} activations, {samples} samples → {} (per sample one message on {} and on each of {}; {bytes} bytes)",
             args.recording.display(),
             segments.len(),
             args.out.display(),
-            4,
             topics.imu,
-            topics.temperature
+            topics.temperature_axes().join(", ")
         );
         return Ok(());
     }

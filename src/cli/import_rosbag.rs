@@ -203,7 +203,7 @@ pub fn run(args: &RosbagArgs) -> anyhow::Result<()> {
                     1.0 / f64::from(args.rate_hz),
                     args.rate_hz
                 );
-                Some(off_ns as f64 * 1e-9)
+                Some(off_ns as f64 / 1e9)
             }
         };
         let a = &mut activations[k];
