@@ -829,7 +829,11 @@ mod tests {
     #[test]
     fn the_standard_definitions_flatten_to_their_wire_fields() {
         let imu = wire_fields(IMU_DEFINITION).unwrap();
-        assert_eq!(imu.len(), 3 + 4 + 9 + 3 + 9 + 3 + 9);
+        assert_eq!(
+            imu.len(),
+            3 + 4 + 1 + 3 + 1 + 3 + 1,
+            "arrays are one wire field each"
+        );
         assert_eq!(imu[0], "int32 header.stamp.sec");
         assert_eq!(imu[2], "string header.frame_id");
         assert_eq!(imu[7], "float64[9] orientation_covariance");
