@@ -521,7 +521,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         {
             let _ = writeln!(
                 md,
-                "Diagnosed on {} activations the fit never saw ({}{}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are held out with the rest ({} held out in all).\n",
+                "Diagnosed on {} activations the fit never saw ({}{}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are {}.\n",
                 activations.len(),
                 if roles.training.is_empty() && roles.selection.is_empty() {
                     if roles.not_judged.is_empty() {
@@ -542,7 +542,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     )
                 },
                 roles.outside_range,
-                roles.held_out.len()
+                if args.evaluation_data.is_some() {
+                    "not judged on, as the calibration data's other activations".to_owned()
+                } else {
+                    format!("held out with the rest ({} held out in all)", roles.held_out.len())
+                }
             );
             if let Some(dir) = &args.evaluation_data {
                 let _ = writeln!(
