@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Python module's checks, from a really clean state: a fresh venv in .venv-check/ (deleted and
 # recreated on every run), `pip install ./crates/drift-py[test,plot]` (a real PEP 517 build through
-# maturin, with matplotlib, pandas and mcap so the optional paths run), then pytest (with the CLI
+# maturin, with matplotlib, pandas, mcap and mcap-ros2-support so the optional paths run), then pytest (with the CLI
 # binary, to compare simulated bytes), the benchmark scripts at their tiny size (a check that they
 # still run and that what they compare agrees; timings printed, never asserted), mypy's stubtest, a
 # strict type check of the package's Python code, the examples and the benchmarks, ruff, and the
@@ -45,7 +45,8 @@ make_venv() {
 
 install_package() {
     # Builds the abi3 wheel with maturin (fetched by pip into an isolated build environment) and
-    # installs it with its test tools (pytest, hypothesis, mypy, ruff, pandas, mcap) and the plot
+    # installs it with its test tools (pytest, hypothesis, mypy, ruff, pandas, mcap,
+    # mcap-ros2-support) and the plot
     # extra (matplotlib); numpy is a runtime dependency.
     "$VENV/bin/python" -m pip install --quiet "./crates/drift-py[test,plot]"
     "$VENV/bin/python" -c 'import gyrodrift, numpy, pandas, matplotlib; print("gyrodrift", gyrodrift.__version__, "from", gyrodrift.__file__, "| numpy", numpy.__version__, "| pandas", pandas.__version__, "| matplotlib", matplotlib.__version__)'
@@ -90,8 +91,8 @@ run_ruff() {
 }
 
 run_recording_read_test() {
-    # The Python `mcap` package must read what `gyrodrift simulate` writes.
-    "$VENV/bin/python" -m pip install --quiet mcap-ros2-support
+    # The Python `mcap` package must read what `gyrodrift simulate` writes (mcap-ros2-support comes
+    # with the package's [test] extra).
     GYRODRIFT_BIN=target/release/gyrodrift "$VENV/bin/python" -m pytest crates/drift-sim/tests/python -q -p no:cacheprovider
 }
 

@@ -15,8 +15,8 @@ pub struct CampaignArgs {
     /// Campaign folder (with `recordings/`) or a folder of `.mcap` recordings.
     #[arg(required_unless_present = "calibration_data")]
     pub campaign: Option<PathBuf>,
-    /// The recordings to fit on, instead of the positional campaign (with `report
-    /// --evaluation-data`: judged on another source).
+    /// The recordings to fit on, instead of the positional campaign (with `--evaluation-data` of
+    /// `report` or `diagnose`: judged on another source).
     #[arg(long, value_name = "DIR", conflicts_with = "campaign")]
     pub calibration_data: Option<PathBuf>,
     /// Chamber set points to fit, °C (protocol activations only).

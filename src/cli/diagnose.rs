@@ -5,7 +5,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use drift_diagnose::closing::{
-    close, mean_profiles, profile_bin_labels, BeforeAfter, Closed, Profile, Stage3Choice,
+    close, close_separate, mean_profiles, profile_bin_labels, BeforeAfter, Closed, Profile,
+    Stage3Choice,
 };
 use drift_diagnose::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_diagnose::warm_start::WarmStartChoice;
@@ -47,6 +48,74 @@ pub struct Args {
     /// none of them measured on afterwards (the before/after uses the rest).
     #[arg(long, value_delimiter = ',', value_name = "CELSIUS,...")]
     pub select_on: Vec<f64>,
+    /// Recordings to judge on, a source separate from the calibration data (the campaign or
+    /// `--calibration-data`), as `report --evaluation-data` does: every activation of the fitted
+    /// units there is held out (the error before and after, the profiles), and none reaches the
+    /// tables, a choice, the ranking or the extended model, which all come from the calibration
+    /// data. The calibration data's own activations outside the calibration and training roles (and
+    /// `--select-on`) are not judged on; the ranking uses them when there are no training
+    /// activations (and only with neither does it rank on the evaluation data, as `diagnose`
+    /// alone ranks on the held-out ones). Units without activations there are left out.
+    #[arg(long, value_name = "DIR")]
+    pub evaluation_data: Option<PathBuf>,
+}
+
+/// One day, ns: how far after the calibration data's last activation the evaluation data's life
+/// starts on the clock (activations are known by their switch-on time, and two sources may share a
+/// clock origin).
+const DAY_NS: u64 = 86_400_000_000_000;
+
+/// The evaluation data's activations per unit (only the units in `fitted`), each unit's moved on the
+/// clock to a day after that unit's last activation in `source` (their order and off-times kept).
+fn evaluation_segments(
+    dir: &std::path::Path,
+    source: &BTreeMap<String, Vec<Segment>>,
+    fitted: &[FittedUnit],
+) -> anyhow::Result<BTreeMap<String, Vec<Segment>>> {
+    let files = pipeline::recording_files(dir)?;
+    let mut units: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for path in &files {
+        let recording = read_recording(path)?;
+        seen.insert(recording.unit_id.clone());
+        if fitted.iter().any(|f| f.unit_id == recording.unit_id) {
+            units
+                .entry(recording.unit_id.clone())
+                .or_default()
+                .extend(recording.segments);
+        }
+    }
+    anyhow::ensure!(
+        !units.is_empty(),
+        "{}: the evaluation data's units ({}) are none of the units fitted on the calibration data ({}): give recordings of the same units",
+        dir.display(),
+        seen.into_iter().collect::<Vec<_>>().join(", "),
+        fitted.iter().map(|f| f.unit_id.as_str()).collect::<Vec<_>>().join(", ")
+    );
+    for (unit, segments) in &mut units {
+        let end = source
+            .get(unit)
+            .into_iter()
+            .flatten()
+            .map(|s| {
+                let period = 1_000_000_000 / u64::from(s.sample_rate_hz.max(1));
+                s.power_on_ns + s.len() as u64 * period
+            })
+            .max()
+            .unwrap_or(0);
+        let first = segments.iter().map(|s| s.power_on_ns).min().unwrap_or(0);
+        let start = end.saturating_add(DAY_NS);
+        for s in segments.iter_mut() {
+            s.power_on_ns = s
+                .power_on_ns
+                .checked_sub(first)
+                .and_then(|t| t.checked_add(start))
+                .ok_or_else(|| {
+                    anyhow::anyhow!("unit {unit}: the evaluation data's clock overflows")
+                })?;
+        }
+    }
+    Ok(units)
 }
 
 /// Where the tables' own history lookup fails, as Markdown: no per-sample candidate can carry it
@@ -370,6 +439,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .or_default()
             .extend(recording.segments);
     }
+    let evaluation = args
+        .evaluation_data
+        .as_deref()
+        .map(|dir| evaluation_segments(dir, &recorded, &outcome.fitted))
+        .transpose()?;
     let mut units: BTreeMap<&String, (Closed<'_>, &FittedUnit)> = BTreeMap::new();
     for (n, (unit, segments)) in recorded.iter().enumerate() {
         steps.update(
@@ -384,15 +458,32 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let Some(fitted) = outcome.fitted.iter().find(|f| &f.unit_id == unit) else {
             continue;
         };
-        let closed = close(
-            fitted,
-            segments,
-            &options.calibration_set_points,
-            &args.select_on,
-            &options.fit,
-            args.extend,
-            true,
-        )?;
+        let closed = match &evaluation {
+            None => close(
+                fitted,
+                segments,
+                &options.calibration_set_points,
+                &args.select_on,
+                &options.fit,
+                args.extend,
+                true,
+            )?,
+            Some(evaluation) => {
+                let Some(judged) = evaluation.get(unit) else {
+                    continue;
+                };
+                close_separate(
+                    fitted,
+                    segments,
+                    judged,
+                    &options.calibration_set_points,
+                    &args.select_on,
+                    &options.fit,
+                    args.extend,
+                    true,
+                )?
+            }
+        };
         if !closed.series.is_empty() {
             units.insert(unit, (closed, fitted));
         }
@@ -414,6 +505,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     steps.finish();
     let mut md = String::from("# gyrodrift diagnosis\n\n");
+    if let Some(dir) = &args.evaluation_data {
+        let _ = writeln!(
+            md,
+            "Calibration data: `{}` (calibration {:?} °C); evaluation data: `{}` (every activation of the fitted units held out; none reaches the tables, a choice, the ranking or the extended model).\n",
+            input.source().display(),
+            options.calibration_set_points,
+            dir.display()
+        );
+    }
     let mut json = Vec::new();
     for (unit, (closed, fitted)) in &units {
         let (activations, axes, roles) = (&closed.series, &closed.axes, &closed.roles);
@@ -421,10 +521,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         {
             let _ = writeln!(
                 md,
-                "Diagnosed on {} activations the fit never saw ({}{}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are held out with the rest ({} held out in all).\n",
+                "Diagnosed on {} activations the fit never saw ({}{}); {} field-like activations at the calibration set points switched on outside the calibrated ambient range (the model clamps there by design) and are {}.\n",
                 activations.len(),
                 if roles.training.is_empty() && roles.selection.is_empty() {
-                    "every activation outside the calibration protocol"
+                    if roles.not_judged.is_empty() {
+                        "every activation outside the calibration protocol"
+                    } else {
+                        "the calibration data's activations outside the calibration protocol"
+                    }
                 } else {
                     "field-like activations at the calibration set points"
                 },
@@ -438,8 +542,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     )
                 },
                 roles.outside_range,
-                roles.held_out.len()
+                if args.evaluation_data.is_some() {
+                    "not judged on, as the calibration data's other activations".to_owned()
+                } else {
+                    format!("held out with the rest ({} held out in all)", roles.held_out.len())
+                }
             );
+            if let Some(dir) = &args.evaluation_data {
+                let _ = writeln!(
+                    md,
+                    "Held out: the {} activations of the evaluation data `{}`; the calibration data's {} activations outside the roles above are not judged on.\n",
+                    roles.held_out.len(),
+                    dir.display(),
+                    roles.not_judged.len()
+                );
+            }
         }
         // The held-out errors are needed by the crossings' table and the extended model's; a
         // unit with neither does not pay for correcting every held-out activation twice more.
@@ -465,6 +582,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             md.push_str(&paper_markdown(&closed.paper_axes, args.top));
         }
         println!("{unit}:");
+        if let Some(dir) = &args.evaluation_data {
+            println!(
+                "  held out: {} activations of the evaluation data {} ({} of the calibration data's not judged on)",
+                closed.roles.held_out.len(),
+                dir.display(),
+                closed.roles.not_judged.len()
+            );
+        }
         for crossing in &fitted.crossings {
             println!("  tables: {}", crossing.note());
         }

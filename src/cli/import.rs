@@ -31,6 +31,11 @@ pub enum Format {
     Campaign(super::import_campaign::CampaignArgs),
     /// PX4 ULog files (`.ulg`): a file, or a folder of them as one series.
     Ulog(super::import_ulog::UlogArgs),
+    /// ROS 2 bags (rosbag2's MCAP storage) with `sensor_msgs/msg/Imu` and
+    /// `sensor_msgs/msg/Temperature` topics: a bag (file or folder), or a folder of bags as one
+    /// series.
+    #[command(visible_alias = "ros2")]
+    Rosbag(super::import_rosbag::RosbagArgs),
 }
 
 /// Options of `gyrodrift import csv`.
@@ -123,6 +128,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Format::Csv(csv) => run_csv(csv),
         Format::Campaign(campaign) => super::import_campaign::run(campaign),
         Format::Ulog(ulog) => super::import_ulog::run(ulog),
+        Format::Rosbag(rosbag) => super::import_rosbag::run(rosbag),
     }
 }
 

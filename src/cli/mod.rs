@@ -7,10 +7,12 @@ pub mod check;
 pub mod demo;
 pub mod diagnose;
 mod exit;
+pub mod export;
 mod extend;
 pub mod fit;
 pub mod import;
 pub mod import_campaign;
+pub mod import_rosbag;
 pub mod import_ulog;
 pub mod interrupt;
 mod measured;
@@ -109,8 +111,11 @@ pub enum Command {
     Check(check::Args),
     /// Rank what explains the residual the paper's model leaves.
     Diagnose(diagnose::Args),
-    /// Convert measured data (CSV) into a recording the other commands read.
+    /// Convert measured data (CSV, bench campaigns, PX4 ULog, ROS 2 bags) into recordings the
+    /// other commands read.
     Import(import::Args),
+    /// Write a recording in another format (ROS 2 bags with one message per sample).
+    Export(export::Args),
 }
 
 /// Runs one parsed command line.
@@ -123,6 +128,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Check(args) => check::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
         Command::Import(args) => import::run(&args),
+        Command::Export(args) => export::run(&args),
     }
 }
 

@@ -276,12 +276,84 @@ pub fn close<'a>(
         .copied()
         .collect();
     let kept = kept_before(&life, settings, &fitted.by_history.settings, clock);
-    let kept_training = &kept[roles.calibration.len()..][..roles.training.len()];
+    close_roles(fitted, roles, &life, &kept, settings, extend_model)
+}
+
+/// [`close`] with the judging on a separate source: the roles, stage 3's and the initial bias's
+/// choices, the diagnosis and the extended model come from `calibration_source` (one unit's
+/// activations of the data the tables were fitted on), and every activation of `evaluation` (the
+/// same unit's, recorded apart) is held out — none of them reaches a choice or a fit. The
+/// calibration source's own activations outside its roles are not judged on
+/// ([`Roles::not_judged`]; the diagnosis ranks on them when there are no training or selection
+/// activations, [`Roles::diagnosed`]). Each source is its own life of the unit: what firmware kept is followed
+/// within each, never from one into the other. Activations are known by their switch-on time
+/// ([`Keying`]), so the two sources' must differ (put the evaluation data after the calibration
+/// data on the clock); a shared one is an error.
+#[allow(clippy::too_many_arguments)]
+pub fn close_separate<'a>(
+    fitted: &FittedUnit,
+    calibration_source: impl IntoIterator<Item = &'a Segment>,
+    evaluation: impl IntoIterator<Item = &'a Segment>,
+    calibration_set_points: &[f64],
+    selection_set_points: &[f64],
+    settings: &FitSettings,
+    extend_model: bool,
+    clock: bool,
+) -> Result<Closed<'a>, FitError> {
+    let source: Vec<&Segment> = calibration_source.into_iter().collect();
+    let evaluation: Vec<&Segment> = evaluation.into_iter().collect();
+    let on: std::collections::HashSet<u64> = source.iter().map(|s| s.power_on_ns).collect();
+    if let Some(shared) = evaluation.iter().find(|s| on.contains(&s.power_on_ns)) {
+        return Err(FitError::Insufficient {
+            unit: fitted.unit_id.clone(),
+            what: format!(
+                "an evaluation activation (series {} activation {}) switches on at {} ns, as one of the calibration data's: move the evaluation data after the calibration data on the clock",
+                shared.labels.series, shared.labels.activation, shared.power_on_ns
+            ),
+        });
+    }
+    let mut roles = Roles::split(source.iter().copied(), calibration_set_points);
+    roles.hold_out_outside_range(fitted, settings);
+    roles.select(selection_set_points);
+    roles.not_judged = std::mem::replace(&mut roles.held_out, evaluation);
+    let life: Vec<&Segment> = source.iter().chain(&roles.held_out).copied().collect();
+    let core = &fitted.by_history.settings;
+    let mut kept = kept_before(&source, settings, core, clock);
+    kept.extend(kept_before(&roles.held_out, settings, core, clock));
+    close_roles(fitted, roles, &life, &kept, settings, extend_model)
+}
+
+/// The loop from its roles on: `kept[i]` is what firmware kept before `life[i]`, the unit's
+/// activations (every one of `roles`' among them).
+fn close_roles<'a>(
+    fitted: &FittedUnit,
+    roles: Roles<'a>,
+    life: &[&'a Segment],
+    kept: &[[Previous; 3]],
+    settings: &FitSettings,
+    extend_model: bool,
+) -> Result<Closed<'a>, FitError> {
+    let kept_of: std::collections::HashMap<u64, [Previous; 3]> = life
+        .iter()
+        .zip(kept)
+        .map(|(s, k)| (s.power_on_ns, *k))
+        .collect();
+    let kept_training: Vec<[Previous; 3]> = roles
+        .training
+        .iter()
+        .map(|s| {
+            kept_of
+                .get(&s.power_on_ns)
+                .copied()
+                .unwrap_or(Previous::NOTHING)
+        })
+        .collect();
+    let kept_training = kept_training.as_slice();
     let stage3 = choose_stage3(fitted, &roles.training, kept_training, settings);
     let keying = Keying::new(
         std::array::from_fn(|a| stage3[a].keyed_by_history),
-        &life,
-        &kept,
+        life,
+        kept,
     );
     let warm_start = warm_start::choose(fitted, &keying, &roles.training, settings);
     let keying = keying.with_warm_start(std::array::from_fn(|a| warm_start[a].chosen));

@@ -33,6 +33,9 @@ pub struct Roles<'a> {
     /// How many field-like activations at the calibration set points were moved to `held_out`
     /// because they switch on outside the calibrated ambient range.
     pub outside_range: usize,
+    /// With the judging on a separate source (`closing::close_separate`): the calibration
+    /// source's activations that would have been held out, and are not judged on.
+    pub not_judged: Vec<&'a Segment>,
 }
 
 impl<'a> Roles<'a> {
@@ -89,11 +92,15 @@ impl<'a> Roles<'a> {
     }
 
     /// The activations the diagnosis ranks candidates on: the training and selection ones when
-    /// there are any (so the held-out ones stay unseen until the before/after), else every
-    /// activation the fit did not see.
+    /// there are any (so the held-out ones stay unseen until the before/after), else the ones not
+    /// judged on (with a separate evaluation source), else every activation the fit did not see.
     pub fn diagnosed(&self) -> Vec<&'a Segment> {
         if self.training.is_empty() && self.selection.is_empty() {
-            self.held_out.clone()
+            if self.not_judged.is_empty() {
+                self.held_out.clone()
+            } else {
+                self.not_judged.clone()
+            }
         } else {
             self.training
                 .iter()

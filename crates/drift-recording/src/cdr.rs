@@ -38,6 +38,12 @@ impl Encoder {
         self.buf.extend_from_slice(&v.to_le_bytes());
         self
     }
+    /// An `int32`.
+    pub fn i32(&mut self, v: i32) -> &mut Self {
+        self.align(4);
+        self.buf.extend_from_slice(&v.to_le_bytes());
+        self
+    }
     /// A `float64`.
     pub fn f64(&mut self, v: f64) -> &mut Self {
         self.align(8);
@@ -93,6 +99,19 @@ impl<'a> Decoder<'a> {
         }
         Ok(Self { data, pos: 4 })
     }
+    /// Checks the encapsulation header of a message written by ROS 2: CDR little endian with any
+    /// options bytes (a DDS implementation may note its trailing padding there); big-endian CDR is
+    /// refused by name.
+    pub fn new_ros2(data: &'a [u8]) -> Result<Self, DecodeError> {
+        match data.get(..2) {
+            Some([0x00, 0x01]) if data.len() >= 4 => Ok(Self { data, pos: 4 }),
+            Some([0x00, 0x00]) => Err("big-endian CDR (encapsulation 00 00): only little-endian CDR is read; re-record on a little-endian machine or convert the bag".into()),
+            Some([a, b]) => Err(format!(
+                "encapsulation {a:02x} {b:02x} is not plain CDR (expected 00 01, little-endian XCDR1)"
+            )),
+            _ => Err(format!("message of {} bytes has no CDR encapsulation header", data.len())),
+        }
+    }
     fn align(&mut self, n: usize) {
         while (self.pos - HEADER.len()) % n != 0 {
             self.pos += 1;
@@ -123,6 +142,12 @@ impl<'a> Decoder<'a> {
         self.align(4);
         let b = self.take(4)?;
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    }
+    /// An `int32`.
+    pub fn i32(&mut self) -> Result<i32, DecodeError> {
+        self.align(4);
+        let b = self.take(4)?;
+        Ok(i32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
     /// A `float64`.
     pub fn f64(&mut self) -> Result<f64, DecodeError> {

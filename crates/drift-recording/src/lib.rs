@@ -8,7 +8,8 @@
 //! through it cannot see the truth.
 //! [`write_recording`] writes the same format from a real test bench's data, and [`read_csv`] reads
 //! measured data from CSV into the same segments; [`read_sheet_campaign`] reads a bench campaign
-//! kept as one CSV file per activation plus an activation sheet.
+//! kept as one CSV file per activation plus an activation sheet. [`ros2`] reads ROS 2 bags
+//! (`sensor_msgs/msg/Imu`, `sensor_msgs/msg/Temperature`) and writes recordings as ROS 2 bags.
 
 pub mod atomic;
 mod aux;
@@ -20,6 +21,7 @@ mod layout;
 mod messages;
 pub mod paper;
 mod read;
+pub mod ros2;
 pub mod schema;
 mod segment;
 mod sheet;

@@ -25,6 +25,8 @@ pub(crate) struct ChannelInfo {
     pub schema: Option<String>,
     /// Encoding of its schema (`ros2msg` for the format's own); `None` with no schema.
     pub schema_encoding: Option<String>,
+    /// Its schema's text (a `.msg` definition for `ros2msg`); empty with no schema.
+    pub schema_data: Vec<u8>,
     /// Encoding of its messages (`cdr` for the format's own).
     pub message_encoding: String,
     /// Channel metadata (e.g. `unit`).
@@ -49,7 +51,7 @@ pub(crate) fn for_each_message<E>(
             .with_validate_data_section_crc(true),
     );
     let mut rest = buf;
-    let mut schemas: HashMap<u16, (String, String)> = HashMap::new();
+    let mut schemas: HashMap<u16, (String, String, Vec<u8>)> = HashMap::new();
     let mut channels: HashMap<u16, ChannelInfo> = HashMap::new();
     while let Some(event) = reader.next_event() {
         let (opcode, data) = match event.map_err(Ok)? {
@@ -63,8 +65,8 @@ pub(crate) fn for_each_message<E>(
             LinearReadEvent::Record { data, opcode } => (opcode, data),
         };
         match mcap::parse_record(opcode, data).map_err(Ok)? {
-            Record::Schema { header, .. } => {
-                schemas.insert(header.id, (header.name, header.encoding));
+            Record::Schema { header, data } => {
+                schemas.insert(header.id, (header.name, header.encoding, data.into_owned()));
             }
             Record::Channel(channel) => {
                 if let Some(known) = channels.get(&channel.id) {
@@ -74,8 +76,12 @@ pub(crate) fn for_each_message<E>(
                 }
                 let schema = schemas.get(&channel.schema_id).cloned();
                 let info = ChannelInfo {
-                    schema_encoding: schema.as_ref().map(|(_, encoding)| encoding.clone()),
-                    schema: schema.map(|(name, _)| name),
+                    schema_encoding: schema.as_ref().map(|(_, encoding, _)| encoding.clone()),
+                    schema_data: schema
+                        .as_ref()
+                        .map(|(_, _, data)| data.clone())
+                        .unwrap_or_default(),
+                    schema: schema.map(|(name, _, _)| name),
                     message_encoding: channel.message_encoding,
                     topic: channel.topic,
                     metadata: channel.metadata,

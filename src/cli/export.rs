@@ -1,0 +1,141 @@
+//! `gyrodrift export ros2`: a recording → ROS 2 bags with one standard message per sample.
+//!
+//! The recording format batches 100 samples per message, which ROS tools and Foxglove plot as one
+//! point per message. The export writes one `sensor_msgs/msg/Imu` per sample (`angular_velocity`,
+//! rad/s) and one `sensor_msgs/msg/Temperature` per sample and axis (°C), stamped with the
+//! sample's time on the recording clock (`drift_recording::ros2::write_ros2_bag`). Output: one
+//! `.mcap` file with every activation, or a new folder with one bag per activation (a series that
+//! `gyrodrift import rosbag` reads back, off-times included).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use drift_recording::read_recording;
+use drift_recording::ros2::{write_ros2_bag, ExportTopics};
+
+/// Options of `gyrodrift export`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The target format.
+    #[command(subcommand)]
+    pub format: Format,
+}
+
+/// Target formats.
+#[derive(Debug, clap::Subcommand)]
+pub enum Format {
+    /// ROS 2 bags (rosbag2's MCAP storage): `sensor_msgs/msg/Imu` and `sensor_msgs/msg/Temperature`,
+    /// one message per sample.
+    #[command(visible_alias = "rosbag")]
+    Ros2(Ros2Args),
+}
+
+/// Options of `gyrodrift export ros2`.
+#[derive(Debug, clap::Args)]
+pub struct Ros2Args {
+    /// One recording (`.mcap` of the gyrodrift format, e.g. `<campaign>/recordings/<name>.mcap`).
+    pub recording: PathBuf,
+    /// Output: a `.mcap` file (every activation in one bag), or a new folder with one bag per
+    /// activation (`activation-001.mcap`, ...).
+    #[arg(long, short = 'o')]
+    pub out: PathBuf,
+    /// The `sensor_msgs/msg/Imu` topic.
+    #[arg(long, default_value = "/imu/data")]
+    pub gyro_topic: String,
+    /// The `sensor_msgs/msg/Temperature` topic of the X axis's sensor; the Y and Z axes' are
+    /// `<topic>/y` and `<topic>/z`.
+    #[arg(long, default_value = "/imu/temperature")]
+    pub temperature_topic: String,
+}
+
+/// Runs `gyrodrift export`.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    match &args.format {
+        Format::Ros2(ros2) => run_ros2(ros2),
+    }
+}
+
+fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        !args.recording.is_dir(),
+        "{}: a folder; give one recording file (a campaign folder holds one per unit, set point and series kind under recordings/)",
+        args.recording.display()
+    );
+    for (option, topic) in [
+        ("--gyro-topic", &args.gyro_topic),
+        ("--temperature-topic", &args.temperature_topic),
+    ] {
+        anyhow::ensure!(
+            topic.starts_with('/') && topic.len() > 1 && !topic.ends_with('/'),
+            "option `{option}`: `{topic}` is not a ROS topic name (expected e.g. /imu/data)"
+        );
+    }
+    let recording = read_recording(&args.recording)?;
+    let topics = ExportTopics {
+        imu: args.gyro_topic.clone(),
+        temperature: args.temperature_topic.clone(),
+    };
+    let samples: usize = recording.segments.iter().map(|s| s.len()).sum();
+    let frame = recording.unit_id.as_str();
+    if args.out.extension().is_some_and(|e| e == "mcap") {
+        let segments: Vec<_> = recording.segments.iter().collect();
+        let bytes = write_ros2_bag(&args.out, &segments, frame, &topics)?;
+        println!(
+            "{}: {} activations, {samples} samples → {} (per sample one message on {} and on each of {}; {bytes} bytes)",
+            args.recording.display(),
+            segments.len(),
+            args.out.display(),
+            topics.imu,
+            topics.temperature_axes().join(", ")
+        );
+        return Ok(());
+    }
+    super::import_campaign::refuse_existing(&args.out)?;
+    let stage = staging(&args.out);
+    let written = write_folder(&stage, &recording.segments, frame, &topics).and_then(|n| {
+        std::fs::rename(&stage, &args.out)
+            .with_context(|| format!("renaming {} to {}", stage.display(), args.out.display()))?;
+        Ok(n)
+    });
+    if written.is_err() {
+        // Best effort: the folder may not even exist.
+        let _ = std::fs::remove_dir_all(&stage);
+    }
+    let bytes = written?;
+    println!(
+        "{}: {} activations, {samples} samples → {} bags in {} ({bytes} bytes)",
+        args.recording.display(),
+        recording.segments.len(),
+        recording.segments.len(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The temporary folder beside `out` that becomes `out`.
+fn staging(out: &Path) -> PathBuf {
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "bags".into());
+    out.with_file_name(format!(".{name}.exporting-{}", std::process::id()))
+}
+
+fn write_folder(
+    folder: &Path,
+    segments: &[drift_recording::Segment],
+    frame: &str,
+    topics: &ExportTopics,
+) -> anyhow::Result<u64> {
+    if let Some(parent) = folder.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("creating {}", parent.display()))?;
+    }
+    std::fs::create_dir(folder).with_context(|| format!("creating {}", folder.display()))?;
+    let mut bytes = 0;
+    for (k, segment) in segments.iter().enumerate() {
+        let path = folder.join(format!("activation-{:03}.mcap", k + 1));
+        bytes += write_ros2_bag(&path, &[segment], frame, topics)?;
+    }
+    Ok(bytes)
+}
