@@ -2,9 +2,8 @@
 
 The corrector is drift-core's, the code the firmware runs, bound with pyo3: a `Corrector` holds a
 model (`ModifiedTables`, the paper's method, or a baseline: `PolynomialTables`,
-`RelativePolynomialTables`) and one unit's
-run-time state, and corrects one sample (`correct`) or numpy arrays (`correct_batch`) with the same
-f32 results as the firmware. The extended model (`ModifiedTables.extension`, `ExtraTerm`) adds
+`RelativePolynomialTables`) and one unit's run-time state, and corrects one sample (`correct`) or
+numpy arrays (`correct_batch`) with the same f32 results as the firmware. The extended model (`ModifiedTables.extension`, `ExtraTerm`) adds
 extra linear terms, some of which read auxiliary inputs passed as `aux=`.
 
 Around it, what the command line does: `simulate` a campaign, `Recording`/`Segment`/`load_campaign`
