@@ -108,7 +108,7 @@ pub struct ModifiedTables<const R: usize = 16, const A: usize = 12, const C: usi
 impl<const R: usize, const A: usize, const C: usize> ModifiedTables<R, A, C> {
     /// Tables with no axis data (which validation rejects), default settings and no extension: a
     /// constant, so firmware can place the tables in a `static` (zero-initialised RAM) and fill them
-    /// with [`decode_into`](crate::blob::decode_into), without building them on the stack.
+    /// with `blob::decode_into` (feature `serde`), without building them on the stack.
     pub const EMPTY: Self = Self {
         settings: Settings::DEFAULT,
         axes: [AxisTable::EMPTY, AxisTable::EMPTY, AxisTable::EMPTY],
