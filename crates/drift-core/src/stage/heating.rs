@@ -131,12 +131,24 @@ pub(crate) fn cached_k(
     rise_celsius: f32,
     margin_celsius: f32,
 ) -> Option<(f32, bool)> {
+    if curve == TOP {
+        let [lo, change] = *lower_knots;
+        // Keyed by history (the blend's knots carry a NaN rise, see `by_history`): `k` alone, as
+        // `at_time` makes it; every rise comparison below would be false, so nothing is flagged.
+        if lo.rise_celsius.is_nan() {
+            let k = lo.k_dps_per_celsius + change.k_dps_per_celsius * moment.fraction;
+            return Some((k, false));
+        }
+        // Above the last curve; a rise back below it searches again.
+        let lower = at_time(moment, *lower_knots);
+        if rise_celsius < lower.rise_celsius {
+            return None;
+        }
+        return Some(above_last(lower, rise_celsius, margin_celsius));
+    }
     let lower = at_time(moment, *lower_knots);
     if rise_celsius < lower.rise_celsius {
         return (curve == 0).then(|| below_first(lower, rise_celsius, margin_celsius));
-    }
-    if curve == TOP {
-        return Some(above_last(lower, rise_celsius, margin_celsius));
     }
     let upper = at_time(moment, *upper_knots);
     (rise_celsius < upper.rise_celsius).then(|| (between(lower, upper, rise_celsius), false))
