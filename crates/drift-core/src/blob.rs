@@ -25,6 +25,8 @@ use crate::model::Model;
 use crate::polynomial::{PolynomialTables, RelativePolynomialTables};
 use crate::table::ModifiedTables;
 
+mod in_place;
+
 /// First four bytes of every image.
 pub const MAGIC: [u8; 4] = *b"GYDT";
 /// The image format version: the only one this build writes and reads. Any change to the
@@ -53,10 +55,31 @@ pub enum Kind {
 pub trait Image: Model + Serialize + DeserializeOwned {
     /// The kind byte written in the header.
     const KIND: Kind;
+
+    /// Decodes `payload` (exactly one model) into `place` and validates it: what [`decode_into`]
+    /// does after the header and CRC. The default decodes by value and assigns only a validated
+    /// model (`place` unchanged on error), which suits small models; the paper's tables write in
+    /// place instead.
+    fn payload_into(payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
+        *place = from_payload(payload)?;
+        Ok(())
+    }
 }
 
 impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R, A, C> {
     const KIND: Kind = Kind::Modified;
+
+    /// Field by field into `place`: the stack holds one curve at a time, never the tables. On
+    /// error `place` is emptied (validation rejects it).
+    fn payload_into(payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
+        let decoded = in_place::fill_modified(place, payload)
+            .map_err(BlobError::Malformed)
+            .and_then(|()| place.validate().map_err(BlobError::Invalid));
+        if decoded.is_err() {
+            in_place::empty(place);
+        }
+        decoded
+    }
 }
 
 impl Image for PolynomialTables {
@@ -227,11 +250,45 @@ pub fn encode<M: Image>(model: &M, buffer: &mut [u8]) -> Result<usize, BlobError
     Ok(total)
 }
 
-/// Decodes and validates an image of model type `M`.
+/// Decodes and validates an image of model type `M`, returned by value.
 ///
-/// The decoded model is returned by value; for large tables on a small stack, decode once at
-/// start-up into a `static` (see `docs/embedded.md` for the stack this takes).
+/// Building the paper's tables by value takes several times their size in stack (serde's nested
+/// decoders): firmware decodes with [`decode_into`] instead, into a `static`.
 pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
+    from_payload(payload::<M>(bytes)?)
+}
+
+/// Decodes and validates an image of model type `M` into `place`, the firmware way: the paper's
+/// tables ([`ModifiedTables`]) are written field by field where they live (a `static`), so
+/// decoding needs well under 1 KB of stack whatever the tables' size (docs/embedded.md), and the
+/// result is the same model [`decode`] returns.
+///
+/// On error `place` does not hold the image's model: it is unchanged when the header or CRC is
+/// rejected; when the payload or its contents are, [`ModifiedTables`] are left empty (validation,
+/// and so [`Corrector::new`](crate::Corrector::new), rejects them) and smaller models unchanged.
+///
+/// ```
+/// use drift_core::blob::decode_into;
+/// use drift_core::ModifiedTables;
+/// # fn image() -> Vec<u8> {
+/// #     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/vectors.json")).unwrap();
+/// #     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+/// #     let hex = json["models"][0]["image_hex"].as_str().unwrap();
+/// #     (0..hex.len()).step_by(2).map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap()).collect()
+/// # }
+/// // Firmware keeps the tables in a `static` (e.g. cortex-m-rt's `static mut` in `#[entry]`,
+/// // initialised with `ModifiedTables::EMPTY` at no stack cost).
+/// let mut tables: ModifiedTables<8, 3, 16> = ModifiedTables::EMPTY;
+/// decode_into(&image(), &mut tables)?;
+/// assert!(drift_core::Corrector::new(&tables).is_ok());
+/// # Ok::<(), drift_core::blob::BlobError>(())
+/// ```
+pub fn decode_into<M: Image>(bytes: &[u8], place: &mut M) -> Result<(), BlobError> {
+    M::payload_into(payload::<M>(bytes)?, place)
+}
+
+/// The payload of an image of model type `M`, after checking the header, the length and the CRC.
+fn payload<M: Image>(bytes: &[u8]) -> Result<&[u8], BlobError> {
     let minimum = HEADER_LEN.saturating_add(TRAILER_LEN);
     if bytes.len() < minimum {
         // Check the magic of whatever is there first: a short non-image is "not an image".
@@ -285,6 +342,5 @@ pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
     if stored != computed {
         return Err(BlobError::CrcMismatch { stored, computed });
     }
-    let payload = body.get(HEADER_LEN..).unwrap_or_default();
-    from_payload(payload)
+    Ok(body.get(HEADER_LEN..).unwrap_or_default())
 }

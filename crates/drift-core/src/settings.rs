@@ -33,17 +33,20 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
-        Self {
-            raw_per_celsius: 200.0,
-            raw_at_zero_celsius: 0.0,
-            ambient_margin_celsius: 0.5,
-            rise_margin_celsius: 0.05,
-            stuck_after_samples: 2000,
-        }
+        Self::DEFAULT
     }
 }
 
 impl Settings {
+    /// The defaults ([`Default`]) as a constant, for `const` and `static` tables.
+    pub const DEFAULT: Self = Self {
+        raw_per_celsius: 200.0,
+        raw_at_zero_celsius: 0.0,
+        ambient_margin_celsius: 0.5,
+        rise_margin_celsius: 0.05,
+        stuck_after_samples: 2000,
+    };
+
     /// Checks that every value is finite and in its documented range.
     pub fn validate(&self) -> Result<(), Error> {
         let at = Location::default();

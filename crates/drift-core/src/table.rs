@@ -113,6 +113,15 @@ pub struct ModifiedTables<const R: usize = 16, const A: usize = 12, const C: usi
 }
 
 impl<const R: usize, const A: usize, const C: usize> ModifiedTables<R, A, C> {
+    /// Tables with no axis data (which validation rejects), default settings and no extension: a
+    /// constant, so firmware can place the tables in a `static` (zero-initialised RAM) and fill them
+    /// with `blob::decode_into` (feature `serde`), without building them on the stack.
+    pub const EMPTY: Self = Self {
+        settings: Settings::DEFAULT,
+        axes: [AxisTable::EMPTY, AxisTable::EMPTY, AxisTable::EMPTY],
+        extension: Extension::NONE,
+    };
+
     /// The validating constructor: returns the tables only if [`Model::validate`] accepts them.
     pub fn try_new(settings: Settings, axes: [AxisTable<R, A, C>; AXES]) -> Result<Self, Error> {
         let tables = Self {
@@ -133,6 +142,12 @@ impl<const R: usize, const A: usize, const C: usize> ModifiedTables<R, A, C> {
 }
 
 impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
+    /// An axis with no reference times and no ambients (which validation rejects).
+    pub const EMPTY: Self = Self {
+        reference_ms: Vec::new(),
+        ambients: Vec::new(),
+    };
+
     /// Whether stage 3 is keyed by the heating history (the curves carry their residual heat)
     /// rather than by the rise.
     pub fn keyed_by_history(&self) -> bool {

@@ -16,7 +16,9 @@
 mod common;
 
 use common::fixture::{self, FixtureTables};
-use drift_core::blob::{decode, encode, BlobError, FORMAT_VERSION, HEADER_LEN, MAGIC};
+use drift_core::blob::{
+    decode, decode_into, encode, BlobError, Image, FORMAT_VERSION, HEADER_LEN, MAGIC,
+};
 use drift_core::{Model, ModifiedTables, PolynomialTables, Problem};
 use proptest::prelude::*;
 
@@ -462,4 +464,69 @@ fn implausible_correlations_are_refused_by_name() {
     // At the limit it is still accepted: the bound refuses slips, not steep real units.
     tables.axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius = 100.0;
     assert!(tables.validate().is_ok());
+}
+
+/// `decode_into` (in place, the firmware's path) and `decode` (by value) agree on `bytes`: the same
+/// model or the same error. After an error the tables in place are empty (rejected by validation)
+/// or, for a header or CRC error, as they were.
+fn agree<M: Image + PartialEq + std::fmt::Debug + Clone>(bytes: &[u8], before: &M) {
+    let mut place = before.clone();
+    let by_value = decode::<M>(bytes);
+    let in_place = decode_into(bytes, &mut place);
+    match (&by_value, &in_place) {
+        (Ok(model), Ok(())) => assert_eq!(&place, model),
+        (Err(a), Err(b)) => {
+            assert_eq!(a, b);
+            assert!(&place == before || place.validate().is_err());
+        }
+        _ => panic!("decode gave {by_value:?}, decode_into {in_place:?}"),
+    }
+}
+
+/// The in-place decoder reads every fixture as the by-value one does, over tables that held
+/// another model, at two capacities (one too small: the same refusal).
+#[test]
+fn decoding_in_place_gives_the_by_value_model() {
+    let mut buffer = vec![0; 64 * 1024];
+    let previous = fixture::by_history();
+    for tables in [
+        fixture::modified(),
+        fixture::extended(),
+        fixture::by_history(),
+        fixture::warm_started(),
+    ] {
+        let len = encode(&tables, &mut buffer).unwrap();
+        agree::<FixtureTables>(&buffer[..len], &previous);
+        agree::<FixtureTables>(&buffer[..len], &FixtureTables::EMPTY);
+        agree::<ModifiedTables>(&buffer[..len], &ModifiedTables::EMPTY);
+        agree::<ModifiedTables<8, 4, 8>>(&buffer[..len], &ModifiedTables::EMPTY);
+        let mut place = previous.clone();
+        decode_into(&buffer[..len], &mut place).unwrap();
+        assert_eq!(place, tables);
+    }
+    for model in [fixture::standard(), fixture::third_order()] {
+        let len = encode(&model, &mut buffer).unwrap();
+        agree::<PolynomialTables>(&buffer[..len], &fixture::standard());
+    }
+}
+
+/// Both decoders agree on every truncation and every bit flip behind a recomputed CRC (so the
+/// mutation reaches the payload and the validation).
+#[test]
+fn decoding_in_place_agrees_on_damaged_payloads() {
+    let good = image();
+    let previous = fixture::warm_started();
+    let stride = if cfg!(miri) { 61 } else { 1 };
+    for len in (0..good.len()).step_by(stride * 7) {
+        agree::<FixtureTables>(&good[..len], &previous);
+    }
+    let mut bytes = good.clone();
+    for byte in (HEADER_LEN..good.len() - 4).step_by(stride) {
+        for bit in [0, 3, 7] {
+            bytes[byte] ^= 1 << bit;
+            reseal(&mut bytes);
+            agree::<FixtureTables>(&bytes, &previous);
+            bytes[byte] ^= 1 << bit;
+        }
+    }
 }

@@ -7,7 +7,7 @@
 //! Invariants: decoding never panics; an accepted image validates, runs a corrector, and
 //! survives encode → decode unchanged (images are not canonical: finding F1).
 
-use drift_core::blob::{decode, encode, Image, HEADER_LEN, TRAILER_LEN};
+use drift_core::blob::{decode, decode_into, encode, Image, HEADER_LEN, TRAILER_LEN};
 use drift_core::{Corrector, ModifiedTables, PolynomialTables, Sample};
 
 const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
@@ -29,9 +29,18 @@ pub fn prepare(mode: u8, bytes: &mut [u8]) {
     }
 }
 
-/// Decodes `bytes` as an `M`; whatever decodes must validate, re-encode and correct.
-fn check<M: Image + PartialEq + core::fmt::Debug>(bytes: &[u8]) {
-    let Ok(model) = decode::<M>(bytes) else {
+/// Decodes `bytes` as an `M`; whatever decodes must validate, re-encode and correct. The in-place
+/// decoder (the firmware's) must give the same model or the same error.
+fn check<M: Image + PartialEq + core::fmt::Debug + Default>(bytes: &[u8]) {
+    let decoded = decode::<M>(bytes);
+    let mut place = M::default();
+    let in_place = decode_into(bytes, &mut place);
+    match (&decoded, &in_place) {
+        (Ok(model), Ok(())) => assert_eq!(&place, model, "decode_into gives another model"),
+        (Err(a), Err(b)) => assert_eq!(a, b, "decode_into gives another error"),
+        _ => panic!("decode gave {decoded:?}, decode_into {in_place:?}"),
+    }
+    let Ok(model) = decoded else {
         return;
     };
     assert!(model.validate().is_ok(), "decoded model fails validation");

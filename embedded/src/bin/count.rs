@@ -9,7 +9,7 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use drift_core::blob::decode;
+use drift_core::blob::{decode, decode_into};
 use drift_core::{AxisModel, Corrector, Model, PolynomialTables, Previous, Sample};
 use gyrodrift_embedded::{FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, STANDARD};
 use panic_semihosting as _;
@@ -119,21 +119,29 @@ where
 
 #[entry]
 fn main() -> ! {
+    // The tables live in `static`s (cortex-m-rt makes these `&'static mut`), decoded in place.
+    static mut MODIFIED_TABLES: FirmwareTables = FirmwareTables::EMPTY;
+    static mut EXTENDED_TABLES: FirmwareTables = FirmwareTables::EMPTY;
+    static mut BY_HISTORY_TABLES: FirmwareTables = FirmwareTables::EMPTY;
     let samples = activation(1000);
     let at_1khz = activation(1);
-    let modified: Result<FirmwareTables, _> = decode(black_box(MODIFIED));
-    let standard: Result<PolynomialTables, _> = decode(black_box(STANDARD));
-    let extended: Result<FirmwareTables, _> = decode(black_box(EXTENDED));
-    let by_history: Result<FirmwareTables, _> = decode(black_box(BY_HISTORY));
-    match (modified, standard, extended, by_history) {
-        (Ok(modified), Ok(standard), Ok(extended), Ok(by_history)) => {
+    let decoded = (
+        decode_into(black_box(MODIFIED), MODIFIED_TABLES),
+        decode::<PolynomialTables>(black_box(STANDARD)),
+        decode_into(black_box(EXTENDED), EXTENDED_TABLES),
+        decode_into(black_box(BY_HISTORY), BY_HISTORY_TABLES),
+    );
+    let (modified, extended, by_history): (&FirmwareTables, &FirmwareTables, &FirmwareTables) =
+        (MODIFIED_TABLES, EXTENDED_TABLES, BY_HISTORY_TABLES);
+    match decoded {
+        (Ok(()), Ok(standard), Ok(()), Ok(())) => {
             hprintln!("samples per interval: {}", SAMPLES);
             hprintln!("interval 1: modified model, samples 1 s apart (worst case)");
-            measure(&modified, &samples, 1);
+            measure(modified, &samples, 1);
             hprintln!("interval 3: standard polynomial, samples 1 s apart");
             measure(&standard, &samples, 3);
             hprintln!("interval 5: modified model, 1000 Hz windows");
-            measure(&modified, &at_1khz, 5);
+            measure(modified, &at_1khz, 5);
             hprintln!("interval 7: harness only (loop, sample and output moves)");
             gyrodrift_marker(7);
             for sample in &samples {
@@ -142,17 +150,17 @@ fn main() -> ! {
             }
             gyrodrift_marker(8);
             hprintln!("interval 9: modified model + 4 extra terms (extended), samples 1 s apart");
-            measure_with_aux(&extended, &samples, 9);
+            measure_with_aux(extended, &samples, 9);
             hprintln!("interval 11: modified model + 4 extra terms (extended), 1000 Hz windows");
-            measure_with_aux(&extended, &at_1khz, 11);
+            measure_with_aux(extended, &at_1khz, 11);
             hprintln!(
                 "interval 13: modified model, stage 3 keyed by history (by_history, power_on_after), samples 1 s apart"
             );
-            measure_after(&by_history, &samples, 13);
+            measure_after(by_history, &samples, 13);
             hprintln!(
                 "interval 15: modified model, stage 3 keyed by history (by_history, power_on_after), 1000 Hz windows"
             );
-            measure_after(&by_history, &at_1khz, 15);
+            measure_after(by_history, &at_1khz, 15);
             debug::exit(debug::EXIT_SUCCESS);
         }
         _ => {

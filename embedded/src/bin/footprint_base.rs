@@ -9,7 +9,7 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::debug;
 #[allow(unused_imports)]
-use drift_core::{blob::decode, Corrector, Sample};
+use drift_core::{blob::decode_into, Corrector, Sample};
 #[allow(unused_imports)]
 use gyrodrift_embedded::{FirmwareTables, MODIFIED};
 use panic_semihosting as _;

@@ -9,16 +9,18 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::debug;
 #[allow(unused_imports)]
-use drift_core::{blob::decode, Corrector, Sample};
+use drift_core::{blob::decode_into, Corrector, Sample};
 #[allow(unused_imports)]
 use gyrodrift_embedded::{FirmwareTables, MODIFIED};
 use panic_semihosting as _;
 
 #[entry]
 fn main() -> ! {
+    static mut TABLES: FirmwareTables = FirmwareTables::EMPTY;
     let image = black_box(MODIFIED);
-    if let Ok(tables) = decode::<FirmwareTables>(image) {
-        if let Ok(mut corrector) = Corrector::new(&tables) {
+    if decode_into(image, TABLES).is_ok() {
+        let tables: &FirmwareTables = TABLES;
+        if let Ok(mut corrector) = Corrector::new(tables) {
             let _ = black_box(corrector.power_on(black_box([6600.0; 3])));
             let sample: Sample = black_box(Sample::default());
             black_box(corrector.correct(&sample));

@@ -9,16 +9,17 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::debug;
 #[allow(unused_imports)]
-use drift_core::{blob::decode, Corrector, Sample};
+use drift_core::{blob::decode_into, Corrector, Sample};
 #[allow(unused_imports)]
 use gyrodrift_embedded::{FirmwareTables, MODIFIED};
 use panic_semihosting as _;
 
 #[entry]
 fn main() -> ! {
+    static mut TABLES: FirmwareTables = FirmwareTables::EMPTY;
     let image = black_box(MODIFIED);
-    let tables = decode::<FirmwareTables>(image);
-    black_box(tables.is_ok());
+    let decoded = decode_into(image, TABLES);
+    black_box(decoded.is_ok());
     debug::exit(debug::EXIT_SUCCESS);
     #[allow(clippy::empty_loop)]
     loop {}

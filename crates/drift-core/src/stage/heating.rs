@@ -65,29 +65,28 @@ impl<'a, const R: usize> BlendedCurves<'a, R> {
     }
 
     /// Curve `c`'s blended knots around the current time; NaN where missing (only for tables that
-    /// skipped validation).
+    /// skipped validation). The ambient weight is tested once per curve, not per point: with no
+    /// weight the upper ambient is not read (its curves may be missing: clamped to the last one).
     #[inline(always)]
     fn knots(&self, c: usize) -> Knots {
         let points =
             |curves: &'a [Curve<R>]| curves.get(c).map_or(&[][..], |k| k.points.as_slice());
-        let (lower, upper) = (points(self.lower), points(self.upper));
-        let blend = |j: usize| match lower.get(j) {
-            Some(lower) if self.weight > 0.0 => match upper.get(j) {
-                Some(upper) => CurvePoint {
-                    rise_celsius: lerp(lower.rise_celsius, upper.rise_celsius, self.weight),
-                    k_dps_per_celsius: lerp(
-                        lower.k_dps_per_celsius,
-                        upper.k_dps_per_celsius,
-                        self.weight,
-                    ),
-                },
-                None => MISSING,
-            },
-            Some(lower) => *lower,
-            None => MISSING,
-        };
-        let lo = blend(self.time_lo);
-        let hi = blend(self.time_hi);
+        let at = |points: &[CurvePoint], j: usize| points.get(j).copied().unwrap_or(MISSING);
+        let lower = points(self.lower);
+        let (mut lo, mut hi) = (at(lower, self.time_lo), at(lower, self.time_hi));
+        if self.weight > 0.0 {
+            let upper = points(self.upper);
+            let blend = |lower: CurvePoint, upper: CurvePoint| CurvePoint {
+                rise_celsius: lerp(lower.rise_celsius, upper.rise_celsius, self.weight),
+                k_dps_per_celsius: lerp(
+                    lower.k_dps_per_celsius,
+                    upper.k_dps_per_celsius,
+                    self.weight,
+                ),
+            };
+            lo = blend(lo, at(upper, self.time_lo));
+            hi = blend(hi, at(upper, self.time_hi));
+        }
         [
             lo,
             CurvePoint {
@@ -132,12 +131,24 @@ pub(crate) fn cached_k(
     rise_celsius: f32,
     margin_celsius: f32,
 ) -> Option<(f32, bool)> {
+    if curve == TOP {
+        let [lo, change] = *lower_knots;
+        // Keyed by history (the blend's knots carry a NaN rise, see `by_history`): `k` alone, as
+        // `at_time` makes it; every rise comparison below would be false, so nothing is flagged.
+        if lo.rise_celsius.is_nan() {
+            let k = lo.k_dps_per_celsius + change.k_dps_per_celsius * moment.fraction;
+            return Some((k, false));
+        }
+        // Above the last curve; a rise back below it searches again.
+        let lower = at_time(moment, *lower_knots);
+        if rise_celsius < lower.rise_celsius {
+            return None;
+        }
+        return Some(above_last(lower, rise_celsius, margin_celsius));
+    }
     let lower = at_time(moment, *lower_knots);
     if rise_celsius < lower.rise_celsius {
         return (curve == 0).then(|| below_first(lower, rise_celsius, margin_celsius));
-    }
-    if curve == TOP {
-        return Some(above_last(lower, rise_celsius, margin_celsius));
     }
     let upper = at_time(moment, *upper_knots);
     (rise_celsius < upper.rise_celsius).then(|| (between(lower, upper, rise_celsius), false))

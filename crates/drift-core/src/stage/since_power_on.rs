@@ -66,8 +66,9 @@ impl Segment {
     /// Locates `since_power_on_ms` among strictly increasing `reference_ms`, starting the search at
     /// `hint` (the previous segment's low index): time moves forward, so the search usually ends one
     /// step from where it starts. A missing reference time reads as `u32::MAX` (only for tables
-    /// that skipped validation). Out of line: once per segment, not per sample.
-    #[inline(never)]
+    /// that skipped validation). Inlined into the model's out-of-line miss path: one call per
+    /// segment, not two.
+    #[inline(always)]
     pub fn locate(reference_ms: &[u32], since_power_on_ms: u32, hint: u8) -> Self {
         let last = reference_ms.len().saturating_sub(1);
         let at = |j: usize| reference_ms.get(j).copied().unwrap_or(u32::MAX);
