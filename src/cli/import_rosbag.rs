@@ -16,8 +16,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use drift_recording::ros2::{bag_files, read_bag, BagClock, BagTopics};
 use drift_recording::{
-    read_csv_bytes, CsvColumns, CsvOptions, CsvTiming, RateUnit, Recording, Segment, SeriesKind,
-    RAW_PER_CELSIUS,
+    read_csv_bytes, CsvOptions, Recording, Segment, SeriesKind, RAW_PER_CELSIUS,
 };
 
 /// Options of `gyrodrift import rosbag`.
@@ -161,20 +160,8 @@ pub fn run(args: &RosbagArgs) -> anyhow::Result<()> {
         args.rate_hz
     );
     let options = CsvOptions {
-        columns: CsvColumns {
-            rate_dps: ["gx".into(), "gy".into(), "gz".into()],
-            segment: None,
-            ..CsvColumns::default()
-        },
-        sample_rate_hz: args.rate_hz,
-        timing: CsvTiming::Resample {
-            max_gap_s: args.max_gap,
-        },
-        set_point_celsius: args.set_point,
-        series_kind: kind,
-        rate_unit: RateUnit::RadPerSec,
         unit_id: args.unit_id.clone(),
-        ..CsvOptions::default()
+        ..super::import_ulog::log_options(args.rate_hz, args.max_gap, args.set_point, kind)
     };
     super::import_campaign::refuse_existing(&args.out)?;
     let topics = BagTopics {

@@ -142,6 +142,30 @@ fn logs(path: &Path) -> anyhow::Result<Vec<PathBuf>> {
     Ok(files)
 }
 
+/// How a flight or robot log's messages become one activation's samples (shared with
+/// `import rosbag`): the gyro in rad/s as columns `gx gy gz`, resampled onto the output grid with
+/// gaps up to `max_gap_s`.
+pub(super) fn log_options(
+    sample_rate_hz: u32,
+    max_gap_s: f64,
+    set_point_celsius: Option<f64>,
+    series_kind: SeriesKind,
+) -> CsvOptions {
+    CsvOptions {
+        columns: CsvColumns {
+            rate_dps: ["gx".into(), "gy".into(), "gz".into()],
+            segment: None,
+            ..CsvColumns::default()
+        },
+        sample_rate_hz,
+        timing: CsvTiming::Resample { max_gap_s },
+        set_point_celsius,
+        series_kind,
+        rate_unit: RateUnit::RadPerSec,
+        ..CsvOptions::default()
+    }
+}
+
 /// Runs `gyrodrift import ulog`.
 pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
     let kind = SeriesKind::parse(&args.series_kind).with_context(|| {
@@ -150,21 +174,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
             args.series_kind
         )
     })?;
-    let options = CsvOptions {
-        columns: CsvColumns {
-            rate_dps: ["gx".into(), "gy".into(), "gz".into()],
-            segment: None,
-            ..CsvColumns::default()
-        },
-        sample_rate_hz: args.rate_hz,
-        timing: CsvTiming::Resample {
-            max_gap_s: args.max_gap,
-        },
-        set_point_celsius: args.set_point,
-        series_kind: kind,
-        rate_unit: RateUnit::RadPerSec,
-        ..CsvOptions::default()
-    };
+    let options = log_options(args.rate_hz, args.max_gap, args.set_point, kind);
     super::import_campaign::refuse_existing(&args.out)?;
     let files = logs(&args.path)?;
     let mut units: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
