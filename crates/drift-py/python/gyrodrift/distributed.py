@@ -62,7 +62,7 @@ WORKER_CONFIG: dict[str, Any] = {"distributed.nanny.pre-spawn-environ.MALLOC_TRI
 alone. Dask's nannies set `MALLOC_TRIM_THRESHOLD_=65536` in every worker they spawn (to give memory
 back to the system sooner). Setting it also turns off glibc's adaptive mmap threshold (mallopt(3)),
 so the fit's and the evaluation's large temporary buffers become fresh mappings, faulted in page by
-page, each time they are allocated: a task then runs markedly slower than in a plain process
+page, each time they are allocated: the same units then took 1.6–1.9× as long on two workers
 (docs/performance.md). Use it
 with `dask.config.set(WORKER_CONFIG)` around `LocalCluster(...)` (what `local_cluster` does), or on
 a real cluster in the workers' Dask configuration (`distributed.nanny.pre-spawn-environ:
@@ -82,8 +82,20 @@ def local_cluster(n_workers: int = 2, **kwargs: Any) -> LocalCluster:
 
 
 def peak_rss_bytes() -> int:
-    """This process's peak resident memory so far, bytes (`resource.getrusage`: Linux reports KiB,
-    macOS bytes; 0 where there is no `resource` module, on Windows)."""
+    """This process's peak resident memory so far, bytes: on Linux the kernel's high-water mark of
+    this process's own memory (`VmHWM` in /proc/self/status), elsewhere `resource.getrusage`'s
+    `ru_maxrss` (macOS: bytes; 0 on Windows, which has neither).
+
+    Not `ru_maxrss` on Linux: for a process started by fork and exec, as Dask's nannies and
+    multiprocessing's "spawn" start workers, it begins at the resident size of the parent at the
+    fork, so a worker spawned from a process holding 2 GB would report 2 GB."""
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024  # kB
+    except OSError:
+        pass
     try:
         import resource
     except ImportError:  # pragma: no cover - Windows
@@ -156,10 +168,10 @@ def process_unit(
     `notes`, `records` (the report's records, `Evaluation.records`), `check` (one record per axis;
     empty without recordings at the validation set points), `check_files`, `timings_s` (step →
     seconds: `evaluate`, `check`, `total`, and the pipeline's own steps prefixed `pipeline:`),
-    `peak_rss_bytes` (the process's peak resident memory when the task ends: in a worker, the
-    largest of every task it has run so far), `host` and `pid`. `error` is None, or the text of the
-    gyrodrift error the unit raised (a `FitError` for data the tables cannot be fitted from,
-    say), with the other results left empty: one bad unit does not stop the line.
+    `peak_rss_bytes` (the process's peak resident memory when the task ends, `peak_rss_bytes()`:
+    in a worker, the largest of every task it has run so far), `host` and `pid`. `error` is None,
+    or the text of the gyrodrift error the unit raised (a `FitError` for data the tables cannot be
+    fitted from, say), with the other results left empty: one bad unit does not stop the line.
     """
     started = time.perf_counter()
     files = [str(p) for p in paths]
