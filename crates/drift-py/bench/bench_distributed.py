@@ -15,10 +15,11 @@ evaluate, check) for every unit four ways, interleaved, best of `--repeats` each
 
 Only the work is timed (the loop in the child; `fan_out` with the cluster up and gyrodrift imported
 in its workers), not starting processes. Each way starts fresh processes, so a process's peak
-resident memory (`ru_maxrss`, reported by the tasks) covers the units it ran, and is printed beside
-its peak before the work. The Rust inside each task uses rayon on every core unless
-`--rayon-threads` caps it (RAYON_NUM_THREADS in the child and the workers). Prints the wall times,
-their ratio to one process, and each process's peak resident memory beside one unit's recordings.
+resident memory (`distributed.peak_rss_bytes`, reported by the tasks) covers the units it ran; it
+is printed beside its peak before the work. The Rust inside each task uses rayon on every core
+unless `--rayon-threads` caps it (RAYON_NUM_THREADS in the child and the workers). Prints the wall
+times, their ratio to one process, and each process's peak resident memory beside one unit's
+recordings.
 Exits 1 if the four ways give different results (table images, records, check records).
 """
 
@@ -125,7 +126,7 @@ def stable(results: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def peak_per_process(results: list[dict[str, Any]]) -> list[int]:
-    """The peak resident memory each process reported last (ru_maxrss only grows), bytes."""
+    """The peak resident memory each process reported last (a high-water mark: it only grows), bytes."""
     peaks: dict[int, int] = {}
     for r in results:
         peaks[r["pid"]] = max(peaks.get(r["pid"], 0), r["peak_rss_bytes"])
