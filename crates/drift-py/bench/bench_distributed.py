@@ -116,7 +116,8 @@ def on_cluster(folder: Path, workers: int, rayon_threads: int | None, dask_defau
     with cluster, Client(cluster) as client:  # type: ignore[no-untyped-call]
         client.run(importlib.import_module, "gyrodrift.distributed")  # imported before the clock starts
         idle = sorted(client.run(distributed.peak_rss_bytes).values())
-        trim = sorted({str(v) for v in client.run(os.environ.get, "MALLOC_TRIM_THRESHOLD_").values()})
+        # os.getenv, not os.environ.get: that bound method would pickle this process's environment.
+        trim = sorted({str(v) for v in client.run(os.getenv, "MALLOC_TRIM_THRESHOLD_").values()})
         print(f"  {workers} worker(s) up, their MALLOC_TRIM_THRESHOLD_: {', '.join(trim)}", flush=True)
         start = time.perf_counter()
         results = distributed.fan_out(client, folder)
