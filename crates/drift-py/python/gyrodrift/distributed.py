@@ -171,7 +171,8 @@ def process_unit(
     `peak_rss_bytes` (the process's peak resident memory when the task ends, `peak_rss_bytes()`:
     in a worker, the largest of every task it has run so far), `host` and `pid`. `error` is None,
     or the text of the gyrodrift error the unit raised (a `FitError` for data the tables cannot be
-    fitted from, say), with the other results left empty: one bad unit does not stop the line.
+    fitted from, say), with the results of the steps it did not reach left empty: one bad unit
+    does not stop the line.
     """
     started = time.perf_counter()
     files = [str(p) for p in paths]
