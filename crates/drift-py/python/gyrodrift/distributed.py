@@ -62,7 +62,7 @@ WORKER_CONFIG: dict[str, Any] = {"distributed.nanny.pre-spawn-environ.MALLOC_TRI
 alone. Dask's nannies set `MALLOC_TRIM_THRESHOLD_=65536` in every worker they spawn (to give memory
 back to the system sooner). Setting it also turns off glibc's adaptive mmap threshold (mallopt(3)),
 so the fit's and the evaluation's large temporary buffers become fresh mappings, faulted in page by
-page, each time they are allocated: the same units then took 1.6–1.9× as long on two workers
+page, each time they are allocated: the same units then took 1.5–1.9× as long on two workers
 (docs/performance.md). Use it
 with `dask.config.set(WORKER_CONFIG)` around `LocalCluster(...)` (what `local_cluster` does), or on
 a real cluster in the workers' Dask configuration (`distributed.nanny.pre-spawn-environ:
