@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # The Python module's checks, from a really clean state: a fresh venv in .venv-check/ (deleted and
-# recreated on every run), `pip install ./crates/drift-py[test,plot]` (a real PEP 517 build through
-# maturin, with matplotlib, pandas, mcap and mcap-ros2-support so the optional paths run), then pytest (with the CLI
-# binary, to compare simulated bytes), the benchmark scripts at their tiny size (a check that they
-# still run and that what they compare agrees; timings printed, never asserted), mypy's stubtest, a
-# strict type check of the package's Python code, the examples and the benchmarks, ruff, and the
-# examples themselves. Prints how long each step took. Safe to re-run; meant to be called from
-# scripts/check.sh (the single test command).
+# recreated on every run), `pip install ./crates/drift-py[test,plot,distributed]` (a real PEP 517
+# build through maturin, with matplotlib, pandas, mcap, mcap-ros2-support and dask so the optional
+# paths run), then pytest (with the CLI binary, to compare simulated bytes), the benchmark scripts at
+# their tiny size (a check that they still run and that what they compare agrees; timings printed,
+# never asserted), mypy's stubtest, a strict type check of the package's Python code, the examples
+# and the benchmarks, ruff, and the examples themselves. Prints how long each step took. Safe to
+# re-run; meant to be called from scripts/check.sh (the single test command).
 #
 # Needs: python3 >= 3.9 (with venv; installed via apt-get if missing), Rust (cargo), and PyPI.
 set -euo pipefail
@@ -46,10 +46,10 @@ make_venv() {
 install_package() {
     # Builds the abi3 wheel with maturin (fetched by pip into an isolated build environment) and
     # installs it with its test tools (pytest, hypothesis, mypy, ruff, pandas, mcap,
-    # mcap-ros2-support) and the plot
-    # extra (matplotlib); numpy is a runtime dependency.
-    "$VENV/bin/python" -m pip install --quiet "./crates/drift-py[test,plot]"
-    "$VENV/bin/python" -c 'import gyrodrift, numpy, pandas, matplotlib; print("gyrodrift", gyrodrift.__version__, "from", gyrodrift.__file__, "| numpy", numpy.__version__, "| pandas", pandas.__version__, "| matplotlib", matplotlib.__version__)'
+    # mcap-ros2-support), the plot extra (matplotlib) and the distributed extra (dask[distributed]);
+    # numpy is a runtime dependency.
+    "$VENV/bin/python" -m pip install --quiet "./crates/drift-py[test,plot,distributed]"
+    "$VENV/bin/python" -c 'import gyrodrift, numpy, pandas, matplotlib, dask; print("gyrodrift", gyrodrift.__version__, "from", gyrodrift.__file__, "| numpy", numpy.__version__, "| pandas", pandas.__version__, "| matplotlib", matplotlib.__version__, "| dask", dask.__version__)'
 }
 
 build_cli() {
@@ -106,7 +106,7 @@ run_examples() {
 "$PYTHON" --version
 command -v cargo >/dev/null || { echo "cargo not found: install Rust (rustup) first" >&2; exit 1; }
 step "fresh venv in $VENV" make_venv
-step "pip install ./crates/drift-py[test,plot] (maturin build)" install_package
+step "pip install ./crates/drift-py[test,plot,distributed] (maturin build)" install_package
 step "cargo build --release -p gyrodrift (the CLI)" build_cli
 step "pytest crates/drift-py/tests" run_pytest
 step "bench scripts at tiny size" run_benches

@@ -66,3 +66,19 @@ def test_report_table_prints_the_papers_table() -> None:
         assert "figures skipped" in out
     else:
         assert "saved 5 figures" in out
+
+
+def test_production_line_fits_every_unit_on_two_workers() -> None:
+    script = next(p for p in EXAMPLES if p.name == "production_line.py")
+    out = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, check=True, timeout=120
+    ).stdout
+    try:
+        import dask.distributed  # noqa: F401
+    except ImportError:
+        assert "pip install 'gyrodrift[distributed]'" in out, out
+        return
+    rows = [line.split(" | ") for line in out.splitlines() if line.startswith("| GIU-")]
+    assert [r[0] for r in rows] == ["| GIU-01", "| GIU-02", "| GIU-03"], out
+    assert all(r[2] == "XYZ" for r in rows), out  # every axis passes the check on +33 °C
+    assert "3 units on 2 workers" in out and "wrote 12 firmware images" in out, out
