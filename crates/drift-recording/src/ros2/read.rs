@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::decode::{decode_imu, decode_temperature};
+use super::definitions::{IMU_DEFINITION, IMU_SCHEMA, TEMPERATURE_DEFINITION, TEMPERATURE_SCHEMA};
 use super::msgdef::check_channel;
-use super::{IMU_DEFINITION, IMU_SCHEMA, TEMPERATURE_DEFINITION, TEMPERATURE_SCHEMA};
 use crate::messages::ChannelInfo;
 
 /// A bag could not be read as asked.

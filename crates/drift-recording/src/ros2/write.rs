@@ -2,7 +2,9 @@
 
 use std::path::Path;
 
-use super::{IMU_DEFINITION, IMU_SCHEMA, PROFILE_ROS2, TEMPERATURE_DEFINITION, TEMPERATURE_SCHEMA};
+use super::definitions::{
+    IMU_DEFINITION, IMU_SCHEMA, PROFILE_ROS2, TEMPERATURE_DEFINITION, TEMPERATURE_SCHEMA,
+};
 use crate::error::WriteError;
 use crate::segment::{temperature_reading, Segment, RAW_PER_CELSIUS};
 use crate::writer::McapFile;
