@@ -280,7 +280,7 @@ impl Campaign {
                 ));
             }
             check_ordered("protocol.chamber_period_min", p.chamber_period_min)?;
-            if !(p.chamber_period_min[0] > 0.0) {
+            if p.chamber_period_min[0] <= 0.0 {
                 return Err(bad(
                     "protocol.chamber_period_min",
                     &format!("must be > 0 min, got {:?}", p.chamber_period_min),
