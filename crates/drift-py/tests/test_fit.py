@@ -97,7 +97,9 @@ def test_the_relative_baseline_is_fitted_saved_and_corrects(campaign_dir: Path, 
     corrector = gyrodrift.Corrector(relative)
     assert corrector.model == relative
     corrector.power_on(segment.temperature_raw[0])
-    corrected, bias, _ = corrector.correct_batch(segment.since_power_on_ms, segment.rate_dps, segment.temperature_raw)
+    corrected, bias, _ = corrector.correct_batch(
+        segment.since_power_on_ms, segment.rate_dps, segment.temperature_raw
+    )
     # bias = q(T_on) + p(T) − p(T_on): at switch-on it is the registered turn-on bias alone.
     assert np.allclose(bias[0], corrector.initial_bias_dps, atol=1e-6)
     assert np.array_equal(corrected, segment.rate_dps - bias)

@@ -3,8 +3,9 @@
 The corrector is drift-core's, the code the firmware runs, bound with pyo3: a `Corrector` holds a
 model (`ModifiedTables`, the paper's method, or a baseline: `PolynomialTables`,
 `RelativePolynomialTables`) and one unit's run-time state, and corrects one sample (`correct`) or
-numpy arrays (`correct_batch`) with the same f32 results as the firmware. The extended model (`ModifiedTables.extension`, `ExtraTerm`) adds
-extra linear terms, some of which read auxiliary inputs passed as `aux=`.
+numpy arrays (`correct_batch`) with the same f32 results as the firmware. The extended model
+(`ModifiedTables.extension`, `ExtraTerm`) adds extra linear terms, some of which read auxiliary
+inputs passed as `aux=`.
 
 Around it, what the command line does: `simulate` a campaign, `Recording`/`Segment`/`load_campaign`
 for MCAP recordings (read, build from arrays, write), `fit` the tables, `evaluate` them on data the
@@ -39,9 +40,9 @@ from ._gyrodrift import (
     ModifiedTables,
     Output,
     PolynomialTables,
-    RelativePolynomialTables,
     Recording,
     RecordingError,
+    RelativePolynomialTables,
     Segment,
     Settings,
     TableError,
@@ -81,9 +82,9 @@ __all__ = [
     "ModifiedTables",
     "Output",
     "PolynomialTables",
-    "RelativePolynomialTables",
     "Recording",
     "RecordingError",
+    "RelativePolynomialTables",
     "Segment",
     "Settings",
     "TableError",

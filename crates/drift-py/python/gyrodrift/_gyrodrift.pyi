@@ -54,6 +54,7 @@ __all__ = [
     "PolynomialTables",
     "Recording",
     "RecordingError",
+    "RelativePolynomialTables",
     "Segment",
     "Settings",
     "TableError",

@@ -62,5 +62,7 @@ def paper_table(records: Iterable[Mapping[str, Any]], *, models: Sequence[str] =
                     continue
                 best, name = min(found)
                 ratios.append(f" {best / modified:.2f}× ({name}) |")
-        lines.append(f"| best baseline / modified | {set_point:+g} °C | {SPLIT_NAMES[split]} |{''.join(ratios)}")
+        lines.append(
+            f"| best baseline / modified | {set_point:+g} °C | {SPLIT_NAMES[split]} |{''.join(ratios)}"
+        )
     return "\n".join(lines) + "\n"
