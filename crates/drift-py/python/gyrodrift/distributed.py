@@ -53,7 +53,7 @@ __all__ = [
 
 _Path = Union[str, "os.PathLike[str]"]
 
-MODELS = ("modified", "by_history", "standard", "third_order")
+MODELS = ("modified", "by_history", "standard", "third_order", "relative")
 """The fitted models a task returns, as `FittedUnit` names them (the CLI's `tables/<unit>/` files)."""
 
 
@@ -225,10 +225,30 @@ def process_unit(
     except gyrodrift.GyrodriftError as error:
         result["error"] = f"{type(error).__name__}: {error}"
     timings["total"] = time.perf_counter() - started
+    return _with_worker(result)
+
+
+def _with_worker(result: dict[str, Any]) -> dict[str, Any]:
+    """`result` with where the task ran and the peak memory of its process."""
     result["peak_rss_bytes"] = peak_rss_bytes()
     result["host"] = socket.gethostname()
     result["pid"] = os.getpid()
     return result
+
+
+def _model_from_image(
+    image: bytes,
+) -> gyrodrift.ModifiedTables | gyrodrift.PolynomialTables | gyrodrift.RelativePolynomialTables:
+    """The model a firmware image holds, whichever kind it is (the image names its kind; a decoder
+    of another kind refuses it with `ImageError`)."""
+    try:
+        return gyrodrift.ModifiedTables.from_image(image)
+    except gyrodrift.ImageError:
+        pass
+    try:
+        return gyrodrift.PolynomialTables.from_image(image)
+    except gyrodrift.ImageError:
+        return gyrodrift.RelativePolynomialTables.from_image(image)
 
 
 def check_unit(
@@ -241,18 +261,14 @@ def check_unit(
     settings_json: str | None = None,
 ) -> dict[str, Any]:
     """Is a stored calibration still valid? One unit's firmware table image (`ModifiedTables` or a
-    polynomial baseline's, as `process_unit` returns it or `gyrodrift fit` writes it) run over new
+    baseline's, as `process_unit` returns it or `gyrodrift fit` writes it) run over new
     recordings of that unit, as `ModifiedTables.check` does: returns `check` (one record per axis),
     `timings_s`, `peak_rss_bytes`, `host`, `pid` and `error` (None or the gyrodrift error's text)."""
     started = time.perf_counter()
     result: dict[str, Any] = {"check": [], "error": None}
     try:
         settings = None if settings_json is None else gyrodrift.FitSettings.from_json(settings_json)
-        model: gyrodrift.ModifiedTables | gyrodrift.PolynomialTables
-        try:
-            model = gyrodrift.ModifiedTables.from_image(image)
-        except gyrodrift.ImageError:
-            model = gyrodrift.PolynomialTables.from_image(image)
+        model = _model_from_image(image)
         result["check"] = model.check(
             [str(p) for p in paths],
             max_drift=max_drift,
@@ -263,10 +279,7 @@ def check_unit(
     except gyrodrift.GyrodriftError as error:
         result["error"] = f"{type(error).__name__}: {error}"
     result["timings_s"] = {"total": time.perf_counter() - started}
-    result["peak_rss_bytes"] = peak_rss_bytes()
-    result["host"] = socket.gethostname()
-    result["pid"] = os.getpid()
-    return result
+    return _with_worker(result)
 
 
 def fan_out(
