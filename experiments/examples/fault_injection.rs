@@ -109,7 +109,7 @@ fn main() -> anyhow::Result<()> {
         ),
     ];
     let mut fitted = None;
-    println!("| fault (every validation activation) | modified °/s | Δ vs none | standard °/s | activation-axes flagged | fit on faulty calibration data |");
+    println!("| fault (every validation activation) | modified °/s | Δ vs none | standard (absolute) °/s | activation-axes flagged | fit on faulty calibration data |");
     println!("|---|---:|---:|---:|---:|---|");
     let mut clean = 0.0;
     for (name, faults, flag) in kinds {
