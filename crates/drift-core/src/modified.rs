@@ -334,15 +334,20 @@ fn saturating_u8_of(index: f32) -> u8 {
     index as u8
 }
 
+// `flags` reads `PastLast`'s flag as a mask of its discriminant.
+const _: () = assert!(
+    SegmentKind::PastLast as u16 == Flags::PAST_LAST_REFERENCE.0
+        && SegmentKind::BeforeFirst as u16 & Flags::PAST_LAST_REFERENCE.0 == 0
+        && SegmentKind::Between as u16 & Flags::PAST_LAST_REFERENCE.0 == 0
+        && SegmentKind::OnLast as u16 & Flags::PAST_LAST_REFERENCE.0 == 0
+);
+
 /// The modified model's envelope flags for one sample.
 #[inline(always)]
 fn flags(rise_out_of_span: bool, kind: SegmentKind) -> Flags {
-    let mut flags = Flags::NONE;
+    let mut flags = Flags(u16::from(kind as u8) & Flags::PAST_LAST_REFERENCE.0);
     if rise_out_of_span {
         flags |= Flags::RISE_OUT_OF_SPAN;
-    }
-    if kind == SegmentKind::PastLast {
-        flags |= Flags::PAST_LAST_REFERENCE;
     }
     flags
 }
