@@ -3,7 +3,6 @@
 //! between them by rise. A table keyed by history instead reads the two curves whose histories
 //! bracket the activation's residual heat at switch-on ([`by_history`]).
 
-use crate::error::saturating_u8;
 use crate::interp::lerp;
 use crate::stage::since_power_on::{Moment, Segment};
 use crate::table::{AmbientCurves, Curve, CurvePoint};
@@ -209,7 +208,8 @@ pub(crate) fn search<const R: usize>(
     *curve = if top {
         TOP
     } else {
-        saturating_u8(lo).min(TOP - 1)
+        // Clamped before the conversion, which then cannot fail: one comparison, not three.
+        u8::try_from(lo.min(usize::from(TOP - 1))).unwrap_or(TOP - 1)
     };
     interpolate(lower, upper, top, rise_celsius, margin_celsius)
 }
