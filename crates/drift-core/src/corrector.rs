@@ -436,7 +436,7 @@ fn correct_axis<A: AxisModel>(
     raw: f32,
 ) -> AxisOutput {
     let mut reading = read_axis(settings, celsius_per_raw, state, rate, raw);
-    if reading.healthy {
+    let bias_dps = if reading.healthy {
         let (drift, model_flags) = axis.drift(
             settings,
             &mut state.model,
@@ -444,9 +444,16 @@ fn correct_axis<A: AxisModel>(
             reading.celsius,
             reading.rise_celsius,
         );
-        hold_drift(state, &mut reading, drift, model_flags);
+        hold_drift(state, &mut reading, drift, model_flags)
+    } else {
+        state.bias_dps
+    };
+    AxisOutput {
+        corrected_dps: rate - bias_dps,
+        bias_dps,
+        flags: reading.flags,
+        rise_celsius: reading.rise_celsius,
     }
-    axis_output(state, &reading, rate)
 }
 
 /// What the shared checks found for one axis's reading.
@@ -498,25 +505,22 @@ fn read_axis<S>(
 }
 
 /// The model's answer for a healthy reading: its flags, and its drift held unless non-finite.
+/// Returns the held bias, so the output does not read back what was just stored.
 #[inline(always)]
-fn hold_drift<S>(state: &mut AxisState<S>, reading: &mut Reading, drift: f32, model_flags: Flags) {
+fn hold_drift<S>(
+    state: &mut AxisState<S>,
+    reading: &mut Reading,
+    drift: f32,
+    model_flags: Flags,
+) -> f32 {
     reading.flags |= model_flags;
     if plausible(drift) {
-        state.bias_dps = state.initial_bias_dps + drift;
+        let bias_dps = state.initial_bias_dps + drift;
+        state.bias_dps = bias_dps;
+        bias_dps
     } else {
         reading.flags |= Flags::MODEL_INVALID;
-    }
-}
-
-/// The axis's output from the held bias.
-#[inline(always)]
-fn axis_output<S>(state: &AxisState<S>, reading: &Reading, rate: f32) -> AxisOutput {
-    let bias_dps = state.bias_dps;
-    AxisOutput {
-        corrected_dps: rate - bias_dps,
-        bias_dps,
-        flags: reading.flags,
-        rise_celsius: reading.rise_celsius,
+        state.bias_dps
     }
 }
 

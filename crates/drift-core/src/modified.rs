@@ -246,7 +246,8 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         rise_celsius: f32,
     ) -> (f32, Flags) {
         let segment = state.segment();
-        if let Some(moment) = segment.moment(since_power_on_ms) {
+        let moment = segment.moment(since_power_on_ms);
+        if let Some(moment) = moment {
             let margin = settings.rise_margin_celsius;
             if let Some((k, beyond)) =
                 cached_k(&state.knots, state.curve, moment, rise_celsius, margin)
@@ -254,12 +255,13 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
                 return (k, flags(beyond, segment.kind));
             }
         }
-        self.correlation_searched(settings, state, since_power_on_ms, rise_celsius)
+        self.correlation_searched(settings, state, since_power_on_ms, rise_celsius, moment)
     }
 
     /// [`Self::correlation`] when the time left the cached segment or the rise left the bracket:
     /// locates the segment if needed and searches the blended curves. Out of line: a few samples
-    /// per segment.
+    /// per segment. `moment` is the time in the cached segment, as the caller found it (`None`:
+    /// outside).
     #[inline(never)]
     fn correlation_searched(
         &self,
@@ -267,9 +269,10 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         state: &mut ModifiedAxisState,
         since_power_on_ms: u32,
         rise_celsius: f32,
+        moment: Option<Moment>,
     ) -> (f32, Flags) {
         let mut segment = state.segment();
-        let moment = segment.moment(since_power_on_ms).unwrap_or_else(|| {
+        let moment = moment.unwrap_or_else(|| {
             segment = Segment::locate(&self.reference_ms, since_power_on_ms, segment.lo);
             state.set_segment(segment);
             segment.moment(since_power_on_ms).unwrap_or(Moment {
@@ -334,15 +337,20 @@ fn saturating_u8_of(index: f32) -> u8 {
     index as u8
 }
 
+// `flags` reads `PastLast`'s flag as a mask of its discriminant.
+const _: () = assert!(
+    SegmentKind::PastLast as u16 == Flags::PAST_LAST_REFERENCE.0
+        && SegmentKind::BeforeFirst as u16 & Flags::PAST_LAST_REFERENCE.0 == 0
+        && SegmentKind::Between as u16 & Flags::PAST_LAST_REFERENCE.0 == 0
+        && SegmentKind::OnLast as u16 & Flags::PAST_LAST_REFERENCE.0 == 0
+);
+
 /// The modified model's envelope flags for one sample.
 #[inline(always)]
 fn flags(rise_out_of_span: bool, kind: SegmentKind) -> Flags {
-    let mut flags = Flags::NONE;
+    let mut flags = Flags(u16::from(kind as u8) & Flags::PAST_LAST_REFERENCE.0);
     if rise_out_of_span {
         flags |= Flags::RISE_OUT_OF_SPAN;
-    }
-    if kind == SegmentKind::PastLast {
-        flags |= Flags::PAST_LAST_REFERENCE;
     }
     flags
 }

@@ -3,7 +3,6 @@
 //! between them by rise. A table keyed by history instead reads the two curves whose histories
 //! bracket the activation's residual heat at switch-on ([`by_history`]).
 
-use crate::error::saturating_u8;
 use crate::interp::lerp;
 use crate::stage::since_power_on::{Moment, Segment};
 use crate::table::{AmbientCurves, Curve, CurvePoint};
@@ -102,8 +101,8 @@ impl<'a, const R: usize> BlendedCurves<'a, R> {
 }
 
 /// A curve's point at `moment` from its knots (stage 1): `lerp` with the change precomputed, the
-/// rise scaled before the first reference time. The only place a point is made, so cached and
-/// fresh knots give the same bits.
+/// rise scaled before the first reference time. With [`at_time_scaled`] (the same arithmetic), the
+/// only place a point is made, so cached and fresh knots give the same bits.
 #[inline(always)]
 fn at_time(moment: Moment, [lo, change]: Knots) -> CurvePoint {
     let fraction = moment.fraction;
@@ -114,6 +113,17 @@ fn at_time(moment: Moment, [lo, change]: Knots) -> CurvePoint {
         } else {
             rise
         },
+        k_dps_per_celsius: lo.k_dps_per_celsius + change.k_dps_per_celsius * fraction,
+    }
+}
+
+/// [`at_time`] with the rise's factor chosen once per search (`fraction` before the first reference
+/// time, else 1): the same bits (`1 · rise` is `rise`), one multiplication per curve instead of a
+/// test and a select of the kept flag.
+#[inline(always)]
+fn at_time_scaled(fraction: f32, rise_scale: f32, [lo, change]: Knots) -> CurvePoint {
+    CurvePoint {
+        rise_celsius: rise_scale * (lo.rise_celsius + change.rise_celsius * fraction),
         k_dps_per_celsius: lo.k_dps_per_celsius + change.k_dps_per_celsius * fraction,
     }
 }
@@ -167,29 +177,39 @@ pub(crate) fn search<const R: usize>(
     knots: &mut [Knots; 2],
     curve: &mut u8,
 ) -> (f32, bool) {
+    let (fraction, rise_scale) = (
+        moment.fraction,
+        if moment.before_first {
+            moment.fraction
+        } else {
+            1.0
+        },
+    );
+    let point = |knots: Knots| at_time_scaled(fraction, rise_scale, knots);
     let last = curves.count().saturating_sub(1);
     let mut lo = usize::from(*curve).min(last);
     let mut lower_knots = curves.knots(lo);
-    let mut lower = at_time(moment, lower_knots);
+    let mut lower = point(lower_knots);
     while lower.rise_celsius > rise_celsius && lo > 0 {
         lo = lo.saturating_sub(1);
         lower_knots = curves.knots(lo);
-        lower = at_time(moment, lower_knots);
+        lower = point(lower_knots);
     }
     let mut upper_knots = curves.knots(lo.saturating_add(1));
-    let mut upper = at_time(moment, upper_knots);
+    let mut upper = point(upper_knots);
     while lo < last && upper.rise_celsius <= rise_celsius {
         lo = lo.saturating_add(1);
         (lower_knots, lower) = (upper_knots, upper);
         upper_knots = curves.knots(lo.saturating_add(1));
-        upper = at_time(moment, upper_knots);
+        upper = point(upper_knots);
     }
     let top = lo >= last;
     *knots = [lower_knots, upper_knots];
     *curve = if top {
         TOP
     } else {
-        saturating_u8(lo).min(TOP - 1)
+        // Clamped before the conversion, which then cannot fail: one comparison, not three.
+        u8::try_from(lo.min(usize::from(TOP - 1))).unwrap_or(TOP - 1)
     };
     interpolate(lower, upper, top, rise_celsius, margin_celsius)
 }

@@ -38,7 +38,13 @@ pub struct Segment {
 }
 
 /// Which stretch of time a [`Segment`] covers.
+///
+/// `PastLast`'s discriminant is the bit of
+/// [`Flags::PAST_LAST_REFERENCE`](crate::Flags::PAST_LAST_REFERENCE) and no other kind's shares
+/// it: every sample reads its flag as one mask, not a comparison and a select (3 instructions per
+/// axis on the Cortex-M4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u8)]
 pub enum SegmentKind {
     /// Before the first reference time: rises scaled, `k` held.
     #[default]
@@ -48,7 +54,7 @@ pub enum SegmentKind {
     /// Exactly on the last reference time.
     OnLast,
     /// Past the last reference time: held and flagged.
-    PastLast,
+    PastLast = 4,
 }
 
 /// A time inside its segment, as stage 3 reads the curves there.
@@ -87,21 +93,31 @@ impl Segment {
         while lo > 0 && at(lo) > since_power_on_ms {
             lo = lo.saturating_sub(1);
         }
-        while lo < last && at(lo.saturating_add(1)) <= since_power_on_ms {
+        // Forward over the times after `lo` (one bounds check for the walk, not one per step); the
+        // first one past the time ends the segment.
+        let mut start_ms = at(lo);
+        let mut end_ms = None;
+        for &time in reference_ms.get(lo.saturating_add(1)..).unwrap_or_default() {
+            if time > since_power_on_ms {
+                end_ms = Some(time);
+                break;
+            }
+            start_ms = time;
             lo = lo.saturating_add(1);
         }
-        let start_ms = at(lo);
-        let (start_ms, len_ms, per_ms, kind) = if lo < last {
-            let span = at(lo.saturating_add(1)).saturating_sub(start_ms);
-            // Spans are far below 2^24 ms, so exact in f32.
-            (start_ms, span, 1.0 / span as f32, SegmentKind::Between)
-        } else if since_power_on_ms == start_ms {
-            (start_ms, 1, 0.0, SegmentKind::OnLast)
-        } else {
-            // Past the last reference time: from the next millisecond to the end of time.
-            let start_ms = start_ms.saturating_add(1);
-            let len_ms = u32::MAX.saturating_sub(start_ms).saturating_add(1);
-            (start_ms, len_ms, 0.0, SegmentKind::PastLast)
+        let (start_ms, len_ms, per_ms, kind) = match end_ms {
+            Some(end_ms) => {
+                let span = end_ms.saturating_sub(start_ms);
+                // Spans are far below 2^24 ms, so exact in f32.
+                (start_ms, span, 1.0 / span as f32, SegmentKind::Between)
+            }
+            None if since_power_on_ms == start_ms => (start_ms, 1, 0.0, SegmentKind::OnLast),
+            None => {
+                // Past the last reference time: from the next millisecond to the end of time.
+                let start_ms = start_ms.saturating_add(1);
+                let len_ms = u32::MAX.saturating_sub(start_ms).saturating_add(1);
+                (start_ms, len_ms, 0.0, SegmentKind::PastLast)
+            }
         };
         Self {
             start_ms,
