@@ -274,6 +274,18 @@ impl<S: Copy + Default> CorrectorState<S> {
             }
             return count;
         }
+        self.correct_blocks_answered(model, samples, outputs);
+        count
+    }
+
+    /// The block path's loop, out of line so that its ~4 KiB of answers is on the stack only for
+    /// a model that answers: the paper's model pays nothing for it in `correct_block`.
+    #[inline(never)]
+    fn correct_blocks_answered<M>(&mut self, model: &M, samples: &[Sample], outputs: &mut [Output])
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
         let mut answered = Answers::default();
         let pairs = samples
             .chunks(BLOCK_SAMPLES)
@@ -285,7 +297,6 @@ impl<S: Copy + Default> CorrectorState<S> {
                 }
             }
         }
-        count
     }
 
     /// Up to [`BLOCK_SAMPLES`] samples of a powered-on activation without extension: the model's
