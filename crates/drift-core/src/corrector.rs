@@ -247,8 +247,10 @@ impl<S: Copy + Default> CorrectorState<S> {
     }
 
     /// Corrects `samples` in order into `outputs` without auxiliary inputs and returns how many
-    /// (the shorter of the two lengths): [`Self::correct`] sample by sample, so the same outputs
-    /// and the same final state, bit for bit.
+    /// (the shorter of the two lengths): the same outputs and the same final state, bit for bit, as
+    /// [`Self::correct`] sample by sample. A model with [`AxisModel::drift_of_temperatures`] (the
+    /// polynomial baselines) evaluates [`BLOCK_SAMPLES`] temperatures at once (~4 KiB of stack);
+    /// the checks, holds and flags still run sample by sample.
     pub fn correct_block<M>(
         &mut self,
         model: &M,
@@ -259,10 +261,108 @@ impl<S: Copy + Default> CorrectorState<S> {
         M: Model,
         M::Axis: AxisModel<State = S>,
     {
-        for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
-            *output = self.correct(model, sample);
+        let settings = model.settings();
+        let answers = self.is_powered_on()
+            && model.extension().is_empty()
+            && (model.axes().iter().zip(&self.axes)).all(|(axis, state)| {
+                axis.drift_of_temperatures(settings, &state.model, &[], &mut [], &mut [])
+            });
+        let count = samples.len().min(outputs.len());
+        if !answers {
+            for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
+                *output = self.correct(model, sample);
+            }
+            return count;
         }
-        samples.len().min(outputs.len())
+        self.correct_blocks_answered(model, samples, outputs);
+        count
+    }
+
+    /// The block path's loop, out of line so that its ~4 KiB of answers is on the stack only for
+    /// a model that answers: the paper's model pays nothing for it in `correct_block`.
+    #[inline(never)]
+    fn correct_blocks_answered<M>(&mut self, model: &M, samples: &[Sample], outputs: &mut [Output])
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        let mut answered = Answers::default();
+        let pairs = samples
+            .chunks(BLOCK_SAMPLES)
+            .zip(outputs.chunks_mut(BLOCK_SAMPLES));
+        for (samples, outputs) in pairs {
+            if !self.correct_answered(model, samples, outputs, &mut answered) {
+                for (sample, output) in samples.iter().zip(outputs.iter_mut()) {
+                    *output = self.correct(model, sample);
+                }
+            }
+        }
+    }
+
+    /// Up to [`BLOCK_SAMPLES`] samples of a powered-on activation without extension: the model's
+    /// drifts for every temperature first, then the per-sample checks with those answers.
+    /// `false`, and nothing changed, if the model does not answer.
+    fn correct_answered<M>(
+        &mut self,
+        model: &M,
+        samples: &[Sample],
+        outputs: &mut [Output],
+        answered: &mut Answers,
+    ) -> bool
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        let settings = model.settings();
+        let celsius_per_raw = settings.celsius_per_raw();
+        let count = samples.len();
+        let [celsius_x, celsius_y, celsius_z] = &mut answered.celsius;
+        let celsius = celsius_x
+            .iter_mut()
+            .zip(celsius_y.iter_mut().zip(celsius_z.iter_mut()));
+        for (sample, (x, (y, z))) in samples.iter().zip(celsius) {
+            // A healthy reading is the last good one, which the per-sample path converts: the same
+            // bits. The answers for the other readings are never read.
+            let [raw_x, raw_y, raw_z] = sample.temperature_raw;
+            *x = settings.celsius_with(raw_x, celsius_per_raw);
+            *y = settings.celsius_with(raw_y, celsius_per_raw);
+            *z = settings.celsius_with(raw_z, celsius_per_raw);
+        }
+        let lanes = answered
+            .celsius
+            .iter()
+            .zip(&mut answered.drift)
+            .zip(&mut answered.flags);
+        for ((axis, state), ((celsius, drift), flags)) in
+            model.axes().iter().zip(&self.axes).zip(lanes)
+        {
+            let celsius = celsius.get(..count).unwrap_or_default();
+            let drift = drift.get_mut(..count).unwrap_or_default();
+            let flags = flags.get_mut(..count).unwrap_or_default();
+            if !axis.drift_of_temperatures(settings, &state.model, celsius, drift, flags) {
+                return false;
+            }
+        }
+        let [state_x, state_y, state_z] = &mut self.axes;
+        let [drift_x, drift_y, drift_z] = &answered.drift;
+        let [flags_x, flags_y, flags_z] = &answered.flags;
+        let x = drift_x.iter().zip(flags_x);
+        let y = drift_y.iter().zip(flags_y);
+        let z = drift_z.iter().zip(flags_z);
+        let answers = x.zip(y.zip(z));
+        for ((sample, output), (x, (y, z))) in samples.iter().zip(outputs.iter_mut()).zip(answers) {
+            let [rate_x, rate_y, rate_z] = sample.rate_dps;
+            let [raw_x, raw_y, raw_z] = sample.temperature_raw;
+            let x = answered_axis(settings, celsius_per_raw, state_x, rate_x, raw_x, x);
+            let y = answered_axis(settings, celsius_per_raw, state_y, rate_y, raw_y, y);
+            let z = answered_axis(settings, celsius_per_raw, state_z, rate_z, raw_z, z);
+            *output = Output {
+                corrected_dps: [x.corrected_dps, y.corrected_dps, z.corrected_dps],
+                bias_dps: [x.bias_dps, y.bias_dps, z.bias_dps],
+                flags: [x.flags, y.flags, z.flags],
+            };
+        }
+        true
     }
 
     /// Corrects one sample, with the auxiliary inputs the extended model's extra terms may read
@@ -453,6 +553,45 @@ fn correct_axis<A: AxisModel>(
         bias_dps,
         flags: reading.flags,
         rise_celsius: reading.rise_celsius,
+    }
+}
+
+/// [`correct_axis`] with the model's answer for this sample's temperature already known.
+#[inline(always)]
+fn answered_axis<S>(
+    settings: &Settings,
+    celsius_per_raw: f32,
+    state: &mut AxisState<S>,
+    rate: f32,
+    raw: f32,
+    (&drift, &model_flags): (&f32, &Flags),
+) -> AxisOutput {
+    let mut reading = read_axis(settings, celsius_per_raw, state, rate, raw);
+    if reading.healthy {
+        hold_drift(state, &mut reading, drift, model_flags);
+    }
+    axis_output(state, &reading, rate)
+}
+
+/// Samples the block path evaluates at once: a multiple of the polynomial's lanes, few enough for
+/// the stack.
+const BLOCK_SAMPLES: usize = 128;
+
+/// The block path's per-axis temperatures and the model's answers for them. Reused from block to
+/// block; entries past a short block are neither evaluated nor read.
+struct Answers {
+    celsius: [[f32; BLOCK_SAMPLES]; AXES],
+    drift: [[f32; BLOCK_SAMPLES]; AXES],
+    flags: [[Flags; BLOCK_SAMPLES]; AXES],
+}
+
+impl Default for Answers {
+    fn default() -> Self {
+        Self {
+            celsius: [[0.0; BLOCK_SAMPLES]; AXES],
+            drift: [[0.0; BLOCK_SAMPLES]; AXES],
+            flags: [[Flags::NONE; BLOCK_SAMPLES]; AXES],
+        }
     }
 }
 

@@ -48,6 +48,24 @@ pub trait AxisModel {
         temperature_celsius: f32,
         rise_celsius: f32,
     ) -> (f32, Flags);
+
+    /// [`Self::drift`] for many temperatures at once, for a model whose drift depends on the
+    /// temperature alone (not on time, rise or a state that changes per sample): writes what
+    /// `drift` returns for each of `celsius` (°C) into `drift` and `model_flags` (the same
+    /// lengths), the same bits, and returns `true`. The corrector's block path asks before its
+    /// per-sample checks, so that the model's arithmetic runs in loops the compiler vectorises
+    /// (the polynomial baselines). The default writes nothing and returns `false`: the corrector
+    /// goes sample by sample. A model answers for every length (none included) or for none.
+    fn drift_of_temperatures(
+        &self,
+        _settings: &Settings,
+        _state: &Self::State,
+        _celsius: &[f32],
+        _drift: &mut [f32],
+        _model_flags: &mut [Flags],
+    ) -> bool {
+        false
+    }
 }
 
 /// A drift model for a whole unit: settings plus one [`AxisModel`] per axis.

@@ -21,8 +21,9 @@ mod common;
 use drift_core::blob::decode;
 use drift_core::{
     AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialAxis,
-    PolynomialTables, Previous, Sample, Settings,
+    PolynomialTables, Previous, RelativePolynomialAxis, RelativePolynomialTables, Sample, Settings,
 };
+use proptest::prelude::*;
 
 /// A block length for the cuts below (any length gives the same bits).
 const BLOCK_SAMPLES: usize = 128;
@@ -292,5 +293,108 @@ fn random_modified_activations_give_the_same_bits_in_blocks() {
             )
             .unwrap();
         check(&tables, state, &samples, &format!("modified run {run}"));
+    }
+}
+
+/// A temperature reading or a rate: mostly ordinary, sometimes a fault or an extreme value.
+fn reading(low: f32, high: f32) -> impl Strategy<Value = f32> {
+    prop_oneof![
+        30 => low..high,
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+        1 => Just(f32::NEG_INFINITY),
+        1 => Just(f32::MAX),
+        1 => Just(-3.0e38_f32),
+        1 => Just(-0.0_f32),
+    ]
+}
+
+/// A polynomial over a random range; now and then with coefficients that overflow (a non-finite or
+/// implausible drift, held and flagged).
+fn polynomial_axis() -> impl Strategy<Value = PolynomialAxis> {
+    let coefficient = prop_oneof![4 => -0.5f32..0.5, 1 => -3.0e38f32..3.0e38];
+    (
+        -20.0f32..60.0,
+        1.0f32..40.0,
+        prop::collection::vec(coefficient, 1..=8),
+    )
+        .prop_map(|(low, span, coefficients)| PolynomialAxis {
+            range_celsius: [low, low + span],
+            coefficients: coefficients.into_iter().collect(),
+        })
+}
+
+/// Samples in runs of the same temperature readings (so the stuck counter trips and resets),
+/// faults and extreme readings among them.
+fn samples() -> impl Strategy<Value = Vec<Sample>> {
+    let run = (
+        1usize..60,
+        prop::array::uniform3(reading(-4_000.0, 16_000.0)),
+        0u32..3_000,
+    );
+    (prop::collection::vec(run, 0..25), reading(-2.0, 2.0)).prop_map(|(runs, rate)| {
+        let mut ms = 0_u32;
+        runs.into_iter()
+            .flat_map(|(length, temperature_raw, step)| {
+                (0..length).map(move |i| (temperature_raw, step, i))
+            })
+            .map(|(temperature_raw, step, i)| {
+                ms = ms.wrapping_add(step);
+                Sample {
+                    since_power_on_ms: ms,
+                    // A fault (the generated rate) now and then, else an ordinary varying rate.
+                    rate_dps: [0, 1, 2].map(|a| {
+                        if (i + a) % 17 == 0 {
+                            rate
+                        } else {
+                            0.01 * (i + a) as f32
+                        }
+                    }),
+                    temperature_raw,
+                }
+            })
+            .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(if cfg!(miri) { 4 } else { 128 }))]
+
+    /// Both polynomial forms give the same bits and the same final state in blocks as sample by
+    /// sample, for any coefficients, stuck threshold and margin, through stuck runs, NaN and
+    /// infinite readings and rates, and readings far outside the range.
+    #[test]
+    fn polynomial_blocks_agree_with_samples(
+        axes in prop::array::uniform3(polynomial_axis()),
+        turn_on in prop::array::uniform3(polynomial_axis()),
+        stuck_after in prop::sample::select(vec![0_u16, 1, 2, 5, 20, 2000]),
+        margin in 0.0f32..2.0,
+        switch_on in prop::array::uniform3(-4_000.0f32..16_000.0),
+        powered_on in prop::bool::weighted(0.9),
+        samples in samples(),
+    ) {
+        let settings = Settings {
+            stuck_after_samples: stuck_after,
+            ambient_margin_celsius: margin,
+            ..Settings::default()
+        };
+        let absolute = PolynomialTables { settings, axes: axes.clone() };
+        let [x, y, z] = axes;
+        let [qx, qy, qz] = turn_on;
+        let relative = RelativePolynomialTables {
+            settings,
+            axes: [(x, qx), (y, qy), (z, qz)]
+                .map(|(drift, turn_on)| RelativePolynomialAxis { drift, turn_on }),
+        };
+        let mut state = CorrectorState::new();
+        if powered_on {
+            state.power_on(&absolute, switch_on).unwrap();
+        }
+        check(&absolute, state, &samples, "absolute");
+        let mut state = CorrectorState::new();
+        if powered_on {
+            state.power_on(&relative, switch_on).unwrap();
+        }
+        check(&relative, state, &samples, "relative");
     }
 }
