@@ -504,8 +504,9 @@ fn missing_calibration(
 enum Decoded {
     /// A calibration file's activations follow: its unit.
     File(String),
-    /// A calibration activation of that file.
-    Activation(Segment),
+    /// A calibration activation of that file (boxed: the channel's slots are as large as the
+    /// largest message).
+    Activation(Box<Segment>),
     /// The file was read whole and is valid: the samples of all its activations.
     End(u64),
     /// Why a file could not be read; nothing follows.
@@ -626,7 +627,7 @@ fn read_calibration(
         let mut samples = 0;
         let read = file.for_each_activation(|segment| {
             samples += segment.len() as u64;
-            !calibration_segment(&segment, options) || send(Decoded::Activation(segment))
+            !calibration_segment(&segment, options) || send(Decoded::Activation(Box::new(segment)))
         });
         match read {
             Ok(true) if send(Decoded::End(samples)) => {}
