@@ -4,9 +4,9 @@
 //! Recordings are read twice, file by file. The first pass decodes the calibration files one
 //! activation at a time on a thread of its own and analyses each activation (into small curves for
 //! the fits) as it arrives, so memory holds one file's bytes and a few activations' samples; the
-//! second holds one file's samples at a time and corrects every activation the fits did not see. Validation set points, field sessions and the noise-floor unit
-//! never reach a fit; at calibration set points each repeat is evaluated with tables refitted
-//! without it.
+//! second holds one file's samples at a time and corrects every activation the fits did not see.
+//! Validation set points, field sessions and the noise-floor unit never reach a fit; at
+//! calibration set points each repeat is evaluated with tables refitted without it.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
