@@ -1,19 +1,21 @@
 //! The main job, one way through: recordings → segments → fitted tables → corrector → residual →
 //! report data.
 //!
-//! Recordings are read twice, file by file, so memory holds one file's samples at a time: the first
-//! pass analyses the calibration activations (small curves) for the fits, the second corrects every
-//! activation the fits did not see. Validation set points, field sessions and the noise-floor unit
-//! never reach a fit; at calibration set points each repeat is evaluated with tables refitted
-//! without it.
+//! Recordings are read twice, file by file. The first pass decodes the calibration files one
+//! activation at a time on a thread of its own and analyses each activation (into small curves for
+//! the fits) as it arrives, so memory holds one file's bytes and a few activations' samples; the
+//! second holds one file's samples at a time and corrects every activation the fits did not see.
+//! Validation set points, field sessions and the noise-floor unit never reach a fit; at
+//! calibration set points each repeat is evaluated with tables refitted without it.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc::{channel, sync_channel, Receiver};
 use std::time::Instant;
 
 use drift_recording::{
-    paper, read_metadata, read_recording, ReadError, Segment, SeriesKind, COMPLETION_MARKER,
-    RECORDINGS_DIR, TRUTH_DIR,
+    paper, read_metadata, read_recording, OpenRecording, ReadError, Segment, SeriesKind,
+    COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR,
 };
 use rayon::prelude::*;
 
@@ -216,16 +218,23 @@ pub fn recording_files(dir: &Path) -> Result<Vec<PathBuf>, PipelineError> {
 /// protocol recording at a calibration set point, `Some(false)` for any other, `None` when the
 /// metadata lacks the set point or series kind (then the segments' own labels must decide).
 pub fn calibration_file(path: &Path, options: &Options) -> Result<Option<bool>, PipelineError> {
-    let metadata = read_metadata(path)?;
+    Ok(calibration_metadata(&read_metadata(path)?, options))
+}
+
+/// [`calibration_file`] from metadata already read.
+pub fn calibration_metadata(
+    metadata: &BTreeMap<String, String>,
+    options: &Options,
+) -> Option<bool> {
     let set_point = metadata
         .get("set_point_celsius")
         .and_then(|s| s.parse::<f64>().ok());
     let kind = metadata
         .get("series_kind")
         .and_then(|s| SeriesKind::parse(s));
-    Ok(set_point.zip(kind).map(|(set_point, kind)| {
+    set_point.zip(kind).map(|(set_point, kind)| {
         kind == SeriesKind::Protocol && is_one_of(set_point, &options.calibration_set_points)
-    }))
+    })
 }
 
 /// Whether an activation is calibration data: a protocol activation at a calibration set point.
@@ -433,6 +442,268 @@ fn evaluate_files<'a>(
     Ok(out)
 }
 
+/// The progress step of pass 1.
+const READ_STEP: &str = "reading and analysing calibration recordings";
+
+/// How many decoded activations may wait for their analysis: enough to ride out an analysis
+/// that falls behind for a moment, few enough that memory holds a handful of activations, never a
+/// recording's worth.
+const ACTIVATIONS_IN_FLIGHT: usize = 4;
+
+/// Stack of the threads that fit a unit early: fitted tables are large values, and the fit holds
+/// several at once (see `STACK_BYTES` in the command's `main.rs`). Only what is touched is
+/// committed.
+const FIT_STACK_BYTES: usize = 64 << 20;
+
+/// A unit's tables from all its calibration activations, and the refits per left-out repeat.
+type UnitFits = (FittedUnit, Vec<(u32, FittedUnit)>);
+
+/// Fits `analysed` (one unit's calibration activations, in file order) and, with
+/// `options.held_out_repeats` and more than one repeat, once more without each repeat.
+fn fit_with_refits(analysed: &[Analysed], options: &Options) -> Result<UnitFits, FitError> {
+    let all = fit_unit(analysed, &options.fit)?;
+    let mut refits = Vec::new();
+    if options.held_out_repeats {
+        let repeats: BTreeSet<u32> = analysed.iter().map(|a| a.labels.repeat).collect();
+        if repeats.len() > 1 {
+            for &repeat in &repeats {
+                let rest: Vec<Analysed> = analysed
+                    .iter()
+                    .filter(|a| a.labels.repeat != repeat)
+                    .cloned()
+                    .collect();
+                refits.push((repeat, fit_unit(&rest, &options.fit)?));
+            }
+        }
+    }
+    Ok((all, refits))
+}
+
+/// The error for a unit whose activations lack one of the calibration set points, if they do.
+fn missing_calibration(
+    unit: &str,
+    analysed: &[Analysed],
+    options: &Options,
+) -> Option<PipelineError> {
+    let mut found = Vec::new();
+    for a in analysed {
+        note_set_point(&mut found, a.labels.set_point_celsius);
+    }
+    let set_point = *options
+        .calibration_set_points
+        .iter()
+        .find(|s| !is_one_of(**s, &found))?;
+    Some(PipelineError::MissingCalibration {
+        unit: unit.to_owned(),
+        set_point,
+        found,
+    })
+}
+
+/// What the reading thread hands the analysing one, in file order.
+enum Decoded {
+    /// A calibration file's activations follow: its unit.
+    File(String),
+    /// A calibration activation of that file (boxed: the channel's slots are as large as the
+    /// largest message).
+    Activation(Box<Segment>),
+    /// The file was read whole and is valid: the samples of all its activations.
+    End(u64),
+    /// Why a file could not be read; nothing follows.
+    Failed(PipelineError),
+}
+
+/// Pass 1's result.
+struct PassOne {
+    /// The calibration activations, analysed, per unit in file and activation order.
+    by_unit: BTreeMap<String, Vec<Analysed>>,
+    /// Fits started while later files were read: how many activations each saw, and its result.
+    early_fits: BTreeMap<String, (usize, Result<UnitFits, FitError>)>,
+    samples_read: u64,
+    read_seconds: f64,
+    analyse_seconds: f64,
+}
+
+/// Reads `files` in order on one thread and analyses their calibration activations on the
+/// calling one as they arrive, so the analysis hides behind the decoding, and memory holds one
+/// file's bytes and a few activations, not a recording's samples. The activations reach the
+/// analysis in file and activation order whatever the threads' timing, so the fits see exactly
+/// what a file-by-file reading gives them; and the first fault in that order is the error: a file
+/// that fails to read wins over an activation of it that fails to analyse, as when each file was
+/// read whole before its analysis.
+///
+/// When a calibration file of another unit begins, the unit before it is fitted on a thread of
+/// its own while the reading goes on: files are usually grouped by unit (sorted by name), and if
+/// the unit comes back later the early fit is not used.
+fn read_and_analyse(
+    files: &[PathBuf],
+    options: &Options,
+    progress: Progress<'_>,
+) -> Result<PassOne, PipelineError> {
+    let (sender, receiver) = sync_channel(ACTIVATIONS_IN_FLIGHT);
+    std::thread::scope(|scope| {
+        let reader = std::thread::Builder::new()
+            .name("gyrodrift-read".into())
+            .spawn_scoped(scope, move || {
+                read_calibration(files, options, progress, |d| sender.send(d).is_ok())
+            });
+        let reader = match reader {
+            Ok(reader) => reader,
+            // Without a second thread, read everything on this one first (the same activations
+            // in the same order, all in memory at once), then analyse.
+            Err(_) => {
+                let (sender, receiver) = channel();
+                let read_seconds =
+                    read_calibration(files, options, progress, |d| sender.send(d).is_ok());
+                drop(sender);
+                let mut pass = analyse_calibration(receiver, options, |_, _| {});
+                if let Ok(pass) = &mut pass {
+                    pass.read_seconds = read_seconds;
+                }
+                return pass;
+            }
+        };
+        let mut early = Vec::new();
+        let mut pass = analyse_calibration(receiver, options, |unit, analysed| {
+            let snapshot = analysed.to_vec();
+            let fit = std::thread::Builder::new()
+                .name("gyrodrift-fit".into())
+                .stack_size(FIT_STACK_BYTES)
+                .spawn_scoped(scope, move || {
+                    let fits = fit_with_refits(&snapshot, options);
+                    (snapshot.len(), fits)
+                });
+            // Without a thread, the unit is fitted after the reading, as any other.
+            if let Ok(fit) = fit {
+                early.push((unit.to_owned(), fit));
+            }
+        });
+        let read_seconds = reader
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        let early_fits: BTreeMap<String, (usize, Result<UnitFits, FitError>)> = early
+            .into_iter()
+            .map(|(unit, fit)| {
+                let fit = fit
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+                (unit, fit)
+            })
+            .collect();
+        if let Ok(pass) = &mut pass {
+            pass.read_seconds = read_seconds;
+            pass.early_fits = early_fits;
+        }
+        pass
+    })
+}
+
+/// Pass 1's reading half: each file's metadata, then the calibration files decoded activation by
+/// activation into `send`, until the end, a file that fails, or `send` returns `false` (the
+/// analysis stopped listening). Returns the seconds it took.
+fn read_calibration(
+    files: &[PathBuf],
+    options: &Options,
+    progress: Progress<'_>,
+    mut send: impl FnMut(Decoded) -> bool,
+) -> f64 {
+    let started = Instant::now();
+    for (i, path) in files.iter().enumerate() {
+        progress(READ_STEP, i as u64, files.len() as u64);
+        let file = match OpenRecording::open(path) {
+            Ok(file) => file,
+            Err(e) => {
+                send(Decoded::Failed(e.into()));
+                break;
+            }
+        };
+        if calibration_metadata(file.metadata(), options) == Some(false) {
+            // Validation and field recordings are never decoded for the fit.
+            continue;
+        }
+        if !send(Decoded::File(file.unit_id().to_owned())) {
+            break;
+        }
+        let mut samples = 0;
+        let read = file.for_each_activation(|segment| {
+            samples += segment.len() as u64;
+            !calibration_segment(&segment, options) || send(Decoded::Activation(Box::new(segment)))
+        });
+        match read {
+            Ok(true) if send(Decoded::End(samples)) => {}
+            Ok(_) => break,
+            Err(e) => {
+                send(Decoded::Failed(e.into()));
+                break;
+            }
+        }
+    }
+    started.elapsed().as_secs_f64()
+}
+
+/// Pass 1's analysing half: analyses the activations from `receiver` in the order they come,
+/// keeping a file's only once the whole file has read valid. Calls `unit_done` with a unit and
+/// its activations when a file of another unit begins, if the unit has every calibration set
+/// point and was not handed over before.
+fn analyse_calibration(
+    receiver: Receiver<Decoded>,
+    options: &Options,
+    mut unit_done: impl FnMut(&str, &[Analysed]),
+) -> Result<PassOne, PipelineError> {
+    let mut pass = PassOne {
+        by_unit: BTreeMap::new(),
+        early_fits: BTreeMap::new(),
+        samples_read: 0,
+        read_seconds: 0.0,
+        analyse_seconds: 0.0,
+    };
+    let mut unit = String::new();
+    let mut handed_over = BTreeSet::new();
+    let mut file: Vec<Analysed> = Vec::new();
+    let mut failed: Option<FitError> = None;
+    for decoded in receiver {
+        match decoded {
+            Decoded::File(next) => {
+                if next != unit {
+                    if let Some(analysed) = pass.by_unit.get(&unit) {
+                        if missing_calibration(&unit, analysed, options).is_none()
+                            && handed_over.insert(unit.clone())
+                        {
+                            unit_done(&unit, analysed);
+                        }
+                    }
+                }
+                unit = next;
+            }
+            Decoded::Activation(segment) => {
+                if failed.is_some() {
+                    continue;
+                }
+                let started = Instant::now();
+                match analyse(&segment, &options.fit) {
+                    Ok(analysed) => file.push(analysed),
+                    Err(e) => failed = Some(e),
+                }
+                pass.analyse_seconds += started.elapsed().as_secs_f64();
+            }
+            Decoded::End(samples) => {
+                if let Some(e) = failed {
+                    return Err(e.into());
+                }
+                pass.samples_read += samples;
+                if !file.is_empty() {
+                    pass.by_unit
+                        .entry(unit.clone())
+                        .or_default()
+                        .append(&mut file);
+                }
+            }
+            Decoded::Failed(e) => return Err(e),
+        }
+    }
+    Ok(pass)
+}
+
 /// Fits every unit found in `files` and evaluates on everything the fits did not see.
 /// With `noise_floor`, the units have no systematic drift: their validation results are labelled
 /// [`Split::NoiseFloor`] and nothing else of theirs is evaluated.
@@ -452,48 +723,14 @@ pub fn run(
         return Err(PipelineError::CalibrationIsValidation { set_point });
     }
 
-    // Pass 1: read, analyse calibration activations.
-    let mut read_seconds = 0.0;
-    let mut analyse_seconds = 0.0;
-    let mut by_unit: BTreeMap<String, Vec<Analysed>> = BTreeMap::new();
-    for (i, path) in files.iter().enumerate() {
-        progress(
-            "reading and analysing calibration recordings",
-            i as u64,
-            files.len() as u64,
-        );
-        let started = Instant::now();
-        if calibration_file(path, options)? == Some(false) {
-            // Validation and field recordings are never decoded for the fit.
-            continue;
-        }
-        let recording = read_recording(path)?;
-        read_seconds += started.elapsed().as_secs_f64();
-        outcome.samples_read += recording
-            .segments
-            .iter()
-            .map(|s| s.len() as u64)
-            .sum::<u64>();
-        let started = Instant::now();
-        let analysed: Vec<Analysed> = recording
-            .segments
-            .par_iter()
-            .filter(|s| calibration_segment(s, options))
-            .map(|s| analyse(s, settings))
-            .collect::<Result<_, _>>()?;
-        analyse_seconds += started.elapsed().as_secs_f64();
-        if !analysed.is_empty() {
-            by_unit
-                .entry(recording.unit_id.clone())
-                .or_default()
-                .extend(analysed);
-        }
-    }
-    progress(
-        "reading and analysing calibration recordings",
-        files.len() as u64,
-        files.len() as u64,
-    );
+    // Pass 1: read and analyse the calibration activations, fitting each unit whose files are
+    // all read while the next unit's are decoded.
+    let pass = read_and_analyse(files, options, progress)?;
+    progress(READ_STEP, files.len() as u64, files.len() as u64);
+    outcome.samples_read = pass.samples_read;
+    let (read_seconds, analyse_seconds) = (pass.read_seconds, pass.analyse_seconds);
+    let by_unit = pass.by_unit;
+    let mut early = pass.early_fits;
 
     // Units are entered only with analysed activations, so every entry is non-empty.
     if by_unit.is_empty() {
@@ -506,40 +743,24 @@ pub fn run(
     // Every unit must have every calibration set point: tables fitted on fewer ambients than
     // asked for would be extrapolated silently.
     for (unit, analysed) in &by_unit {
-        let mut found = Vec::new();
-        for a in analysed {
-            note_set_point(&mut found, a.labels.set_point_celsius);
-        }
-        if let Some(&set_point) = options
-            .calibration_set_points
-            .iter()
-            .find(|s| !is_one_of(**s, &found))
-        {
-            return Err(PipelineError::MissingCalibration {
-                unit: unit.clone(),
-                set_point,
-                found,
-            });
+        if let Some(missing) = missing_calibration(unit, analysed, options) {
+            return Err(missing);
         }
     }
 
-    // Fits: all calibration data, and one per left-out repeat.
+    // Fits: all calibration data, and one per left-out repeat; an early fit counts only if it
+    // saw every activation of its unit.
     let started = Instant::now();
     let mut held_out: BTreeMap<(String, u32), FittedUnit> = BTreeMap::new();
     for (unit, analysed) in &by_unit {
-        outcome.fitted.push(fit_unit(analysed, settings)?);
-        if options.held_out_repeats {
-            let repeats: BTreeSet<u32> = analysed.iter().map(|a| a.labels.repeat).collect();
-            if repeats.len() > 1 {
-                for &repeat in &repeats {
-                    let rest: Vec<Analysed> = analysed
-                        .iter()
-                        .filter(|a| a.labels.repeat != repeat)
-                        .cloned()
-                        .collect();
-                    held_out.insert((unit.clone(), repeat), fit_unit(&rest, settings)?);
-                }
-            }
+        let fits = match early.remove(unit) {
+            Some((seen, fits)) if seen == analysed.len() => fits,
+            _ => fit_with_refits(analysed, options),
+        };
+        let (all, refits) = fits?;
+        outcome.fitted.push(all);
+        for (repeat, fitted) in refits {
+            held_out.insert((unit.clone(), repeat), fitted);
         }
     }
     let fit_seconds = started.elapsed().as_secs_f64();

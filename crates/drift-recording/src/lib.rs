@@ -42,7 +42,7 @@ pub use layout::{AUX_RATE_HZ, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR, TRUT
 pub use messages::RECORD_LENGTH_LIMIT;
 pub use read::{
     is_truth_path, read_campaign_dir, read_metadata, read_recording, read_recording_bytes,
-    Recording, REQUIRED_TOPICS,
+    OpenRecording, Recording, REQUIRED_TOPICS,
 };
 pub use segment::{
     temperature_reading, AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS,

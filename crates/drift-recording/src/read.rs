@@ -264,7 +264,70 @@ pub fn read_metadata(path: &Path) -> Result<BTreeMap<String, String>, ReadError>
 
 /// Reads and validates one recording.
 pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
-    decode(path, open(path)?)
+    OpenRecording::open(path)?.read()
+}
+
+/// A recording file read into memory and checked up to its metadata (the checks of
+/// [`read_metadata`]), its messages not yet decoded: a reader that chooses files by their metadata
+/// reads each file once, and one that wants activations one at a time never holds a whole
+/// recording's samples.
+pub struct OpenRecording {
+    path: PathBuf,
+    opened: Opened,
+}
+
+impl OpenRecording {
+    /// Reads the file and checks it up to its metadata, as [`read_metadata`] does.
+    pub fn open(path: &Path) -> Result<Self, ReadError> {
+        Ok(Self {
+            path: path.to_path_buf(),
+            opened: open(path)?,
+        })
+    }
+
+    /// The `gyrodrift.recording` metadata record.
+    pub fn metadata(&self) -> &BTreeMap<String, String> {
+        &self.opened.metadata
+    }
+
+    /// Unit id.
+    pub fn unit_id(&self) -> &str {
+        &self.opened.unit_id
+    }
+
+    /// Decodes and validates every message, as [`read_recording`] does.
+    pub fn read(self) -> Result<Recording, ReadError> {
+        let mut segments = Vec::new();
+        let (path, metadata, unit_id, sample_rate_hz) = (
+            self.path.clone(),
+            self.opened.metadata.clone(),
+            self.opened.unit_id.clone(),
+            self.opened.sample_rate_hz,
+        );
+        decode(&self.path, self.opened, &mut |segment| {
+            segments.push(segment);
+            true
+        })?;
+        Ok(Recording {
+            path,
+            metadata,
+            unit_id,
+            sample_rate_hz,
+            segments,
+        })
+    }
+
+    /// Decodes and validates the messages with [`read_recording`]'s checks, handing `each` every
+    /// activation as soon as its switch-off is read, in recording order; `each` returns whether to
+    /// go on. Returns `Ok(true)` when the whole file was read and valid, `Ok(false)` when `each`
+    /// stopped it. An error can come after activations were handed over (a fault later in the
+    /// file): then the file is invalid as a whole, as it is for [`read_recording`].
+    pub fn for_each_activation(
+        self,
+        mut each: impl FnMut(Segment) -> bool,
+    ) -> Result<bool, ReadError> {
+        decode(&self.path, self.opened, &mut each)
+    }
 }
 
 /// Reads and validates a recording held in memory; `name` stands for the file in errors and in
@@ -272,16 +335,33 @@ pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
 /// checks as [`read_recording`], which reads the file and calls this; fuzzing drives it directly.
 pub fn read_recording_bytes(name: &Path, bytes: &[u8]) -> Result<Recording, ReadError> {
     refuse_truth_name(name)?;
-    decode(name, open_bytes(name, bytes.to_vec())?)
+    OpenRecording {
+        path: name.to_path_buf(),
+        opened: open_bytes(name, bytes.to_vec())?,
+    }
+    .read()
 }
 
-fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
+/// Why decoding stopped before the end of the file.
+enum Halt {
+    Invalid(ReadError),
+    /// The receiver of the activations wanted no more.
+    Stopped,
+}
+
+/// Decodes `opened`'s messages, handing each finished activation to `each`; `Ok(false)` when
+/// `each` returned `false`.
+fn decode(
+    path: &Path,
+    opened: Opened,
+    each: &mut dyn FnMut(Segment) -> bool,
+) -> Result<bool, ReadError> {
     let Opened {
         buf,
-        metadata,
         unit_id,
         sample_rate_hz,
         session_set_point_celsius,
+        ..
     } = opened;
     let mcap_err = |e| ReadError::Mcap {
         path: path.to_path_buf(),
@@ -293,14 +373,26 @@ fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
         rate_hz: sample_rate_hz,
         session_set_point_celsius,
         open: None,
-        segments: Vec::new(),
+        each,
+        stopped: false,
         topics: HashMap::new(),
         named_units: HashMap::new(),
     };
-    crate::messages::for_each_message(&buf, |channel, log_ns, data| {
-        reader.message(channel, log_ns, data)
-    })
-    .map_err(|e| e.map_or_else(|e| e, mcap_err))?;
+    let decoded = crate::messages::for_each_message(&buf, |channel, log_ns, data| {
+        reader
+            .message(channel, log_ns, data)
+            .map_err(Halt::Invalid)?;
+        if reader.stopped {
+            return Err(Halt::Stopped);
+        }
+        Ok(())
+    });
+    match decoded {
+        Ok(()) => {}
+        Err(Ok(e)) => return Err(mcap_err(e)),
+        Err(Err(Halt::Invalid(e))) => return Err(e),
+        Err(Err(Halt::Stopped)) => return Ok(false),
+    }
     if reader.open.is_some() {
         let index = reader
             .topics
@@ -312,14 +404,7 @@ fn decode(path: &Path, opened: Opened) -> Result<Recording, ReadError> {
             "file ends while the unit is on (no switch-off event)".into(),
         ));
     }
-    let segments = reader.segments;
-    Ok(Recording {
-        path: path.to_path_buf(),
-        metadata,
-        unit_id,
-        sample_rate_hz,
-        segments,
-    })
+    Ok(true)
 }
 
 struct Reader<'p> {
@@ -329,7 +414,10 @@ struct Reader<'p> {
     /// The recording's nominal set point, copied into every activation's labels.
     session_set_point_celsius: Option<f64>,
     open: Option<Open>,
-    segments: Vec<Segment>,
+    /// Takes each finished activation; `false`: no more wanted.
+    each: &'p mut dyn FnMut(Segment) -> bool,
+    /// `each` returned `false`.
+    stopped: bool,
     topics: HashMap<String, TopicState>,
     /// Unit of each named channel, from the first channel record it was read with.
     named_units: HashMap<String, String>,
@@ -505,7 +593,7 @@ impl Reader<'_> {
                 self.rate_hz
             ));
         }
-        self.segments.push(Segment {
+        let segment = Segment {
             labels: open.labels,
             sample_rate_hz: self.rate_hz,
             power_on_ns: open.on_ns,
@@ -513,7 +601,8 @@ impl Reader<'_> {
             rate_dps: open.rate,
             temperature_raw: open.raw,
             aux,
-        });
+        };
+        self.stopped = !(self.each)(segment);
         Ok(())
     }
 
