@@ -548,12 +548,7 @@ fn correct_axis<A: AxisModel>(
     } else {
         state.bias_dps
     };
-    AxisOutput {
-        corrected_dps: rate - bias_dps,
-        bias_dps,
-        flags: reading.flags,
-        rise_celsius: reading.rise_celsius,
-    }
+    output_of(&reading, rate, bias_dps)
 }
 
 /// [`correct_axis`] with the model's answer for this sample's temperature already known.
@@ -567,10 +562,23 @@ fn answered_axis<S>(
     (&drift, &model_flags): (&f32, &Flags),
 ) -> AxisOutput {
     let mut reading = read_axis(settings, celsius_per_raw, state, rate, raw);
-    if reading.healthy {
-        hold_drift(state, &mut reading, drift, model_flags);
+    let bias_dps = if reading.healthy {
+        hold_drift(state, &mut reading, drift, model_flags)
+    } else {
+        state.bias_dps
+    };
+    output_of(&reading, rate, bias_dps)
+}
+
+/// One axis's output from its checked reading and the bias held for it.
+#[inline(always)]
+fn output_of(reading: &Reading, rate: f32, bias_dps: f32) -> AxisOutput {
+    AxisOutput {
+        corrected_dps: rate - bias_dps,
+        bias_dps,
+        flags: reading.flags,
+        rise_celsius: reading.rise_celsius,
     }
-    axis_output(state, &reading, rate)
 }
 
 /// Samples the block path evaluates at once: a multiple of the polynomial's lanes, few enough for

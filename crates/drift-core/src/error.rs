@@ -102,6 +102,11 @@ pub enum Problem {
         /// The largest plausible magnitude, in the field's unit.
         limit: u16,
     },
+    /// A correlation whose drift at its point (`k · rise`) is larger than any gyro drifts.
+    ImplausibleDrift {
+        /// The largest plausible drift, °/s.
+        limit: u16,
+    },
 }
 
 /// A table or settings value failed validation.
@@ -155,6 +160,12 @@ impl fmt::Display for Error {
             Problem::Mismatch => f.write_str(": differs from the earlier entry it must equal"),
             Problem::Implausible { limit } => {
                 write!(f, ": magnitude beyond {limit}, implausible for a gyro")
+            }
+            Problem::ImplausibleDrift { limit } => {
+                write!(
+                    f,
+                    ": k × rise beyond {limit} °/s of drift, implausible for a gyro"
+                )
             }
         }
     }

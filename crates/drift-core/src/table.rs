@@ -11,10 +11,12 @@ use crate::settings::Settings;
 use crate::warm_start::{self, WarmStart};
 use crate::AXES;
 
-/// The largest plausible |k|, (°/s) per °C: 100 °/s of drift for one degree of self-heating is
-/// beyond any gyro (MEMS parts give 0.001–0.1), so a larger value is a unit slip or a broken fit,
-/// refused when the tables are validated rather than corrected with at run time.
-pub const MAX_PLAUSIBLE_K: u16 = 100;
+/// The largest plausible drift a stored point stands for, |k · rise|, °/s: 100 °/s of thermal drift
+/// is beyond any gyro (MEMS parts drift by hundredths to tenths), so a larger product is a unit
+/// slip or a broken fit, refused when the tables are validated rather than corrected with at run
+/// time. `k` alone is not bounded: where the rise at a reference time is near zero (early after
+/// switch-on, or a unit whose sensor barely warms), `k = drift / rise` is steep and still right.
+pub const MAX_PLAUSIBLE_STORED_DRIFT_DPS: u16 = 100;
 /// The largest plausible |rise| since switch-on, °C (a unit's self-heating is a few to tens of °C).
 pub const MAX_PLAUSIBLE_RISE_CELSIUS: u16 = 500;
 
@@ -215,29 +217,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
                 let at = at.curve(c);
                 check_len("points", at, references, curve.points.len())?;
                 for (j, point) in curve.points.iter().enumerate() {
-                    for (field, value, limit) in [
-                        (
-                            "rise_celsius",
-                            point.rise_celsius,
-                            MAX_PLAUSIBLE_RISE_CELSIUS,
-                        ),
-                        (
-                            "k_dps_per_celsius",
-                            point.k_dps_per_celsius,
-                            MAX_PLAUSIBLE_K,
-                        ),
-                    ] {
-                        if !value.is_finite() {
-                            return Err(Error::new(field, at.point(j), Problem::NonFinite));
-                        }
-                        if value.abs() > f32::from(limit) {
-                            return Err(Error::new(
-                                field,
-                                at.point(j),
-                                Problem::Implausible { limit },
-                            ));
-                        }
-                    }
+                    check_point(point, at.point(j))?;
                 }
             }
             if by_history {
@@ -282,4 +262,33 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
         }
         Ok(())
     }
+}
+
+/// A stored point: finite, a rise within [`MAX_PLAUSIBLE_RISE_CELSIUS`] and the drift it stands for
+/// within [`MAX_PLAUSIBLE_STORED_DRIFT_DPS`].
+fn check_point(point: &CurvePoint, at: Location) -> Result<(), Error> {
+    let (rise, k) = (point.rise_celsius, point.k_dps_per_celsius);
+    if !rise.is_finite() {
+        return Err(Error::new("rise_celsius", at, Problem::NonFinite));
+    }
+    if !k.is_finite() {
+        return Err(Error::new("k_dps_per_celsius", at, Problem::NonFinite));
+    }
+    let limit = MAX_PLAUSIBLE_RISE_CELSIUS;
+    if rise.abs() > f32::from(limit) {
+        return Err(Error::new(
+            "rise_celsius",
+            at,
+            Problem::Implausible { limit },
+        ));
+    }
+    let limit = MAX_PLAUSIBLE_STORED_DRIFT_DPS;
+    if (k * rise).abs() > f32::from(limit) {
+        return Err(Error::new(
+            "k_dps_per_celsius",
+            at,
+            Problem::ImplausibleDrift { limit },
+        ));
+    }
+    Ok(())
 }

@@ -441,29 +441,46 @@ fn extended_images_round_trip_and_bad_terms_are_named() {
 
 #[test]
 fn implausible_correlations_are_refused_by_name() {
-    // A k of 1e3 (°/s)/°C would turn a 4 °C rise into a 4,000 °/s "bias".
+    // A k of 1e5 (°/s)/°C (a unit slip) where the curve has risen 0.07 °C stores a drift of
+    // thousands of °/s.
     let mut tables = fixture::modified();
-    tables.axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius = 1.0e3;
+    let rise = tables.axes[2].ambients[0].curves[1].points[0].rise_celsius;
+    assert!(rise * 1.0e5 > 1000.0, "{rise}");
+    tables.axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius = 1.0e5;
     let error = tables.validate().unwrap_err();
     assert_eq!(
         error.problem,
-        Problem::Implausible {
-            limit: drift_core::MAX_PLAUSIBLE_K
+        Problem::ImplausibleDrift {
+            limit: drift_core::MAX_PLAUSIBLE_STORED_DRIFT_DPS
         }
     );
     assert_eq!(
         error.to_string(),
-        "axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius: magnitude beyond 100, \
-         implausible for a gyro"
+        "axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius: k × rise beyond 100 °/s of \
+         drift, implausible for a gyro"
     );
     let mut buffer = vec![0; 64 * 1024];
     assert!(matches!(
         encode(&tables, &mut buffer),
         Err(BlobError::Invalid(_))
     ));
-    // At the limit it is still accepted: the bound refuses slips, not steep real units.
-    tables.axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius = 100.0;
+    // Just under the limit it is still accepted: the bound refuses slips, not steep real units.
+    tables.axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius = 99.0 / rise;
     assert!(tables.validate().is_ok());
+    // A steep k where the rise is still near zero (early after switch-on, a sensor that barely
+    // warms) stands for a small drift: a fit gives it, and it is right.
+    let point = &mut tables.axes[2].ambients[0].curves[0].points[0];
+    (point.rise_celsius, point.k_dps_per_celsius) = (2.0e-5, 5.0e4);
+    assert!(tables.validate().is_ok());
+    // A rise no unit reaches is refused on its own.
+    let last = tables.axes[2].ambients[0].curves.len() - 1;
+    tables.axes[2].ambients[0].curves[last].points[0].rise_celsius = 600.0;
+    assert_eq!(
+        tables.validate().unwrap_err().problem,
+        Problem::Implausible {
+            limit: drift_core::MAX_PLAUSIBLE_RISE_CELSIUS
+        }
+    );
 }
 
 /// `decode_into` (in place, the firmware's path) and `decode` (by value) agree on `bytes`: the same
