@@ -102,9 +102,10 @@ pub enum Problem {
         /// The largest plausible magnitude, in the field's unit.
         limit: u16,
     },
-    /// A correlation whose drift at its point (`k · rise`) is larger than any gyro drifts.
+    /// A correlation beyond any gyro's, standing for a drift at its point (`k · rise`) larger
+    /// than any gyro drifts.
     ImplausibleDrift {
-        /// The largest plausible drift, °/s.
+        /// The largest plausible |k|, (°/s) per °C, and drift, °/s.
         limit: u16,
     },
 }
@@ -164,7 +165,7 @@ impl fmt::Display for Error {
             Problem::ImplausibleDrift { limit } => {
                 write!(
                     f,
-                    ": k × rise beyond {limit} °/s of drift, implausible for a gyro"
+                    ": beyond {limit} (°/s)/°C for a drift k × rise beyond {limit} °/s, implausible for a gyro"
                 )
             }
         }

@@ -53,8 +53,8 @@ pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};
 pub use table::{
-    AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, MAX_PLAUSIBLE_RISE_CELSIUS,
-    MAX_PLAUSIBLE_STORED_DRIFT_DPS,
+    AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, MAX_PLAUSIBLE_K,
+    MAX_PLAUSIBLE_RISE_CELSIUS, MAX_PLAUSIBLE_STORED_DRIFT_DPS,
 };
 pub use warm_start::WarmStart;
 

@@ -11,11 +11,16 @@ use crate::settings::Settings;
 use crate::warm_start::{self, WarmStart};
 use crate::AXES;
 
-/// The largest plausible drift a stored point stands for, |k · rise|, °/s: 100 °/s of thermal drift
-/// is beyond any gyro (MEMS parts drift by hundredths to tenths), so a larger product is a unit
-/// slip or a broken fit, refused when the tables are validated rather than corrected with at run
-/// time. `k` alone is not bounded: where the rise at a reference time is near zero (early after
-/// switch-on, or a unit whose sensor barely warms), `k = drift / rise` is steep and still right.
+/// The largest plausible |k|, (°/s) per °C, and the largest plausible drift a stored point stands
+/// for, |k · rise|, °/s: 100 °/s of drift, or of drift per degree of self-heating, is beyond any
+/// gyro (MEMS parts drift by hundredths to tenths). A point beyond both is a unit slip or a broken
+/// fit, refused when the tables are validated rather than corrected with at run time. Either alone
+/// is not refused: where the rise at a reference time is near zero (early after switch-on, a
+/// sensor that barely warms) `k = drift / rise` is steep for a small drift, and the closed loop's
+/// refits without a candidate term can store a large drift on a moderate `k` before the guard
+/// judges the term on held-out data.
+pub const MAX_PLAUSIBLE_K: u16 = 100;
+/// See [`MAX_PLAUSIBLE_K`].
 pub const MAX_PLAUSIBLE_STORED_DRIFT_DPS: u16 = 100;
 /// The largest plausible |rise| since switch-on, °C (a unit's self-heating is a few to tens of °C).
 pub const MAX_PLAUSIBLE_RISE_CELSIUS: u16 = 500;
@@ -264,8 +269,8 @@ impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
     }
 }
 
-/// A stored point: finite, a rise within [`MAX_PLAUSIBLE_RISE_CELSIUS`] and the drift it stands for
-/// within [`MAX_PLAUSIBLE_STORED_DRIFT_DPS`].
+/// A stored point: finite, a rise within [`MAX_PLAUSIBLE_RISE_CELSIUS`], and `k` within
+/// [`MAX_PLAUSIBLE_K`] or the drift it stands for within [`MAX_PLAUSIBLE_STORED_DRIFT_DPS`].
 fn check_point(point: &CurvePoint, at: Location) -> Result<(), Error> {
     let (rise, k) = (point.rise_celsius, point.k_dps_per_celsius);
     if !rise.is_finite() {
@@ -283,7 +288,7 @@ fn check_point(point: &CurvePoint, at: Location) -> Result<(), Error> {
         ));
     }
     let limit = MAX_PLAUSIBLE_STORED_DRIFT_DPS;
-    if (k * rise).abs() > f32::from(limit) {
+    if k.abs() > f32::from(MAX_PLAUSIBLE_K) && (k * rise).abs() > f32::from(limit) {
         return Err(Error::new(
             "k_dps_per_celsius",
             at,

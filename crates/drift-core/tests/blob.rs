@@ -456,8 +456,8 @@ fn implausible_correlations_are_refused_by_name() {
     );
     assert_eq!(
         error.to_string(),
-        "axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius: k × rise beyond 100 °/s of \
-         drift, implausible for a gyro"
+        "axes[2].ambients[0].curves[1].points[0].k_dps_per_celsius: beyond 100 (°/s)/°C for a \
+         drift k × rise beyond 100 °/s, implausible for a gyro"
     );
     let mut buffer = vec![0; 64 * 1024];
     assert!(matches!(
@@ -472,8 +472,15 @@ fn implausible_correlations_are_refused_by_name() {
     let point = &mut tables.axes[2].ambients[0].curves[0].points[0];
     (point.rise_celsius, point.k_dps_per_celsius) = (2.0e-5, 5.0e4);
     assert!(tables.validate().is_ok());
-    // A rise no unit reaches is refused on its own.
+    // A moderate k standing for a large drift (a closed-loop refit without a candidate term can
+    // store one before the guard judges the term) is not refused either: only a point beyond both.
     let last = tables.axes[2].ambients[0].curves.len() - 1;
+    let point = &mut tables.axes[2].ambients[0].curves[last].points[7];
+    let drift = point.rise_celsius * 90.0;
+    point.k_dps_per_celsius = 90.0;
+    assert!(drift > 100.0, "{drift}");
+    assert!(tables.validate().is_ok());
+    // A rise no unit reaches is refused on its own.
     tables.axes[2].ambients[0].curves[last].points[0].rise_celsius = 600.0;
     assert_eq!(
         tables.validate().unwrap_err().problem,
