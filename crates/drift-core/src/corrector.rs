@@ -249,7 +249,7 @@ impl<S: Copy + Default> CorrectorState<S> {
     /// Corrects `samples` in order into `outputs` without auxiliary inputs and returns how many
     /// (the shorter of the two lengths): the same outputs and the same final state, bit for bit, as
     /// [`Self::correct`] sample by sample. A model with [`AxisModel::drift_of_temperatures`] (the
-    /// polynomial baselines) evaluates [`BLOCK_SAMPLES`] temperatures at once (~4 KiB of stack);
+    /// polynomial baselines) evaluates 128 temperatures at once (~4 KiB of stack);
     /// the checks, holds and flags still run sample by sample.
     pub fn correct_block<M>(
         &mut self,
@@ -299,7 +299,7 @@ impl<S: Copy + Default> CorrectorState<S> {
         }
     }
 
-    /// Up to [`BLOCK_SAMPLES`] samples of a powered-on activation without extension: the model's
+    /// Up to `BLOCK_SAMPLES` samples of a powered-on activation without extension: the model's
     /// drifts for every temperature first, then the per-sample checks with those answers.
     /// `false`, and nothing changed, if the model does not answer.
     fn correct_answered<M>(
