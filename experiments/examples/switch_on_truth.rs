@@ -17,7 +17,7 @@
 //! unit's bias follows the sensor's site, so its element columns are left empty.
 
 use anyhow::Context;
-use drift_diagnose::closing::close;
+use drift_diagnose::closing::{close, LoopOptions};
 use drift_diagnose::roles::Roles;
 use drift_diagnose::switch_on_rate::{start_rates, switch_ons};
 use drift_evaluate::evaluate::switch_on_raw;
@@ -132,15 +132,11 @@ fn main() -> anyhow::Result<()> {
         .map(|s| analyse(s, &settings))
         .collect::<Result<Vec<_>, _>>()?;
     let fitted = fit_unit(&analysed, &settings)?;
-    let closed = close(
-        &fitted,
-        &segments,
-        &plan.calibration,
-        &[],
-        &settings,
-        false,
-        plan.clock,
-    )?;
+    let options = LoopOptions {
+        clock: plan.clock,
+        ..LoopOptions::new(&plan.calibration)
+    };
+    let closed = close(&fitted, &segments, &[], &options, &settings)?;
     let core = &fitted.modified.settings;
     let fits = &closed.switch_on_rate;
     for fit in fits {

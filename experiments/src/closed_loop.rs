@@ -13,7 +13,9 @@
 use std::path::Path;
 
 use anyhow::Context;
-use drift_diagnose::closing::{close, mean_profiles, profile_bin_labels, BeforeAfter, Profile};
+use drift_diagnose::closing::{
+    close, mean_profiles, profile_bin_labels, BeforeAfter, LoopOptions, Profile,
+};
 use drift_diagnose::roles::Roles;
 use drift_evaluate::evaluate;
 use drift_evaluate::excess::{excess_cut, excess_ratio, ExcessCut};
@@ -406,15 +408,12 @@ pub fn run(
     for crossing in &base.crossings {
         eprintln!("  tables: {}", crossing.note());
     }
-    let closed = close(
-        &base,
-        &all,
-        calibration,
-        &[],
-        settings,
-        true,
-        plan_size.clock,
-    )?;
+    let options = LoopOptions {
+        extend: true,
+        clock: plan_size.clock,
+        ..LoopOptions::new(calibration)
+    };
+    let closed = close(&base, &all, &[], &options, settings)?;
     eprintln!(
         "  {} field activations at the calibration set points inside the calibrated ambient range, {} outside held out",
         closed.roles.training.len(),

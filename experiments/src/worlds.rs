@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use drift_diagnose::closing::close;
+use drift_diagnose::closing::{close, LoopOptions};
 use drift_diagnose::roles::Roles;
 use drift_evaluate::evaluate;
 use drift_evaluate::excess::{excess_cut, ExcessCut};
@@ -288,7 +288,12 @@ pub fn close_blind(
     } else {
         &[]
     };
-    let closed = close(&base, &all, &CALIBRATION, selection, settings, true, true)?;
+    let options = LoopOptions {
+        extend: true,
+        select_on: selection.to_vec(),
+        ..LoopOptions::new(&CALIBRATION)
+    };
+    let closed = close(&base, &all, &[], &options, settings)?;
     let measured: Vec<_> = closed
         .before_after(&base, settings)
         .into_iter()

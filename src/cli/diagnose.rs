@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use drift_diagnose::closing::{
-    close, close_separate, mean_profiles, profile_bin_labels, BeforeAfter, Closed, Profile,
-    Stage3Choice,
+    close_both, close_separate_both, mean_profiles, profile_bin_labels, BeforeAfter, Closed,
+    LoopOptions, Profile, Stage3Choice,
 };
 use drift_diagnose::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_diagnose::warm_start::WarmStartChoice;
@@ -48,6 +48,21 @@ pub struct Args {
     /// none of them measured on afterwards (the before/after uses the rest).
     #[arg(long, value_delimiter = ',', value_name = "CELSIUS,...")]
     pub select_on: Vec<f64>,
+    /// Set points whose series — field and protocol — are the diagnosis data, e.g. a field
+    /// campaign recorded at +33 °C for the purpose. Cross-fitted by series: the loop ranks, fits and
+    /// guards on half of the series and is judged on the other half, then the halves swap; the
+    /// report shows both halves and whether they agree.
+    #[arg(long, value_delimiter = ',', value_name = "CELSIUS,...")]
+    pub diagnose_on: Vec<f64>,
+    /// Recordings whose activations (of the fitted units, at any set point) are the diagnosis
+    /// data, cross-fitted by series like `--diagnose-on`.
+    #[arg(long, value_name = "DIR")]
+    pub diagnosis_data: Option<PathBuf>,
+    /// A recorded channel that describes the bench, not the unit (repeatable): context for the
+    /// report, never ranked and never a firmware term. The chamber's set point and air
+    /// (`chamber_set_point`, `chamber_air`) always are.
+    #[arg(long = "bench-channel", value_name = "NAME")]
+    pub bench_channels: Vec<String>,
     /// Recordings to judge on, a source separate from the calibration data (the campaign or
     /// `--calibration-data`), as `report --evaluation-data` does: every activation of the fitted
     /// units there is held out (the error before and after, the profiles), and none reaches the
@@ -422,6 +437,65 @@ fn residual_plots(
     Ok(md)
 }
 
+/// Per axis, the significant winner and the admitted terms of one half's loop.
+fn findings(closed: &Closed<'_>) -> [(String, Vec<String>); 3] {
+    std::array::from_fn(|axis| {
+        let winner = closed.axes[axis]
+            .chosen()
+            .map_or_else(|| "nothing significant".to_owned(), |c| c.name.clone());
+        let admitted = closed
+            .extended
+            .iter()
+            .flat_map(|e| e.admissions.iter())
+            .filter(|a| a.admitted && a.axis == closed.axes[axis].axis)
+            .map(|a| a.candidate.clone())
+            .collect();
+        (winner, admitted)
+    })
+}
+
+/// With the diagnosis data cross-fitted, whether the two halves found and admitted the same, per
+/// unit and axis: a finding one half alone makes is not yet a finding.
+fn agreement_markdown(units: &[(String, Closed<'_>, &FittedUnit)]) -> String {
+    let mut md = String::new();
+    for pair in units.windows(2) {
+        let [(first, a, unit_a), (_, b, unit_b)] = pair else {
+            continue;
+        };
+        if unit_a.unit_id != unit_b.unit_id || !first.ends_with("half 1 of 2") {
+            continue;
+        }
+        let _ = writeln!(
+            md,
+            "# Unit {}: do the halves agree?
+
+Each half ranked, fitted and guarded on its own series and was judged on the other's.
+
+| axis | half 1: significant winner | half 2: significant winner | half 1: admitted | half 2: admitted | agree |\n|---|---|---|---|---|---|",
+            unit_a.unit_id
+        );
+        for ((axis, (wa, ta)), (wb, tb)) in ["X", "Y", "Z"].iter().zip(findings(a)).zip(findings(b))
+        {
+            let list = |t: &[String]| {
+                if t.is_empty() {
+                    "–".to_owned()
+                } else {
+                    t.join(", ")
+                }
+            };
+            let _ = writeln!(
+                md,
+                "| {axis} | {wa} | {wb} | {} | {} | {} |",
+                list(&ta),
+                list(&tb),
+                if wa == wb && ta == tb { "yes" } else { "no" }
+            );
+        }
+        md.push('\n');
+    }
+    md
+}
+
 /// Runs `gyrodrift diagnose`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
@@ -439,12 +513,35 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .or_default()
             .extend(recording.segments);
     }
+    let diagnosis_data = args
+        .diagnosis_data
+        .as_deref()
+        .map(|dir| evaluation_segments(dir, &recorded, &outcome.fitted))
+        .transpose()?
+        .unwrap_or_default();
+    // The evaluation data's life starts a day after the diagnosis data's, when both are given.
+    let mut before_evaluation = recorded.clone();
+    for (unit, extra) in &diagnosis_data {
+        before_evaluation
+            .entry(unit.clone())
+            .or_default()
+            .extend(extra.iter().cloned());
+    }
     let evaluation = args
         .evaluation_data
         .as_deref()
-        .map(|dir| evaluation_segments(dir, &recorded, &outcome.fitted))
+        .map(|dir| evaluation_segments(dir, &before_evaluation, &outcome.fitted))
         .transpose()?;
-    let mut units: BTreeMap<&String, (Closed<'_>, &FittedUnit)> = BTreeMap::new();
+    let mut loop_options = LoopOptions {
+        select_on: args.select_on.clone(),
+        diagnose_on: args.diagnose_on.clone(),
+        extend: args.extend,
+        ..LoopOptions::new(&options.calibration_set_points)
+    };
+    loop_options
+        .bench_channels
+        .extend(args.bench_channels.iter().cloned());
+    let mut units: Vec<(String, Closed<'_>, &FittedUnit)> = Vec::new();
     for (n, (unit, segments)) in recorded.iter().enumerate() {
         steps.update(
             if args.extend {
@@ -458,34 +555,31 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let Some(fitted) = outcome.fitted.iter().find(|f| &f.unit_id == unit) else {
             continue;
         };
-        let closed = match &evaluation {
-            None => close(
-                fitted,
-                segments,
-                &options.calibration_set_points,
-                &args.select_on,
-                &options.fit,
-                args.extend,
-                true,
-            )?,
+        let extra: Vec<&Segment> = diagnosis_data.get(unit).into_iter().flatten().collect();
+        let halves = match &evaluation {
+            None => close_both(fitted, segments, &extra, &loop_options, &options.fit)?,
             Some(evaluation) => {
                 let Some(judged) = evaluation.get(unit) else {
                     continue;
                 };
-                close_separate(
+                close_separate_both(
                     fitted,
                     segments,
                     judged,
-                    &options.calibration_set_points,
-                    &args.select_on,
+                    &extra,
+                    &loop_options,
                     &options.fit,
-                    args.extend,
-                    true,
                 )?
             }
         };
-        if !closed.series.is_empty() {
-            units.insert(unit, (closed, fitted));
+        for closed in halves {
+            if !closed.series.is_empty() {
+                let label = match closed.half {
+                    Some(half) => format!("{unit}, half {} of 2", half + 1),
+                    None => unit.clone(),
+                };
+                units.push((label, closed, fitted));
+            }
         }
     }
     anyhow::ensure!(
@@ -515,7 +609,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     let mut json = Vec::new();
-    for (unit, (closed, fitted)) in &units {
+    for (unit, closed, fitted) in &units {
         let (activations, axes, roles) = (&closed.series, &closed.axes, &closed.roles);
         let _ = writeln!(md, "# Unit {unit}\n");
         {
@@ -539,6 +633,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         " and {} protocol activations at {:?} °C, not measured on afterwards",
                         roles.selection.len(),
                         args.select_on
+                    )
+                } + &if roles.diagnosis.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; and {} activations of this half of the analyst's diagnosis series, ranked, fitted and guarded on, while the other half's series are held out and judge",
+                        roles.diagnosis.len()
                     )
                 },
                 roles.outside_range,
@@ -678,7 +779,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             )?);
         }
         json.push(serde_json::json!({
-            "unit": unit,
+            "unit": &fitted.unit_id,
+            "half": closed.half,
             "axes": axes,
             "paper_axes": &closed.paper_axes,
             "proposed_terms": closed.proposed.terms.iter().map(|t| &t.candidate).collect::<Vec<_>>(),
@@ -695,6 +797,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             "profiles": profiles,
         }));
     }
+    md.push_str(&agreement_markdown(&units));
     write_atomic(&args.out.join("diagnosis.md"), md.as_bytes())?;
     write_atomic(
         &args.out.join("diagnosis.json"),

@@ -98,7 +98,20 @@ pub fn verdict(unit: &str, closed: &Closed<'_>) -> String {
         .map(|a| format!("{} on {}", a.candidate, a.axis))
         .collect();
     if admitted.is_empty() {
-        format!("proposed {proposed}; none lowers the held-out error; {kept}")
+        let reasons: Vec<String> = extended
+            .admissions
+            .iter()
+            .filter(|a| a.reason.starts_with("significant"))
+            .map(|a| format!("{} on {}: {}", a.candidate, a.axis, a.reason))
+            .collect();
+        if reasons.is_empty() {
+            format!("proposed {proposed}; none lowers the held-out error; {kept}")
+        } else {
+            format!(
+                "proposed {proposed}; none admitted ({}); {kept}",
+                reasons.join("; ")
+            )
+        }
     } else {
         format!(
             "admitted {} (firmware image `extended-{unit}.bin`)",
@@ -109,7 +122,7 @@ pub fn verdict(unit: &str, closed: &Closed<'_>) -> String {
 
 /// The guard's decisions and the admitted terms, as Markdown.
 fn terms_markdown(closed: &Closed<'_>) -> String {
-    let (calibration, training) = (&closed.roles.calibration, &closed.roles.training);
+    let calibration = &closed.roles.calibration;
     let mut md = String::new();
     if closed.proposed.terms.is_empty() {
         md.push_str("Nothing significant maps to a term the firmware can compute, and the tables absorb every temperature-rate candidate, so there is no element rate to offer.\n\n");
@@ -125,23 +138,24 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
     };
     let _ = writeln!(
         md,
-        "Guard: each proposed term is admitted on an axis only if the refitted model with it (coefficients and tables fitted without the held-out fold) does better on held-out activations among the {} field-like activations at the calibration set points within the calibrated ambient range (5-fold cross-validation by activation, against the terms admitted before it; one-sided test, Bonferroni over every term and axis, family-wise 5 %). An auxiliary input, which moves offsets between activations, must lower the squared residual without making the paper's drift metric significantly worse (one-sided, 5 %, by more than 1 %). A term that changes the shape within activations (temperature rate, rise², another axis's rise) must lower the drift without making the squared residual significantly worse.\n",
-        training.len(),
+        "Guard, on the {} activations the terms are fitted on (field-like activations at the calibration set points within the calibrated ambient range, and this half of the analyst's diagnosis series if any), 5-fold cross-validation by series, the refitted model with the term (coefficients and tables fitted without the held-out fold) against the one without it. On an axis whose diagnosis found the term significant, it is admitted unless it makes the held-out folds worse (the squared residual, or the paper's drift metric by more than 1 %; one-sided, 5 %). On any other axis it must earn its place: an auxiliary input, which moves offsets between activations, must lower the squared residual, a term that changes the shape within activations (temperature rate, rise², another axis's rise) the drift (one-sided test, Bonferroni over every term and axis, family-wise 5 %), without making the other metric significantly worse.\n",
+        closed.roles.fitting().len(),
     );
     md.push_str(
-        "| term | axis | held-out gain, (°/s)² | p | held-out drift gain, °/s | p drift | admitted |\n|---|---|---:|---:|---:|---:|:---:|\n",
+        "| term | axis | held-out gain, (°/s)² | p | held-out drift gain, °/s | p drift | admitted | why |\n|---|---|---:|---:|---:|---:|:---:|---|\n",
     );
     for a in &extended.admissions {
         let _ = writeln!(
             md,
-            "| {} | {} | {:.2e} | {:.3} | {:+.2e} | {:.3} | {} |",
+            "| {} | {} | {:.2e} | {:.3} | {:+.2e} | {:.3} | {} | {} |",
             a.candidate,
             a.axis,
             a.improvement,
             a.p_value,
             a.drift_gain_dps,
             a.drift_p_value,
-            if a.admitted { "yes" } else { "no" }
+            if a.admitted { "yes" } else { "no" },
+            a.reason
         );
     }
     md.push('\n');
@@ -152,8 +166,8 @@ fn terms_markdown(closed: &Closed<'_>) -> String {
     let tables = &extended.tables;
     let _ = writeln!(
         md,
-        "Terms (coefficients fitted on the {} field-like activations against what the paper's tables leave of each term, tables refitted once on {} calibration activations with the terms' contribution removed):\n",
-        training.len(),
+        "Terms (coefficients fitted on the {} activations above against what the paper's tables leave of each term, tables refitted once at the drift fit's reference times on {} calibration activations with the terms' contribution removed):\n",
+        closed.roles.fitting().len(),
         calibration.len()
     );
     md.push_str("| term | from candidate | centre X, Y, Z | coefficient X, Y, Z (°/s per unit) |\n|---|---|---|---|\n");

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use crate::keying::Keying;
 use drift_fit::analyse::analyse;
 use drift_fit::error::FitError;
-use drift_fit::fit::fit_unit;
+use drift_fit::fit::fit_unit_at;
 use drift_fit::settings::FitSettings;
 
 /// The paper's tables fitted to one quantity, stage 3 keyed per axis as the loop's model is.
@@ -39,11 +39,18 @@ impl Absorber {
     /// Fits the paper's tables to the quantity `values` gives on each calibration activation.
     /// `values` returns `None` where the quantity does not exist; such activations are left out,
     /// and a quantity no calibration activation has (an empty channel) has no absorber: `None`.
+    ///
+    /// The tables are fitted at `references`, the reference times (analysis-grid indices per axis,
+    /// [`drift_fit::fit::reference_indices`]) of the drift's own fit: the paper's operator is
+    /// linear in the rates only for fixed reference times, and chosen afresh for the candidate they
+    /// would take out of it something other than what the drift's tables take (measured: a third of
+    /// an interaction effect's explained share lost).
     pub fn fit(
         calibration: &[&Segment],
         values: impl Fn(&Segment) -> Option<[Vec<f32>; 3]> + Sync,
         settings: &FitSettings,
         keying: &Keying,
+        references: &[Vec<usize>; 3],
     ) -> Result<Option<Self>, FitError> {
         let analysed = calibration
             .par_iter()
@@ -52,7 +59,7 @@ impl Absorber {
         if analysed.is_empty() {
             return Ok(None);
         }
-        let fitted = fit_unit(&analysed, settings)?;
+        let fitted = fit_unit_at(&analysed, settings, Some(references))?;
         Ok(Some(Self {
             tables: keying.tables(&fitted.modified, &fitted.by_history),
         }))
@@ -107,7 +114,14 @@ mod tests {
             aux: BTreeMap::new(),
         };
         let keying = Keying::new([false; 3], &[&segment], &[drift_core::Previous::COOLED]);
-        let absorber = Absorber::fit(&[&segment], |_| None, &FitSettings::default(), &keying);
+        let references: [Vec<usize>; 3] = Default::default();
+        let absorber = Absorber::fit(
+            &[&segment],
+            |_| None,
+            &FitSettings::default(),
+            &keying,
+            &references,
+        );
         assert!(matches!(absorber, Ok(None)));
     }
 }

@@ -39,6 +39,14 @@ pub const REFERENCE_CELSIUS: f64 = 25.0;
 /// The auxiliary channel holding the chamber's set point (the ambient the unit is kept at).
 pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
 
+/// Channels that describe the bench rather than the unit, by default: the chamber's set point and
+/// its air. Firmware in the field has neither, and the chamber air follows the ambient, which the
+/// paper's model reads from the switch-on temperature: where that reading is off (short off-times,
+/// ramps) any channel that follows the air explains the residual, in every world, null included.
+/// They are context — never ranked, never a term. The analyst adds others with
+/// `--bench-channel`.
+pub const DEFAULT_BENCH_CHANNELS: [&str; 2] = [SET_POINT_CHANNEL, "chamber_air"];
+
 /// A recorded auxiliary channel less its mean over the calibration activations: what an
 /// interaction multiplies. Uncentred, a channel that hardly moves times the heating is the heating
 /// itself, scaled — a candidate that matches the tables' own lookup error rather than anything the

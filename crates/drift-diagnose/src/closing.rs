@@ -5,6 +5,8 @@
 //! activations. The command line (`gyrodrift diagnose [--extend]`), the Python module and the
 //! closed-loop experiment all run this.
 
+use std::collections::HashMap;
+
 use drift_core::{Previous, SwitchOn};
 use drift_recording::Segment;
 use rayon::prelude::*;
@@ -52,6 +54,9 @@ pub struct Closed<'a> {
     /// The extended model, when asked for, when something was proposed and there are training
     /// activations to fit it on.
     pub extended: Option<Extended>,
+    /// With the analyst's diagnosis data cross-fitted: which half of its series this loop ranked
+    /// and fitted on (0 or 1; the other half is among the held-out activations).
+    pub half: Option<usize>,
 }
 
 /// The error of one held-out activation with the paper's model and with the extended one.
@@ -247,36 +252,171 @@ fn choose_stage3(
     })
 }
 
+/// What the analyst asks of one unit's loop.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LoopOptions {
+    /// The chamber set points whose protocol activations the paper's tables are fitted on, °C.
+    pub calibration_set_points: Vec<f64>,
+    /// Set points (not the calibration's) whose protocol activations the diagnosis also ranks on,
+    /// none of them measured on afterwards ([`Roles::select`]).
+    pub select_on: Vec<f64>,
+    /// Set points whose series, field and protocol, are the analyst's diagnosis data, cross-fitted
+    /// by series ([`Roles::diagnose_on`]).
+    pub diagnose_on: Vec<f64>,
+    /// Recorded channels that describe the bench, not the unit (the chamber's air and set point by
+    /// default, [`crate::candidates::DEFAULT_BENCH_CHANNELS`]): never ranked, never a term.
+    pub bench_channels: Vec<String>,
+    /// Build, guard and measure the extended model.
+    pub extend: bool,
+    /// The firmware knows when the unit cooled fully ([`drift_evaluate::evaluate::kept_before`]).
+    pub clock: bool,
+    /// Which half of the diagnosis series this loop ranks and fits on (0 or 1); the other half is
+    /// held out and judges.
+    pub half: usize,
+}
+
+impl LoopOptions {
+    /// The loop over the calibration at `calibration_set_points`, the default bench channels, the
+    /// firmware's clock known.
+    pub fn new(calibration_set_points: &[f64]) -> Self {
+        Self {
+            calibration_set_points: calibration_set_points.to_vec(),
+            bench_channels: crate::candidates::DEFAULT_BENCH_CHANNELS
+                .iter()
+                .map(|c| (*c).to_owned())
+                .collect(),
+            clock: true,
+            ..Self::default()
+        }
+    }
+
+    /// Whether the analyst named diagnosis data (set points or another source), so that the loop
+    /// runs twice, once per half.
+    pub fn cross_fitted(&self, diagnosis_data: &[&Segment]) -> bool {
+        !self.diagnose_on.is_empty() || !diagnosis_data.is_empty()
+    }
+}
+
+/// The roles of one source: split, the training outside the ambient range held out, the
+/// selection and the diagnosis half moved in (`diagnosis_data`: activations of another source
+/// that are the analyst's diagnosis data whatever their set point).
+fn roles_of<'a>(
+    fitted: &FittedUnit,
+    source: &[&'a Segment],
+    diagnosis_data: &[&'a Segment],
+    options: &LoopOptions,
+    settings: &FitSettings,
+) -> Roles<'a> {
+    let mut roles = Roles::split(source.iter().copied(), &options.calibration_set_points);
+    roles.hold_out_outside_range(fitted, settings);
+    roles.select(&options.select_on);
+    if options.cross_fitted(diagnosis_data) {
+        roles.held_out.extend(diagnosis_data);
+        let named = |s: &Segment| {
+            diagnosis_data.iter().any(|d| std::ptr::eq(*d, s))
+                || drift_evaluate::pipeline::is_one_of(
+                    s.labels.nominal_set_point_celsius(),
+                    &options.diagnose_on,
+                )
+        };
+        roles.diagnose_on(named, options.half);
+    }
+    roles
+}
+
 /// Splits `segments` (one unit's) by role, chooses stage 3's lookup per axis on the training
-/// activations ([`Stage3Choice`]; `clock`: the firmware also knows when the unit cooled fully,
-/// [`drift_evaluate::evaluate::kept_before`]), diagnoses the chosen model on the training activations (or,
-/// without any, on every activation the fit did not see), and with `extend` fits the guarded
-/// extended model. The protocol activations at `selection_set_points` (set points the fit did not
-/// use) are diagnosed beside the training ones and not measured on ([`Roles::select`]).
+/// activations ([`Stage3Choice`]), diagnoses the chosen model on the training, selection and
+/// diagnosis activations (or, without any, on every activation the fit did not see), and with
+/// `options.extend` fits the guarded extended model. `diagnosis_data` (another source's
+/// activations of the same unit, placed after `segments` on the clock) joins the analyst's
+/// diagnosis data.
+///
+/// With diagnosis data (`options.diagnose_on` or `diagnosis_data`) this is the loop of the half
+/// `options.half`; [`close_both`] runs both halves at the cost of little more than one.
 pub fn close<'a>(
     fitted: &FittedUnit,
     segments: impl IntoIterator<Item = &'a Segment>,
-    calibration_set_points: &[f64],
-    selection_set_points: &[f64],
+    diagnosis_data: &[&'a Segment],
+    options: &LoopOptions,
     settings: &FitSettings,
-    extend_model: bool,
-    clock: bool,
 ) -> Result<Closed<'a>, FitError> {
-    let mut roles = Roles::split(segments, calibration_set_points);
-    roles.hold_out_outside_range(fitted, settings);
-    roles.select(selection_set_points);
+    let source: Vec<&Segment> = segments.into_iter().collect();
+    first_of(
+        fitted,
+        close_each(
+            fitted,
+            &source,
+            diagnosis_data,
+            options,
+            settings,
+            &[options.half],
+        )?,
+    )
+}
+
+/// [`close`] for every half of the analyst's diagnosis data (two when there are any, cross-fitted:
+/// each half ranked, fitted and guarded on, and judged by the other; else the one loop).
+pub fn close_both<'a>(
+    fitted: &FittedUnit,
+    segments: impl IntoIterator<Item = &'a Segment>,
+    diagnosis_data: &[&'a Segment],
+    options: &LoopOptions,
+    settings: &FitSettings,
+) -> Result<Vec<Closed<'a>>, FitError> {
+    let source: Vec<&Segment> = segments.into_iter().collect();
+    close_each(
+        fitted,
+        &source,
+        diagnosis_data,
+        options,
+        settings,
+        halves(options, diagnosis_data),
+    )
+}
+
+/// The halves a cross-fitted loop runs: both with diagnosis data, else the one asked for.
+fn halves<'h>(options: &'h LoopOptions, diagnosis_data: &[&Segment]) -> &'h [usize] {
+    if options.cross_fitted(diagnosis_data) {
+        &[0, 1]
+    } else {
+        std::slice::from_ref(&options.half)
+    }
+}
+
+fn first_of<'a>(fitted: &FittedUnit, closed: Vec<Closed<'a>>) -> Result<Closed<'a>, FitError> {
+    closed
+        .into_iter()
+        .next()
+        .ok_or_else(|| FitError::Insufficient {
+            unit: fitted.unit_id.clone(),
+            what: "no loop was run".into(),
+        })
+}
+
+fn close_each<'a>(
+    fitted: &FittedUnit,
+    source: &[&'a Segment],
+    diagnosis_data: &[&'a Segment],
+    options: &LoopOptions,
+    settings: &FitSettings,
+    halves: &[usize],
+) -> Result<Vec<Closed<'a>>, FitError> {
+    let roles = halves
+        .iter()
+        .map(|&half| {
+            let options = LoopOptions {
+                half,
+                ..options.clone()
+            };
+            roles_of(fitted, source, diagnosis_data, &options, settings)
+        })
+        .collect();
     // The unit's whole life in order, as its firmware would have lived it: every activation
     // passes what it kept on to the next.
-    let life: Vec<&Segment> = roles
-        .calibration
-        .iter()
-        .chain(&roles.training)
-        .chain(&roles.selection)
-        .chain(&roles.held_out)
-        .copied()
-        .collect();
-    let kept = kept_before(&life, settings, &fitted.by_history.settings, clock);
-    close_roles(fitted, roles, &life, &kept, settings, extend_model)
+    let mut life: Vec<&Segment> = source.iter().chain(diagnosis_data).copied().collect();
+    life.sort_by_key(|s| s.power_on_ns);
+    let kept = kept_before(&life, settings, &fitted.by_history.settings, options.clock);
+    close_halves(fitted, roles, &life, &kept, settings, options)
 }
 
 /// [`close`] with the judging on a separate source: the roles, stage 3's and the initial bias's
@@ -289,20 +429,62 @@ pub fn close<'a>(
 /// within each, never from one into the other. Activations are known by their switch-on time
 /// ([`Keying`]), so the two sources' must differ (put the evaluation data after the calibration
 /// data on the clock); a shared one is an error.
-#[allow(clippy::too_many_arguments)]
 pub fn close_separate<'a>(
     fitted: &FittedUnit,
     calibration_source: impl IntoIterator<Item = &'a Segment>,
     evaluation: impl IntoIterator<Item = &'a Segment>,
-    calibration_set_points: &[f64],
-    selection_set_points: &[f64],
+    diagnosis_data: &[&'a Segment],
+    options: &LoopOptions,
     settings: &FitSettings,
-    extend_model: bool,
-    clock: bool,
 ) -> Result<Closed<'a>, FitError> {
+    let closed = close_separate_each(
+        fitted,
+        calibration_source,
+        evaluation,
+        diagnosis_data,
+        options,
+        settings,
+        &[options.half],
+    )?;
+    first_of(fitted, closed)
+}
+
+/// [`close_separate`] for every half of the analyst's diagnosis data ([`close_both`]).
+pub fn close_separate_both<'a>(
+    fitted: &FittedUnit,
+    calibration_source: impl IntoIterator<Item = &'a Segment>,
+    evaluation: impl IntoIterator<Item = &'a Segment>,
+    diagnosis_data: &[&'a Segment],
+    options: &LoopOptions,
+    settings: &FitSettings,
+) -> Result<Vec<Closed<'a>>, FitError> {
+    close_separate_each(
+        fitted,
+        calibration_source,
+        evaluation,
+        diagnosis_data,
+        options,
+        settings,
+        halves(options, diagnosis_data),
+    )
+}
+
+fn close_separate_each<'a>(
+    fitted: &FittedUnit,
+    calibration_source: impl IntoIterator<Item = &'a Segment>,
+    evaluation: impl IntoIterator<Item = &'a Segment>,
+    diagnosis_data: &[&'a Segment],
+    options: &LoopOptions,
+    settings: &FitSettings,
+    halves: &[usize],
+) -> Result<Vec<Closed<'a>>, FitError> {
     let source: Vec<&Segment> = calibration_source.into_iter().collect();
     let evaluation: Vec<&Segment> = evaluation.into_iter().collect();
-    let on: std::collections::HashSet<u64> = source.iter().map(|s| s.power_on_ns).collect();
+    let on: std::collections::HashSet<u64> = source
+        .iter()
+        .chain(diagnosis_data)
+        .map(|s| s.power_on_ns)
+        .collect();
     if let Some(shared) = evaluation.iter().find(|s| on.contains(&s.power_on_ns)) {
         return Err(FitError::Insufficient {
             unit: fitted.unit_id.clone(),
@@ -312,33 +494,51 @@ pub fn close_separate<'a>(
             ),
         });
     }
-    let mut roles = Roles::split(source.iter().copied(), calibration_set_points);
-    roles.hold_out_outside_range(fitted, settings);
-    roles.select(selection_set_points);
-    roles.not_judged = std::mem::replace(&mut roles.held_out, evaluation);
-    let life: Vec<&Segment> = source.iter().chain(&roles.held_out).copied().collect();
+    // Judged on the evaluation data alone: what the calibration source holds outside its roles
+    // (the other half of the diagnosis series among it) is not judged on.
+    let roles: Vec<Roles> = halves
+        .iter()
+        .map(|&half| {
+            let options = LoopOptions {
+                half,
+                ..options.clone()
+            };
+            let mut roles = roles_of(fitted, &source, diagnosis_data, &options, settings);
+            roles.not_judged = std::mem::replace(&mut roles.held_out, evaluation.clone());
+            roles
+        })
+        .collect();
+    let mut own: Vec<&Segment> = source.iter().chain(diagnosis_data).copied().collect();
+    own.sort_by_key(|s| s.power_on_ns);
+    let life: Vec<&Segment> = own.iter().chain(&evaluation).copied().collect();
     let core = &fitted.by_history.settings;
-    let mut kept = kept_before(&source, settings, core, clock);
-    kept.extend(kept_before(&roles.held_out, settings, core, clock));
-    close_roles(fitted, roles, &life, &kept, settings, extend_model)
+    let mut kept = kept_before(&own, settings, core, options.clock);
+    kept.extend(kept_before(&evaluation, settings, core, options.clock));
+    close_halves(fitted, roles, &life, &kept, settings, options)
 }
 
-/// The loop from its roles on: `kept[i]` is what firmware kept before `life[i]`, the unit's
-/// activations (every one of `roles`' among them).
-fn close_roles<'a>(
+/// The loop from its roles on, for each of `halves` (one, or two when the analyst's diagnosis
+/// data are cross-fitted): `kept[i]` is what firmware kept before `life[i]`, the unit's activations
+/// (every one of the roles' among them). The halves share their calibration and training roles, so
+/// stage 3's and the initial bias's choices, the rate filters' start and every candidate's
+/// absorber are made once, and each diagnosed activation is put on the grid once.
+fn close_halves<'a>(
     fitted: &FittedUnit,
-    roles: Roles<'a>,
+    halves: Vec<Roles<'a>>,
     life: &[&'a Segment],
     kept: &[[Previous; 3]],
     settings: &FitSettings,
-    extend_model: bool,
-) -> Result<Closed<'a>, FitError> {
+    options: &LoopOptions,
+) -> Result<Vec<Closed<'a>>, FitError> {
+    let Some(first) = halves.first() else {
+        return Ok(Vec::new());
+    };
     let kept_of: std::collections::HashMap<u64, [Previous; 3]> = life
         .iter()
         .zip(kept)
         .map(|(s, k)| (s.power_on_ns, *k))
         .collect();
-    let kept_training: Vec<[Previous; 3]> = roles
+    let kept_training: Vec<[Previous; 3]> = first
         .training
         .iter()
         .map(|s| {
@@ -348,74 +548,104 @@ fn close_roles<'a>(
                 .unwrap_or(Previous::NOTHING)
         })
         .collect();
-    let kept_training = kept_training.as_slice();
-    let stage3 = choose_stage3(fitted, &roles.training, kept_training, settings);
+    let stage3 = choose_stage3(fitted, &first.training, &kept_training, settings);
     let keying = Keying::new(
         std::array::from_fn(|a| stage3[a].keyed_by_history),
         life,
         kept,
     );
-    let warm_start = warm_start::choose(fitted, &keying, &roles.training, settings);
+    let warm_start = warm_start::choose(fitted, &keying, &first.training, settings);
     let keying = keying.with_warm_start(std::array::from_fn(|a| warm_start[a].chosen));
     // Where a rate filter starts at switch-on, measured once on the calibration: the diagnosis
     // starts its rate candidates there and the extended model its rate term.
     let switch_on_rate = fit_switch_on_rate(
-        &roles.calibration,
+        &first.calibration,
         &keying,
         &fitted.modified.settings,
         settings,
     );
-    let diagnosed = |keying: &Keying| -> Result<Vec<ActivationSeries>, FitError> {
+    // Every activation any half diagnoses, on the grid once per model diagnosed.
+    let mut union: Vec<&Segment> = halves.iter().flat_map(Roles::diagnosed).collect();
+    union.sort_by_key(|s| s.power_on_ns);
+    union.dedup_by_key(|s| s.power_on_ns);
+    let on_grid = |keying: &Keying| -> Result<HashMap<u64, ActivationSeries>, FitError> {
         let diagnoser = Diagnoser::new(
             fitted,
-            &roles.calibration,
+            &first.calibration,
             settings,
             keying.clone(),
             switch_on_rate.clone().map(|fit| fit.rate),
+            &options.bench_channels,
         )?;
-        Ok(roles
-            .diagnosed()
+        Ok(union
             .iter()
-            .map(|s| diagnoser.series(s))
+            .map(|s| (s.power_on_ns, diagnoser.series(s)))
             .collect())
     };
-    let series = diagnosed(&keying)?;
-    let axes = diagnose(&series);
-    let paper_axes = if keying.any() {
-        diagnose(&diagnosed(
+    let loop_grid = on_grid(&keying)?;
+    let paper_grid = if keying.any() {
+        Some(on_grid(
             &keying
                 .with_by_history([false; 3])
                 .with_warm_start([false; 3]),
         )?)
     } else {
-        axes.clone()
-    };
-    let proposed = TermPlan::choose(&axes);
-    let extended = if extend_model && !proposed.terms.is_empty() && !roles.training.is_empty() {
-        Some(extend(
-            fitted,
-            &keying,
-            &proposed,
-            &switch_on_rate,
-            &roles.calibration,
-            &roles.training,
-            settings,
-        )?)
-    } else {
         None
     };
-    Ok(Closed {
-        roles,
-        stage3,
-        warm_start,
-        keying,
-        series,
-        axes,
-        paper_axes,
-        proposed,
-        switch_on_rate,
-        extended,
-    })
+    let pick =
+        |grid: &HashMap<u64, ActivationSeries>, roles: &Roles<'a>| -> Vec<ActivationSeries> {
+            roles
+                .diagnosed()
+                .iter()
+                .filter_map(|s| grid.get(&s.power_on_ns).cloned())
+                .collect()
+        };
+    let cross_fitted = halves.len() > 1;
+    halves
+        .into_iter()
+        .enumerate()
+        .map(|(half, roles)| {
+            let series = pick(&loop_grid, &roles);
+            let axes = diagnose(&series);
+            let paper_axes = match &paper_grid {
+                Some(grid) => diagnose(&pick(grid, &roles)),
+                None => axes.clone(),
+            };
+            let proposed = TermPlan::choose(&axes);
+            let fitting = roles.fitting();
+            let extended = if options.extend && !proposed.terms.is_empty() && !fitting.is_empty() {
+                Some(extend(
+                    fitted,
+                    &keying,
+                    &proposed,
+                    &switch_on_rate,
+                    &roles.calibration,
+                    &fitting,
+                    settings,
+                )?)
+            } else {
+                None
+            };
+            let half = if cross_fitted {
+                Some(half)
+            } else {
+                (!roles.diagnosis.is_empty()).then_some(options.half)
+            };
+            Ok(Closed {
+                roles,
+                stage3: stage3.clone(),
+                warm_start: warm_start.clone(),
+                keying: keying.clone(),
+                series,
+                axes,
+                paper_axes,
+                proposed,
+                switch_on_rate: switch_on_rate.clone(),
+                extended,
+                half,
+            })
+        })
+        .collect()
 }
 
 impl Closed<'_> {

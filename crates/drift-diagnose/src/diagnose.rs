@@ -41,7 +41,7 @@ use crate::statistics::one_sided_mean_test;
 use crate::switch_on_rate::start_rates;
 use drift_evaluate::evaluate::{spread, switch_on_raw};
 use drift_fit::error::FitError;
-use drift_fit::fit::FittedUnit;
+use drift_fit::fit::{reference_indices, FittedUnit};
 use drift_fit::lowpass::centred_moving_average;
 use drift_fit::settings::FitSettings;
 
@@ -95,20 +95,26 @@ impl Diagnoser {
     ///
     /// The model diagnosed is the paper's with stage 3 keyed as `keying` says per axis; a rate
     /// candidate's filter starts at `switch_on_rate` (measured on the same calibration,
-    /// [`crate::switch_on_rate::fit_switch_on_rate`]), as the firmware's term would.
+    /// [`crate::switch_on_rate::fit_switch_on_rate`]), as the firmware's term would. Channels in
+    /// `bench_channels` describe the bench, not the unit, and are not candidates.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         fitted: &FittedUnit,
         calibration: &[&Segment],
         settings: &FitSettings,
         keying: Keying,
         switch_on_rate: [SwitchOnRate; 3],
+        bench_channels: &[String],
     ) -> Result<Self, FitError> {
         let mut channels: Vec<String> = calibration
             .first()
             .map(|s| s.aux.keys().cloned().collect())
             .unwrap_or_default();
         channels.retain(|c| calibration.iter().all(|s| s.aux.contains_key(c)));
+        // The residual heat reads the chamber set point (the bench's reference for the ambient);
+        // the set point itself, like every bench channel, is never a candidate.
         let has_set_point = channels.iter().any(|c| c == SET_POINT_CHANNEL);
+        channels.retain(|c| !bench_channels.contains(c));
         let core = fitted.modified.settings;
         // Each channel's mean over every calibration sample: where its interactions are centred.
         let centred = channels.into_iter().map(|c| {
@@ -121,6 +127,9 @@ impl Diagnoser {
             let centre = sum / n.max(1) as f64;
             (c, centre)
         });
+        // The drift fit's reference times: each candidate is taken out by the paper's own
+        // operator (`Absorber::fit`).
+        let references = reference_indices(&fitted.modified, settings);
         // A kind no calibration activation carries (an empty channel) is not offered.
         let kinds = Kind::all(centred, has_set_point)
             .into_iter()
@@ -134,6 +143,7 @@ impl Diagnoser {
                     },
                     settings,
                     &keying,
+                    &references,
                 );
                 absorber.transpose().map(|a| a.map(|a| (kind, a)))
             })
@@ -316,11 +326,16 @@ struct Score {
 /// their unit, set point and off-times, so one held out beside its siblings in the training set
 /// would be judged by what it has in common with them), `folds` folds; activation by activation
 /// when there are fewer series than folds.
+///
+/// A series is known by its unit, its recording's *nominal* set point, its kind and its index —
+/// never by a measured temperature: in a field session whose ambient ramps, the set point logged
+/// at each switch-on differs from activation to activation, and keyed on it a series fell apart
+/// into single activations (correlated folds, optimistic gains).
 pub fn series_folds(activations: &[ActivationSeries], folds: usize) -> (Vec<usize>, usize) {
     let key = |a: &ActivationSeries| {
         (
             a.labels.unit_id.clone(),
-            (a.labels.set_point_celsius * 1000.0).round() as i64,
+            (a.labels.nominal_set_point_celsius() * 1000.0).round() as i64,
             a.labels.series_kind.as_str(),
             a.labels.series,
         )

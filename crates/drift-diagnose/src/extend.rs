@@ -29,7 +29,7 @@ use crate::switch_on_rate::{switch_ons, without_heating, SwitchOnRateFit};
 use drift_evaluate::evaluate::{metric, sample_at, switch_on_raw};
 use drift_fit::analyse::analyse;
 use drift_fit::error::FitError;
-use drift_fit::fit::{fit_unit, FittedUnit};
+use drift_fit::fit::{fit_unit_at, reference_indices, FittedUnit};
 use drift_fit::lowpass::centred_moving_average;
 use drift_fit::settings::FitSettings;
 
@@ -50,6 +50,10 @@ pub struct ChosenTerm {
     /// The term's kind, as drift-core computes it.
     #[serde(skip)]
     pub term: Term,
+    /// The axes whose diagnosis found this term's candidate significant (its siblings of a vector
+    /// channel and the other axes were not): there the term is admitted unless it makes the
+    /// held-out data worse; elsewhere it must show a held-out gain of its own.
+    pub found_on: [bool; 3],
 }
 
 /// The extra terms and which recorded auxiliary channel feeds each auxiliary input.
@@ -178,15 +182,26 @@ impl TermPlan {
                     }
                     // A new auxiliary channel always makes a new term, so the channel list only
                     // grows with the terms.
-                    let new = plan
-                        .term_for(&name)
-                        .filter(|term| !plan.terms.iter().any(|t| t.term == *term));
-                    if let Some(term) = new {
-                        plan.terms.push(ChosenTerm {
-                            candidate: describe(term, &name),
-                            term,
-                        });
+                    let Some(term) = plan.term_for(&name) else {
+                        continue;
+                    };
+                    let axis_index = AXIS_NAMES.iter().position(|a| *a == axis.axis);
+                    let found_here = name == candidate.name;
+                    if let Some(known) = plan.terms.iter_mut().find(|t| t.term == term) {
+                        if let (Some(a), true) = (axis_index, found_here) {
+                            known.found_on[a] = true;
+                        }
+                        continue;
                     }
+                    let mut found_on = [false; 3];
+                    if let (Some(a), true) = (axis_index, found_here) {
+                        found_on[a] = true;
+                    }
+                    plan.terms.push(ChosenTerm {
+                        candidate: describe(term, &name),
+                        term,
+                        found_on,
+                    });
                 }
             }
         }
@@ -375,7 +390,7 @@ fn term_values(
 
 /// Family-wise significance level of the guard over every (term, axis) it tests.
 const ADMIT_ALPHA: f64 = 0.05;
-/// Folds of the guard's cross-validation by activation.
+/// Folds of the guard's cross-validation by series.
 const FOLDS: usize = 5;
 
 /// What the guard decided for one term on one axis.
@@ -399,6 +414,8 @@ pub struct Admission {
     pub drift_p_value: f64,
     /// Whether the term was admitted on this axis (coefficient fitted) or left at zero.
     pub admitted: bool,
+    /// Why, in words: every decision, and every refusal above all, says what it rests on.
+    pub reason: String,
 }
 
 /// One training activation on a 10 Hz grid: the paper model's residual and, per term, what the
@@ -546,7 +563,14 @@ fn refit(
                 )
             })
             .collect::<Result<Vec<_>, _>>()?;
-        fit_unit(&analysed, settings)?
+        // At the drift fit's reference times: the tables then take of the terms exactly what
+        // their absorbers took, and the coefficients fitted on the left-over values mean here
+        // what they meant there.
+        fit_unit_at(
+            &analysed,
+            settings,
+            Some(&reference_indices(&base.modified, settings)),
+        )?
     };
     let tables = keying
         .tables(&refitted.modified, &refitted.by_history)
@@ -622,6 +646,31 @@ fn coefficients(
     coefficient
 }
 
+/// The guard's folds over `activations`: whole series together ([`crate::roles::series_key`]),
+/// [`FOLDS`] of them; activation by activation when there are fewer series than folds.
+fn series_folds_of(activations: &[&Segment]) -> (Vec<usize>, usize) {
+    let mut keys: Vec<_> = activations
+        .iter()
+        .map(|s| crate::roles::series_key(s))
+        .collect();
+    keys.sort();
+    keys.dedup();
+    if keys.len() >= FOLDS {
+        let fold_of = activations
+            .iter()
+            .map(|s| {
+                keys.binary_search(&crate::roles::series_key(s))
+                    .unwrap_or(0)
+                    % FOLDS
+            })
+            .collect();
+        (fold_of, FOLDS)
+    } else {
+        let folds = FOLDS.clamp(2, activations.len().max(2));
+        ((0..activations.len()).map(|i| i % folds).collect(), folds)
+    }
+}
+
 /// One held-out activation's evidence on one axis.
 struct HeldOutGain {
     /// Mean square of the 1-s residual without the term less with it, (°/s)².
@@ -660,20 +709,20 @@ fn held_out_gains(
     let with: [Vec<usize>; 3] = admitted
         .clone()
         .map(|a| a.into_iter().chain([term]).collect());
-    let folds = FOLDS.clamp(2, training.len().max(2));
+    let (fold_of, folds) = series_folds_of(training);
     let mut gains: [Vec<HeldOutGain>; 3] = Default::default();
     for fold in 0..folds {
         let train: Vec<&TrainingSeries> = series
             .iter()
-            .enumerate()
-            .filter(|(i, _)| i % folds != fold)
-            .map(|(_, s)| s)
+            .zip(&fold_of)
+            .filter(|(_, &f)| f != fold)
+            .map(|(s, _)| s)
             .collect();
         let held_out: Vec<&Segment> = training
             .iter()
-            .enumerate()
-            .filter(|(i, _)| i % folds == fold)
-            .map(|(_, s)| *s)
+            .zip(&fold_of)
+            .filter(|(_, &f)| f == fold)
+            .map(|(s, _)| *s)
             .collect();
         let held_out_errors = |chosen: &[Vec<usize>; 3]| -> Result<Vec<[(f64, f64); 3]>, FitError> {
             let extension = plan.extension(centre, &coefficients(plan, &train, chosen));
@@ -740,6 +789,7 @@ pub fn extend(
         switch_on_rate: std::array::from_fn(|a| start(&switch_on_rate[a])),
         ..plan.clone()
     };
+    let references = reference_indices(&base.modified, settings);
     let absorbers = (0..plan.terms.len())
         .map(|t| {
             Absorber::fit(
@@ -752,6 +802,7 @@ pub fn extend(
                 },
                 settings,
                 keying,
+                &references,
             )?
             .ok_or_else(|| FitError::Insufficient {
                 unit: base.unit_id.clone(),
@@ -805,22 +856,72 @@ pub fn extend(
             let level = ADMIT_ALPHA / (3 * plan.terms.len()).max(1) as f64;
             let drift_before =
                 gains.iter().map(|g| g.drift_before).sum::<f64>() / gains.len().max(1) as f64;
+            // Where the diagnosis found the term significant, the burden is on refusing it: it
+            // is admitted unless the held-out folds say it makes things worse, on the metric it
+            // is for or on the other one (one-sided, 5 %). A right, significant candidate that
+            // waited for a Bonferroni-level gain of its own on a few dozen activations went
+            // unadmitted on every axis it was found on.
+            let squared_worse = improvement < 0.0 && 1.0 - p_value < ADMIT_ALPHA;
+            let drift_worse =
+                drift_gain < -0.01 * drift_before && 1.0 - drift_p_value < ADMIT_ALPHA;
+            if chosen.found_on[axis] {
+                let admit = !squared_worse && !drift_worse;
+                let reason = if admit {
+                    "significant in the diagnosis on this axis, and no worse on the held-out folds"
+                        .to_owned()
+                } else if drift_worse {
+                    format!(
+                        "significant in the diagnosis, but raises the held-out drift by {:.2e} °/s (p {:.3})",
+                        -drift_gain,
+                        1.0 - drift_p_value
+                    )
+                } else {
+                    format!(
+                        "significant in the diagnosis, but raises the held-out squared residual by {:.2e} (°/s)² (p {:.3})",
+                        -improvement,
+                        1.0 - p_value
+                    )
+                };
+                if admit {
+                    admitted[axis].push(t);
+                }
+                admissions.push(Admission {
+                    candidate: chosen.candidate.clone(),
+                    axis: AXIS_NAMES[axis],
+                    improvement,
+                    p_value,
+                    drift_gain_dps: drift_gain,
+                    drift_p_value,
+                    admitted: admit,
+                    reason,
+                });
+                continue;
+            }
             // Each kind is tested on the metric it is for, and refused when it costs the other
             // one significantly (one-sided, 5 %).
             let admit = if changes_shape(chosen.term) {
                 // A shape within activations (the element's heating rate, rise², another axis's
                 // rise) lowers the drift of every activation while its share of the squared
                 // residual, which the offsets between activations dominate, stays in the noise.
-                let squared_worse = improvement < 0.0 && 1.0 - p_value < ADMIT_ALPHA;
                 drift_p_value < level && drift_gain > 0.0 && !squared_worse
             } else {
                 // An auxiliary input moves offsets (supply, orientation), which the drift cannot
                 // see; it may add wiggles within activations: refused when the drift gets worse
                 // by more than 1 %. Not "no worse on average": an offset term leaves the metric
                 // alone up to noise, and a refit moves it consistently by ~1e-7 °/s.
-                let drift_worse =
-                    drift_gain < -0.01 * drift_before && 1.0 - drift_p_value < ADMIT_ALPHA;
                 p_value < level && improvement > 0.0 && !drift_worse
+            };
+            let (metric, p) = if changes_shape(chosen.term) {
+                ("drift", drift_p_value)
+            } else {
+                ("squared residual", p_value)
+            };
+            let reason = if admit {
+                format!("not found on this axis, but lowers the held-out {metric} (p {p:.1e} < {level:.1e})")
+            } else if squared_worse || drift_worse {
+                "not found on this axis, and makes the held-out data worse".to_owned()
+            } else {
+                format!("not found on this axis, and its held-out {metric} gain is not significant (p {p:.3}, needs < {level:.1e} over every term and axis)")
             };
             if admit {
                 admitted[axis].push(t);
@@ -833,6 +934,7 @@ pub fn extend(
                 drift_gain_dps: drift_gain,
                 drift_p_value,
                 admitted: admit,
+                reason,
             });
         }
     }

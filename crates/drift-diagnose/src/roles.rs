@@ -8,6 +8,11 @@
 //! - **selection** (only when the analyst names set points for it): the protocol activations at
 //!   those set points, which the fit never saw — the diagnosis ranks candidates on them beside the
 //!   training ones, and nothing is measured on them;
+//! - **diagnosis** (when the analyst names data for it: `--diagnose-on` set points of the campaign,
+//!   or `--diagnosis-data`): half of the named series — ranked on, terms fitted and guarded on —
+//!   while the other half stays held out and judges; the loop then runs again with the halves
+//!   swapped ([`Roles::diagnose_on`]), so that every named series is judged once by a loop that
+//!   never saw it;
 //! - **held out**: everything else (other set points, other sessions, and the training-like
 //!   activations outside the ambient range) — the before/after is measured on them.
 
@@ -28,6 +33,9 @@ pub struct Roles<'a> {
     pub training: Vec<&'a Segment>,
     /// Protocol activations at set points named for the diagnosis ([`Roles::select`]).
     pub selection: Vec<&'a Segment>,
+    /// The half of the analyst's diagnosis series this loop ranks, fits and guards on
+    /// ([`Roles::diagnose_on`]); the other half is held out.
+    pub diagnosis: Vec<&'a Segment>,
     /// Everything else.
     pub held_out: Vec<&'a Segment>,
     /// How many field-like activations at the calibration set points were moved to `held_out`
@@ -91,11 +99,45 @@ impl<'a> Roles<'a> {
         self.held_out = kept;
     }
 
+    /// Moves half of the series in `named` (the analyst's diagnosis data: the held-out activations
+    /// at the `--diagnose-on` set points, field and protocol, or a separate source) to the
+    /// diagnosis role and holds out the other half: `half` 0 or 1 picks which. Series are known by
+    /// unit, nominal set point, kind and index ([`series_key`]), never by a measured temperature,
+    /// and alternate between the halves in that order, so both halves span the same set points
+    /// and kinds.
+    pub fn diagnose_on(&mut self, named: impl Fn(&Segment) -> bool, half: usize) {
+        let (mut named, kept): (Vec<&Segment>, Vec<&Segment>) = std::mem::take(&mut self.held_out)
+            .into_iter()
+            .partition(|s| named(s));
+        let mut keys: Vec<SeriesKey> = named.iter().map(|s| series_key(s)).collect();
+        keys.sort();
+        keys.dedup();
+        let in_half = |s: &Segment| {
+            keys.binary_search(&series_key(s))
+                .is_ok_and(|i| i % 2 == half % 2)
+        };
+        let (diagnosis, judged): (Vec<&Segment>, Vec<&Segment>) =
+            named.drain(..).partition(|s| in_half(s));
+        self.diagnosis.extend(diagnosis);
+        self.held_out = kept;
+        self.held_out.extend(judged);
+    }
+
+    /// The activations the extended model's coefficients are fitted and its terms guarded on: the
+    /// training ones and the diagnosis half.
+    pub fn fitting(&self) -> Vec<&'a Segment> {
+        self.training
+            .iter()
+            .chain(&self.diagnosis)
+            .copied()
+            .collect()
+    }
+
     /// The activations the diagnosis ranks candidates on: the training and selection ones when
     /// there are any (so the held-out ones stay unseen until the before/after), else the ones not
     /// judged on (with a separate evaluation source), else every activation the fit did not see.
     pub fn diagnosed(&self) -> Vec<&'a Segment> {
-        if self.training.is_empty() && self.selection.is_empty() {
+        if self.training.is_empty() && self.selection.is_empty() && self.diagnosis.is_empty() {
             if self.not_judged.is_empty() {
                 self.held_out.clone()
             } else {
@@ -105,10 +147,26 @@ impl<'a> Roles<'a> {
             self.training
                 .iter()
                 .chain(&self.selection)
+                .chain(&self.diagnosis)
                 .copied()
                 .collect()
         }
     }
+}
+
+/// What identifies a series: unit, nominal set point (m°C), kind and series index.
+pub type SeriesKey = (String, i64, &'static str, u32);
+
+/// The series `segment` belongs to ([`SeriesKey`]): the recording's nominal set point, not the
+/// ambient at switch-on, which in a ramped field session differs at every activation.
+pub fn series_key(segment: &Segment) -> SeriesKey {
+    let labels = &segment.labels;
+    (
+        labels.unit_id.clone(),
+        (labels.nominal_set_point_celsius() * 1000.0).round() as i64,
+        labels.series_kind.as_str(),
+        labels.series,
+    )
 }
 
 #[cfg(test)]
@@ -121,13 +179,22 @@ mod tests {
 
     /// A one-sample activation: only its labels matter to the split.
     fn activation(kind: SeriesKind, at_switch_on: f64, session: Option<f64>) -> Segment {
+        in_series(kind, at_switch_on, session, 1)
+    }
+
+    fn in_series(
+        kind: SeriesKind,
+        at_switch_on: f64,
+        session: Option<f64>,
+        series: u32,
+    ) -> Segment {
         Segment {
             labels: SegmentLabels {
                 unit_id: "U".into(),
                 set_point_celsius: at_switch_on,
                 session_set_point_celsius: session,
                 series_kind: kind,
-                series: 1,
+                series,
                 repeat: 1,
                 activation: 1,
                 interval_min: None,
@@ -139,6 +206,60 @@ mod tests {
             rate_dps: [vec![0.0], vec![0.0], vec![0.0]],
             temperature_raw: [vec![6000], vec![6000], vec![6000]],
             aux: BTreeMap::new(),
+        }
+    }
+
+    /// The analyst's diagnosis series at +33 °C (ramped: every switch-on logs another set point)
+    /// split into halves of whole series, alternating; the calibration's roles stay as they were,
+    /// and the other half is held out.
+    #[test]
+    fn diagnosis_series_split_into_halves_of_whole_series() {
+        let mut segments = vec![
+            in_series(SeriesKind::Protocol, 30.0, Some(30.0), 1),
+            in_series(SeriesKind::Field, 30.4, Some(30.0), 1),
+        ];
+        for series in 1..=4 {
+            for k in 0..5 {
+                segments.push(in_series(
+                    SeriesKind::Field,
+                    31.0 + f64::from(k) * 0.7 + f64::from(series) * 0.01,
+                    Some(33.0),
+                    series,
+                ));
+            }
+        }
+        segments.push(in_series(SeriesKind::Protocol, 33.0, Some(33.0), 1));
+        let named = |s: &Segment| is_one_of(s.labels.nominal_set_point_celsius(), &[33.0]);
+        let halves: Vec<Roles> = (0..2)
+            .map(|half| {
+                let mut roles = Roles::split(&segments, &[30.0, 40.0]);
+                roles.diagnose_on(named, half);
+                roles
+            })
+            .collect();
+        for (half, roles) in halves.iter().enumerate() {
+            assert_eq!(roles.calibration.len(), 1);
+            assert_eq!(roles.training.len(), 1);
+            let keys = |v: &[&Segment]| -> Vec<SeriesKey> {
+                let mut k: Vec<SeriesKey> = v.iter().map(|s| series_key(s)).collect();
+                k.dedup();
+                k
+            };
+            let diagnosed = keys(&roles.diagnosis);
+            // Whole series: five activations per field series in this half.
+            let field = roles
+                .diagnosis
+                .iter()
+                .filter(|s| s.labels.series_kind == SeriesKind::Field)
+                .count();
+            assert_eq!(field % 5, 0, "half {half}: {field}");
+            let other = &halves[1 - half];
+            assert!(diagnosed
+                .iter()
+                .all(|k| !keys(&other.diagnosis).contains(k)));
+            assert_eq!(roles.diagnosis.len() + other.diagnosis.len(), 21);
+            assert_eq!(roles.held_out.len(), 21 - roles.diagnosis.len());
+            assert!(roles.fitting().len() == 1 + roles.diagnosis.len());
         }
     }
 

@@ -120,3 +120,24 @@ fn model_inputs_are_absorbed_and_noise_is_not_significant() {
         "{false_alarms} of 20 null runs reported an effect"
     );
 }
+
+/// A ramped field series logs another set point at every switch-on; its activations still share
+/// one fold, because a series is known by its recording's nominal set point.
+#[test]
+fn a_ramped_field_series_stays_in_one_fold() {
+    let mut noise = Lcg(7);
+    let activations: Vec<ActivationSeries> = (0..30)
+        .map(|i| {
+            let mut a = activation(i, |_, _, _| 0.0, &mut noise);
+            a.labels.series = (i / 5) as u32;
+            a.labels.session_set_point_celsius = Some(33.0);
+            a.labels.set_point_celsius = 31.0 + 0.37 * i as f64;
+            a
+        })
+        .collect();
+    let (fold_of, folds) = drift_diagnose::diagnose::series_folds(&activations, 5);
+    assert_eq!(folds, 5);
+    for series in fold_of.chunks(5) {
+        assert!(series.iter().all(|&f| f == series[0]), "{fold_of:?}");
+    }
+}

@@ -153,11 +153,30 @@ fn axis_table(
     first: usize,
     settings: &FitSettings,
     stage3: Stage3,
+    given: Option<&[usize]>,
 ) -> Result<(Box<Table>, Vec<String>), String> {
     let window = settings.reference_window_points;
     let mut table = Box::<Table>::default();
     let mut notes = Vec::new();
-    let knots = choose(set_points, axis, first, settings.reference_count, window);
+    let shortest = set_points
+        .iter()
+        .flat_map(|sp| sp.curves.iter())
+        .map(|c| c.len())
+        .min()
+        .unwrap_or(0);
+    let knots = match given {
+        Some(knots) => {
+            if let Some(&late) = knots.iter().find(|&&j| j >= shortest) {
+                return Err(format!(
+                    "axis {axis}: the given reference time {} ms lies after the shortest curve's end ({} ms)",
+                    late as u64 * u64::from(settings.grid_ms),
+                    shortest as u64 * u64::from(settings.grid_ms)
+                ));
+            }
+            knots.to_vec()
+        }
+        None => choose(set_points, axis, first, settings.reference_count, window),
+    };
     for &j in &knots {
         let _ = table.reference_ms.push(j as u32 * settings.grid_ms);
     }
@@ -320,6 +339,36 @@ fn smooth_warm_starts(starts: &[(f64, f64, f64)]) -> heapless::Vec<WarmStart, MA
 /// Fits one unit from its analysed activations (calibration set points only: the caller keeps the
 /// validation data out).
 pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<FittedUnit, FitError> {
+    fit_unit_at(activations, settings, None)
+}
+
+/// The reference times of `tables`, per axis, as indices of the analysis grid of `settings`: what
+/// [`fit_unit_at`] takes to fit other quantities at the same reference times.
+pub fn reference_indices(tables: &ModifiedTables, settings: &FitSettings) -> [Vec<usize>; 3] {
+    let grid_ms = settings.grid_ms.max(1);
+    std::array::from_fn(|axis| {
+        tables.axes[axis]
+            .reference_ms
+            .iter()
+            .map(|&ms| (ms / grid_ms) as usize)
+            .collect()
+    })
+}
+
+/// [`fit_unit`] with the reference times given per axis (grid indices, [`reference_indices`])
+/// instead of chosen from the data, or chosen when `references` is `None`.
+///
+/// Why: for fixed reference times the paper's fit — the initial bias (an intercept), `k` at each
+/// reference time (a mean of drift over rise), the warm starts (least squares) — is linear in the
+/// rates, and so is the corrector's prediction. The tables fitted to a quantity `x` at the
+/// reference times the drift fit chose are then exactly what the drift's tables take of `x`: the
+/// paper leaves `c·(x − L x)` of a bias `g + c·x` beside what it leaves of `g`. Chosen afresh for
+/// `x`, the reference times differ and that identity is lost.
+pub fn fit_unit_at(
+    activations: &[Analysed],
+    settings: &FitSettings,
+    references: Option<&[Vec<usize>; 3]>,
+) -> Result<FittedUnit, FitError> {
     check(settings)?;
     let unit_id = activations
         .first()
@@ -423,8 +472,11 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
     let (tables, ((standard, third_order), (relative, relative_orders))) = rayon::join(
         || {
             per_axis(|axis| {
-                let by_rise = axis_table(&set_points, axis, first, settings, Stage3::ByRise)?;
-                let by_history = axis_table(&set_points, axis, first, settings, Stage3::ByHistory)?;
+                let given = references.map(|r| r[axis].as_slice());
+                let by_rise =
+                    axis_table(&set_points, axis, first, settings, Stage3::ByRise, given)?;
+                let by_history =
+                    axis_table(&set_points, axis, first, settings, Stage3::ByHistory, given)?;
                 Ok::<_, String>((by_rise, by_history))
             })
         },

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use drift_diagnose::closing::close;
+use drift_diagnose::closing::{close, LoopOptions};
 use drift_diagnose::closing::{BeforeAfter, Profile, Stage3Choice, PROFILE_EDGES_S};
 use drift_diagnose::diagnose::AxisDiagnosis;
 use drift_diagnose::extend::Admission;
@@ -112,7 +112,11 @@ pub fn diagnose_unit(
                 all.len()
             )));
         }
-        let closed = close(unit, own, &set_points, &[], settings, extend, true)?;
+        let options = LoopOptions {
+            extend,
+            ..LoopOptions::new(&set_points)
+        };
+        let closed = close(unit, own, &[], &options, settings)?;
         if closed.series.is_empty() {
             return Err(Error::Input(format!(
                 "`segments` holds no activation of unit {} outside the calibration protocol at {set_points:?} °C to diagnose",
