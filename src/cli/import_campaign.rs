@@ -1,5 +1,7 @@
 //! `gyrodrift import campaign`: a bench campaign kept as one CSV file per activation plus an
-//! activation sheet → a campaign folder that `fit`, `report`, `diagnose` and `check` read.
+//! activation sheet → a campaign folder that `fit`, `report`, `diagnose` and `check` read. An
+//! activation file may also be a ROS 2 bag (an `.mcap` file or a bag folder) or a PX4 ULog
+//! (`.ulg`), read as `import rosbag` and `import ulog` read one log.
 //!
 //! Everything is read and validated first (errors name the sheet or the activation file, the row
 //! and the column); the recordings and `import.json` are then written into a temporary folder
@@ -8,9 +10,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use drift_recording::{read_sheet_campaign, write_recording, RECORDINGS_DIR};
+use drift_recording::{read_sheet_campaign_with, write_recording, RECORDINGS_DIR};
 
 use super::reading::ReadingArgs;
+use super::sheet_logs::LogArgs;
 
 /// Options of `gyrodrift import campaign`.
 #[derive(Debug, clap::Args)]
@@ -26,6 +29,9 @@ pub struct CampaignArgs {
     /// Column mapping, units and timing of every activation file.
     #[command(flatten)]
     pub reading: ReadingArgs,
+    /// Topics and clock of the activation files that are ROS 2 bags or ULog files.
+    #[command(flatten)]
+    pub logs: LogArgs,
 }
 
 /// The temporary folder beside `out` that becomes `out`.
@@ -56,7 +62,13 @@ pub fn refuse_existing(out: &Path) -> anyhow::Result<()> {
 pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
     let options = args.reading.options()?;
     refuse_existing(&args.out)?;
-    let recordings = read_sheet_campaign(&args.sheet, &options)?;
+    let clock = args.logs.clock()?;
+    let max_gap = args.reading.max_gap;
+    let recordings = read_sheet_campaign_with(&args.sheet, &options, &|path, csv| {
+        args.logs
+            .read(path, csv, clock, max_gap)
+            .map(|read| read.map_err(|e| super::message(&e).into()))
+    })?;
     let manifest = serde_json::json!({
         "sheet": args.sheet.display().to_string(),
         "sample_rate_hz": args.reading.rate_hz,

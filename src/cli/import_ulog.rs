@@ -49,7 +49,7 @@ pub struct UlogArgs {
 }
 
 /// The gyro topics of a log: (unit suffix, topic, rate fields, temperature field).
-fn gyros(log: &Ulog) -> Vec<(String, &UlogTopic, [&'static str; 3], &'static str)> {
+pub(super) fn gyros(log: &Ulog) -> Vec<(String, &UlogTopic, [&'static str; 3], &'static str)> {
     let gyro = log.topic("sensor_gyro");
     if !gyro.is_empty() {
         return gyro
@@ -81,7 +81,7 @@ fn gyros(log: &Ulog) -> Vec<(String, &UlogTopic, [&'static str; 3], &'static str
 
 /// One topic instance of one log as CSV text (time s, rates rad/s, temperature °C), read back by
 /// the CSV reader with resampling: one activation.
-fn activation(
+pub(super) fn activation(
     log: &Ulog,
     topic: &UlogTopic,
     rates: [&str; 3],

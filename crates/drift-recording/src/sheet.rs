@@ -7,7 +7,7 @@
 //!
 //! | column | meaning | empty cell |
 //! |---|---|---|
-//! | `file` | the activation's CSV file, relative to the sheet's folder | error |
+//! | `file` | the activation's file (CSV, or a log the caller reads: a ROS 2 bag file or folder, a PX4 ULog), relative to the sheet's folder | error |
 //! | `unit` | unit id | error |
 //! | `set_point_celsius` | chamber set point of the session, °C | error |
 //! | `series` | series number (from 1) | error |
@@ -32,7 +32,7 @@ use crate::aux::fixed_aux_unit;
 use crate::csv_file::{read_csv, CsvError, CsvOptions};
 use crate::layout::AUX_RATE_HZ;
 use crate::read::Recording;
-use crate::segment::{AuxChannel, SeriesKind, RAW_PER_CELSIUS};
+use crate::segment::{AuxChannel, Segment, SeriesKind, RAW_PER_CELSIUS};
 
 /// The format's own auxiliary channel of the chamber's set point, °C.
 const SET_POINT_CHANNEL: &str = "chamber_set_point";
@@ -97,6 +97,19 @@ pub enum SheetError {
         line: u64,
         /// The activation file's error.
         source: Box<CsvError>,
+    },
+    /// An activation log (a ROS 2 bag, a ULog) failed to read: the sheet's row here, the log's
+    /// file, topic and message in the source error.
+    #[error("{sheet}: row {row} (line {line}), column `file`")]
+    Log {
+        /// The sheet.
+        sheet: PathBuf,
+        /// The sheet's data row naming the log.
+        row: u64,
+        /// Its line.
+        line: u64,
+        /// The log reader's error.
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// The sheet has no data row.
     #[error("{path}: no activations (the sheet has a header but no data rows)")]
@@ -216,7 +229,7 @@ pub fn read_sheet(path: &Path) -> Result<Vec<SheetRow>, SheetError> {
         };
         let file_text = required("file")?;
         let file = folder.join(file_text);
-        if !file.is_file() {
+        if !file.exists() {
             return Err(bad("file", format!("no such file `{}`", file.display())));
         }
         if let Some(first) = seen_files.insert(file.clone(), row) {
@@ -345,6 +358,22 @@ pub fn read_sheet_campaign(
     sheet: &Path,
     options: &CsvOptions,
 ) -> Result<Vec<(String, Recording)>, SheetError> {
+    read_sheet_campaign_with(sheet, options, &|_, _| None)
+}
+
+/// What reads an activation file that is not CSV: `Some` with the activation's samples (or why
+/// they cannot be read) for a file it knows (a ROS 2 bag, a ULog), `None` for a CSV file. It gets
+/// the row's file and the CSV options with the row's unit, set point and series kind.
+pub type LogReader<'a> = dyn Fn(&Path, &CsvOptions) -> Option<Result<Segment, Box<dyn std::error::Error + Send + Sync>>>
+    + 'a;
+
+/// [`read_sheet_campaign`], with `logs` reading the activation files that are logs of another
+/// tool; each activation's labels are the sheet's whatever the file says.
+pub fn read_sheet_campaign_with(
+    sheet: &Path,
+    options: &CsvOptions,
+    logs: &LogReader<'_>,
+) -> Result<Vec<(String, Recording)>, SheetError> {
     let rows = read_sheet(sheet)?;
     let mut order: Vec<(String, SeriesKind, u64)> = Vec::new();
     for row in &rows {
@@ -380,13 +409,25 @@ pub fn read_sheet_campaign(
             file_options.set_point_celsius =
                 Some(row.switch_on_ambient_celsius.unwrap_or(set_point));
             file_options.series_kind = *kind;
-            let read = read_csv(&row.file, &file_options).map_err(|source| SheetError::File {
-                sheet: sheet.to_path_buf(),
-                row: row_number,
-                line,
-                source: Box::new(source),
-            })?;
-            let Some(mut segment) = read.segments.into_iter().next() else {
+            let segment = match logs(&row.file, &file_options) {
+                Some(read) => Some(read.map_err(|source| SheetError::Log {
+                    sheet: sheet.to_path_buf(),
+                    row: row_number,
+                    line,
+                    source,
+                })?),
+                None => {
+                    let read =
+                        read_csv(&row.file, &file_options).map_err(|source| SheetError::File {
+                            sheet: sheet.to_path_buf(),
+                            row: row_number,
+                            line,
+                            source: Box::new(source),
+                        })?;
+                    read.segments.into_iter().next()
+                }
+            };
+            let Some(mut segment) = segment else {
                 return Err(SheetError::Row {
                     path: sheet.to_path_buf(),
                     row: row_number,
