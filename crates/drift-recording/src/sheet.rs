@@ -323,6 +323,40 @@ pub fn read_sheet(path: &Path) -> Result<Vec<SheetRow>, SheetError> {
     Ok(rows)
 }
 
+/// How far the sensor's temperature at switch-on may lie below the chamber's (a chamber still
+/// settling), and above it (heat left from the previous activation), °C.
+const SWITCH_ON_BELOW_C: f64 = 5.0;
+const SWITCH_ON_ABOVE_C: f64 = 30.0;
+
+/// The activation's first temperature reading against the sheet's ambient: a label of another
+/// set point, or a temperature in another unit than °C, is refused.
+fn check_switch_on_temperature(
+    segment: &Segment,
+    ambient: f64,
+    row: &SheetRow,
+) -> Result<(), String> {
+    let first = (0..3)
+        .filter_map(|axis| {
+            segment.temperature_raw[axis]
+                .iter()
+                .find(|&&r| r != crate::segment::TEMPERATURE_MISSING_RAW)
+                .map(|&r| f64::from(r) / RAW_PER_CELSIUS)
+        })
+        .fold(None, |m: Option<f64>, c| Some(m.map_or(c, |m| m.min(c))));
+    let Some(celsius) = first else {
+        return Ok(());
+    };
+    if celsius < ambient - SWITCH_ON_BELOW_C || celsius > ambient + SWITCH_ON_ABOVE_C {
+        return Err(format!(
+            "{ambient} °C, but the data of `{}` start at {celsius:.2} °C: a sensor switched on in this ambient reads between {:.0} and {:.0} °C; the label is another set point's, or the file's temperature is not in °C",
+            row.file.display(),
+            ambient - SWITCH_ON_BELOW_C,
+            ambient + SWITCH_ON_ABOVE_C
+        ));
+    }
+    Ok(())
+}
+
 /// The recording a sheet row goes into: unit, series kind and set point.
 fn recording_key(row: &SheetRow) -> (String, SeriesKind, u64) {
     (
@@ -445,6 +479,25 @@ pub fn read_sheet_campaign_with(
                     end.saturating_add(off_ns)
                 }
             };
+            let ambient = row.switch_on_ambient_celsius.unwrap_or(set_point);
+            // A field session's chamber may ramp away from the sensor; a protocol's is settled.
+            let checked = if *kind == SeriesKind::Protocol {
+                check_switch_on_temperature(&segment, ambient, row)
+            } else {
+                Ok(())
+            };
+            checked.map_err(|reason| SheetError::Row {
+                path: sheet.to_path_buf(),
+                row: row_number,
+                line,
+                column: if row.switch_on_ambient_celsius.is_some() {
+                    "switch_on_ambient_celsius"
+                } else {
+                    "set_point_celsius"
+                }
+                .into(),
+                reason,
+            })?;
             if let Some((end, (prev_row, _))) = previous {
                 if power_on_ns <= end {
                     return Err(SheetError::Row {
@@ -460,9 +513,22 @@ pub fn read_sheet_campaign_with(
                         ),
                     });
                 }
+                if let (Some(off), Some(_)) = (row.off_before_s, row.switch_on_ns) {
+                    let gap = power_on_ns.saturating_sub(end) as f64 * 1e-9;
+                    if (off - gap).abs() > (0.05 * gap).max(1.0) {
+                        return Err(SheetError::Row {
+                            path: sheet.to_path_buf(),
+                            row: row_number,
+                            line,
+                            column: "off_before_s".into(),
+                            reason: format!(
+                                "{off} s, but `switch_on_s` puts this switch-on {gap:.1} s after the end of the previous activation (row {prev_row}); correct one of them"
+                            ),
+                        });
+                    }
+                }
             }
             segment.power_on_ns = power_on_ns;
-            let ambient = row.switch_on_ambient_celsius.unwrap_or(set_point);
             // The chamber's set point as the format's own channel, constant over the activation:
             // what the sheet knows of it (a bench logging it would give it per sample).
             if fs % AUX_RATE_HZ == 0 {
