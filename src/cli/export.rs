@@ -96,7 +96,7 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    super::import_campaign::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out)?;
     let stage = staging(&args.out);
     let written = write_folder(&stage, &recording.segments, source, &topics).and_then(|n| {
         std::fs::rename(&stage, &args.out)

@@ -289,7 +289,7 @@ pub fn run(args: &RosbagArgs) -> anyhow::Result<()> {
             "option `--rate-hz`: must divide 10⁹, got {rate}"
         );
     }
-    super::import_campaign::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out)?;
     let topics = BagTopics {
         gyro: args.gyro_topic.clone(),
         temperature: args.temperature_topic.clone(),
@@ -438,7 +438,7 @@ pub fn run(args: &RosbagArgs) -> anyhow::Result<()> {
         },
         "bags": listed,
     });
-    let lines = super::import_campaign::write_campaign(&args.out, &[(stem, recording)], &manifest)?;
+    let lines = super::campaign_out::write_campaign(&args.out, &[(stem, recording)], &manifest)?;
     for line in lines {
         println!("{line}");
     }

@@ -175,7 +175,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         )
     })?;
     let options = log_options(args.rate_hz, args.max_gap, args.set_point, kind);
-    super::import_campaign::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out)?;
     let files = logs(&args.path)?;
     let mut units: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
     let mut read = Vec::new();
@@ -246,7 +246,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         "off_times": "unknown: ULog headers carry boot time, not wall-clock time",
         "logs": read,
     });
-    let lines = super::import_campaign::write_campaign(&args.out, &recordings, &manifest)?;
+    let lines = super::campaign_out::write_campaign(&args.out, &recordings, &manifest)?;
     for line in lines {
         println!("{line}");
     }

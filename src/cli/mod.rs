@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 mod campaign_args;
+mod campaign_out;
 pub mod check;
 pub mod demo;
 pub mod diagnose;
