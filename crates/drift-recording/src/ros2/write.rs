@@ -61,7 +61,7 @@ pub struct WrittenBag {
 /// rad/s; no orientation or acceleration estimate: element 0 of their covariances is −1) and one
 /// `sensor_msgs/msg/Temperature` per axis (°C, NaN for a missing reading), with `header.stamp` =
 /// log time = the sample's time on the recording clock and `header.frame_id` = the unit id; and
-/// the labels record ([`super::labels`]) that `import rosbag` reads back. Written through a
+/// the labels record ([`super::LABELS_RECORD`]) that `import rosbag` reads back. Written through a
 /// temporary file renamed at the end.
 pub fn write_ros2_bag(
     path: &Path,
