@@ -2,7 +2,8 @@
 `rosbags` library (scripts/ros2-campaign.py): 2 set points × 3 off-times × 5 activations at 100 Hz
 (20 s each here; the full-size 2-min campaign is measured in docs/measured.md), labelled by an
 activation sheet, go `import campaign` → `fit` → `report`, and the fitted drift has the slope the
-bags were written with. Needs the CLI binary: GYRODRIFT_BIN (scripts/check-python.sh sets it).
+bags were written with. What `export ros2` writes opens in `rosbags`' AnyReader, and a bag whose
+messages rosbag2 compressed is refused with the word "compressed". Needs the CLI binary: GYRODRIFT_BIN (scripts/check-python.sh sets it).
 """
 
 from __future__ import annotations
@@ -91,3 +92,54 @@ def test_bags_written_by_rosbags_import_fit_and_report_with_the_known_slope(tmp_
         rise = sum(c * (1 - (-1) ** k) for k, c in enumerate(coefficients))
         slope = rise / (high - low)
         assert abs(slope - want) <= 0.02 * want, (slope, want)
+
+
+def test_an_export_opens_in_rosbags_and_a_compressed_bag_is_refused_by_name(tmp_path: Path) -> None:
+    from rosbags.highlevel import AnyReader
+
+    gyrodrift = binary()
+    bags = tmp_path / "bags"
+    run(sys.executable, str(SCRIPT), str(bags), "--seconds", "3", "--set-points", "30")
+    campaign = tmp_path / "campaign"
+    run(gyrodrift, "import", "campaign", str(bags / "sheet.csv"), "-o", str(campaign), "--rate-hz", "100")
+    exported = tmp_path / "exported"
+    run(
+        gyrodrift,
+        "export",
+        "ros2",
+        str(campaign / "recordings" / "ROBOT-1_sp+30.0C_protocol.mcap"),
+        "-o",
+        str(exported),
+    )
+    manifest = json.loads((campaign / "import.json").read_text())
+    samples = [a["samples"] for a in manifest["recordings"][0]["activations"]]
+    assert len(samples) == 15
+    for k, n in enumerate(samples, start=1):
+        with AnyReader([exported / f"activation-{k:03}"]) as reader:
+            hashes = {c.topic: c.digest for c in reader.connections}
+            assert hashes["/imu/data"].startswith("RIHS01_"), hashes
+            count = 0
+            for connection, _, raw in reader.messages():
+                message = reader.deserialize(raw, connection.msgtype)
+                assert message.header.frame_id == "ROBOT-1"
+                count += 1
+            assert count == 4 * n, (k, count, n)
+    squeezed = tmp_path / "squeezed"
+    run(
+        sys.executable,
+        str(SCRIPT),
+        str(squeezed),
+        "--seconds",
+        "1",
+        "--set-points",
+        "30",
+        "--compression",
+        "message",
+    )
+    done = subprocess.run(
+        [gyrodrift, "import", "rosbag", str(squeezed / "sp+30_off1min_1"), "-o", str(tmp_path / "refused")],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 2, done.stderr
+    assert "compressed" in done.stderr and "topic /imu/data, message #0" in done.stderr, done.stderr
