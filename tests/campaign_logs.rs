@@ -1,7 +1,8 @@
 //! `gyrodrift import campaign` with ROS 2 bags in the sheet's `file` column: a simulated series
 //! exported as one bag folder per activation and labelled by a sheet imports to the same samples
 //! with the sheet's labels; sheet labels the data contradict (a set point the temperatures are
-//! not at, an off-time the switch-on times do not give) are refused by row and column.
+//! not at, an off-time the switch-on times do not give) are refused by row and column; a PX4 log
+//! in the sheet gives one gyro, chosen by option.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -121,4 +122,56 @@ fn bags_named_by_a_sheet_import_with_its_labels_and_contradicting_labels_are_ref
         "{text}"
     );
     assert!(!refused.exists());
+}
+
+/// A real PX4 log in the sheet (pyulog's sample, when the shared data is present): one of its
+/// three gyros, chosen by `--ulog-instance`, with the sheet's labels.
+#[test]
+fn a_ulog_named_by_a_sheet_imports_one_gyro_with_the_sheet_labels() {
+    let log = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/formats/px4-ulog/sample_log_small.ulg");
+    if !log.exists() {
+        eprintln!("skipped: {} is not here", log.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::copy(&log, d.join("flight.ulg")).unwrap();
+    let sheet_path = d.join("sheet.csv");
+    std::fs::write(
+        &sheet_path,
+        "file,unit,set_point_celsius,series,repeat,activation,off_before_s,series_kind,switch_on_s\nflight.ulg,PX4,25,1,1,1,,field,0\n",
+    )
+    .unwrap();
+    let import = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "import",
+            "campaign",
+            sheet_path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--rate-hz",
+            "10",
+            "--max-gap",
+            "2",
+        ];
+        args.extend_from_slice(extra);
+        gyrodrift(&args)
+    };
+    let (status, text) = import(&d.join("refused"), &[]);
+    assert_eq!(status.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("sheet.csv: row 1 (line 2), column `file`: ")
+            && text.contains("flight.ulg: 3 gyros (sensor_gyro instance 0, sensor_gyro instance 1, sensor_gyro instance 2)")
+            && text.contains("`--ulog-instance`"),
+        "{text}"
+    );
+    let out = d.join("out");
+    let (status, text) = import(&out, &["--ulog-instance", "1"]);
+    assert!(status.status.success(), "{text}");
+    let r = read_recording(&out.join("recordings/PX4_sp+25.0C_field.mcap")).unwrap();
+    assert_eq!(r.segments.len(), 1);
+    assert_eq!(r.segments[0].labels.unit_id, "PX4");
+    assert_eq!(r.segments[0].labels.set_point_celsius, 25.0);
+    assert!(r.segments[0].len() > 10);
 }
