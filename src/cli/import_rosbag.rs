@@ -8,7 +8,9 @@
 //! --timing resample` does (a step longer than `--max-gap` is an error naming the bag, the topic
 //! and the message). One bag is one power-on: one activation. A folder of bags is one series in
 //! order of the bags' start times, each activation's off-time before it the time from the previous
-//! bag's last message (plus one grid period, the sample it stands for) to its first. Written like
+//! bag's last message (plus one grid period, the sample it stands for) to its first. A bag that
+//! `export ros2` wrote carries its recording's labels, which are used instead (options given on
+//! the command line win), and splits into the activations it came from. Written like
 //! `import campaign`: a temporary folder renamed at the end; a failed import leaves nothing.
 
 use std::path::{Path, PathBuf};
@@ -32,7 +34,7 @@ pub struct RosbagArgs {
     #[arg(long, default_value = "/imu/data")]
     pub gyro_topic: String,
     /// The `sensor_msgs/msg/Temperature` topic of the gyro's temperature sensor, °C (used for all
-    /// three axes).
+    /// three axes, unless the bag also has `<topic>/y` and `<topic>/z`, as `export ros2` writes).
     #[arg(long, default_value = "/imu/temperature")]
     pub temperature_topic: String,
     /// Message times: `header` (`header.stamp`, the driver's time of the measurement) or `log`
