@@ -46,7 +46,7 @@ make_venv() {
 install_package() {
     # Builds the abi3 wheel with maturin (fetched by pip into an isolated build environment) and
     # installs it with its test tools (pytest, hypothesis, mypy, ruff, pandas, mcap,
-    # mcap-ros2-support), the plot extra (matplotlib) and the distributed extra (dask[distributed]);
+    # mcap-ros2-support, rosbags), the plot extra (matplotlib) and the distributed extra (dask[distributed]);
     # numpy is a runtime dependency.
     "$VENV/bin/python" -m pip install --quiet "./crates/drift-py[test,plot,distributed]"
     "$VENV/bin/python" -c 'import gyrodrift, numpy, pandas, matplotlib, dask; print("gyrodrift", gyrodrift.__version__, "from", gyrodrift.__file__, "| numpy", numpy.__version__, "| pandas", pandas.__version__, "| matplotlib", matplotlib.__version__, "| dask", dask.__version__)'

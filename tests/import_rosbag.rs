@@ -30,6 +30,12 @@ struct Bag<'a> {
     receive_delay_ns: u64,
     /// Swap the header stamps of samples 5 and 6.
     swap_stamps: bool,
+    /// `angular_velocity_covariance[0]`.
+    rate_covariance: f64,
+    /// Odd gyro messages from a second sensor (`header.frame_id` `imu2_link`).
+    two_frames: bool,
+    /// The temperature messages' `header.frame_id`.
+    temperature_frame: &'a str,
 }
 
 const STANDARD: Bag<'static> = Bag {
@@ -37,13 +43,16 @@ const STANDARD: Bag<'static> = Bag {
     imu_encodings: ("ros2msg", "cdr"),
     receive_delay_ns: 3_000_000,
     swap_stamps: false,
+    rate_covariance: 0.001,
+    two_frames: false,
+    temperature_frame: "imu_link",
 };
 
-fn imu(e: &mut Encoder, t: u64, w: [f64; 3]) -> Vec<u8> {
+fn imu(e: &mut Encoder, t: u64, w: [f64; 3], frame: &str, covariance: f64) -> Vec<u8> {
     let e = e.begin();
     e.i32((t / 1_000_000_000) as i32)
         .u32((t % 1_000_000_000) as u32)
-        .string("imu_link");
+        .string(frame);
     for v in [0.0, 0.0, 0.0, 1.0] {
         e.f64(v);
     }
@@ -51,7 +60,8 @@ fn imu(e: &mut Encoder, t: u64, w: [f64; 3]) -> Vec<u8> {
         e.f64(if k == 0 { -1.0 } else { 0.0 });
     }
     e.f64(w[0]).f64(w[1]).f64(w[2]);
-    for _ in 0..9 {
+    e.f64(covariance);
+    for _ in 1..9 {
         e.f64(0.001);
     }
     e.f64(0.1).f64(0.2).f64(9.81);
@@ -61,11 +71,11 @@ fn imu(e: &mut Encoder, t: u64, w: [f64; 3]) -> Vec<u8> {
     e.bytes().to_vec()
 }
 
-fn temperature(e: &mut Encoder, t: u64, celsius: f64) -> Vec<u8> {
+fn temperature(e: &mut Encoder, t: u64, celsius: f64, frame: &str) -> Vec<u8> {
     e.begin()
         .i32((t / 1_000_000_000) as i32)
         .u32((t % 1_000_000_000) as u32)
-        .string("imu_link")
+        .string(frame)
         .f64(celsius)
         .f64(0.0)
         .bytes()
@@ -125,12 +135,20 @@ fn write_bag(path: &Path, s: &Segment, range: std::ops::Range<usize>, how: Bag<'
             publish_time: log,
         };
         let rates = [0, 1, 2].map(|a| f64::from(s.rate_dps[a][i]).to_radians());
-        w.write_to_known_channel(&header(imu_channel, i as u32), &imu(&mut e, stamp, rates))
-            .unwrap();
+        let frame = if how.two_frames && i % 2 == 1 {
+            "imu2_link"
+        } else {
+            "imu_link"
+        };
+        w.write_to_known_channel(
+            &header(imu_channel, i as u32),
+            &imu(&mut e, stamp, rates, frame, how.rate_covariance),
+        )
+        .unwrap();
         let celsius = f64::from(s.temperature_raw[0][i]) / 200.0;
         w.write_to_known_channel(
             &header(temperature_channel, i as u32),
-            &temperature(&mut e, stamp, celsius),
+            &temperature(&mut e, stamp, celsius, how.temperature_frame),
         )
         .unwrap();
         if i % 50 == 0 {
@@ -367,7 +385,7 @@ fn bags_that_are_not_what_the_options_say_are_refused_by_file_topic_and_message(
     );
     let text = import_fails(&bag, &out, &[]);
     assert!(
-        text.contains("stamps.mcap: topic /imu/data, message #6: header.stamp")
+        text.contains("stamps.mcap: topic /imu/data, message #6: header.stamp 1700003600.050000000 s is not after the previous message's (1700003600.060000000 s)")
             && text.contains("import with `--timestamps log`"),
         "{text}"
     );
@@ -397,6 +415,131 @@ fn bags_that_are_not_what_the_options_say_are_refused_by_file_topic_and_message(
     assert!(
         text.contains("b.mcap starts 0.010000 s after the last message of")
             && text.contains("put the files of one power-on into one bag folder"),
+        "{text}"
+    );
+    // What the messages say about themselves: rates not provided (REP-145), two sensors on one
+    // topic (also by log time, which the header's error used to suggest), a temperature of
+    // another sensor.
+    let bag = d.join("unknown.mcap");
+    write_bag(
+        &bag,
+        s,
+        0..300,
+        Bag {
+            rate_covariance: -1.0,
+            ..STANDARD
+        },
+    );
+    let text = import_fails(&bag, &out, &[]);
+    assert!(
+        text.contains(
+            "unknown.mcap: topic /imu/data, message #0: angular_velocity_covariance[0] is −1"
+        ) && text.contains("REP-145"),
+        "{text}"
+    );
+    let bag = d.join("two.mcap");
+    write_bag(
+        &bag,
+        s,
+        0..300,
+        Bag {
+            two_frames: true,
+            ..STANDARD
+        },
+    );
+    for clock in ["header", "log"] {
+        let text = import_fails(&bag, &out, &["--timestamps", clock]);
+        assert!(
+            text.contains("two.mcap: topic /imu/data, message #1: header.frame_id `imu2_link` differs from the topic's first message's `imu_link`: two sensors"),
+            "{text}"
+        );
+    }
+    let bag = d.join("other.mcap");
+    write_bag(
+        &bag,
+        s,
+        0..300,
+        Bag {
+            temperature_frame: "board_link",
+            ..STANDARD
+        },
+    );
+    let text = import_fails(&bag, &out, &[]);
+    assert!(
+        text.contains("other.mcap: topic /imu/temperature: header.frame_id `board_link` is not the gyro's (`imu_link` on /imu/data)")
+            && text.contains("--any-temperature-frame"),
+        "{text}"
+    );
+    ok(&[
+        "import",
+        "rosbag",
+        bag.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--any-temperature-frame",
+    ]);
+    std::fs::remove_dir_all(&out).unwrap();
+    // A grid faster than the messages: refused unless asked for.
+    let text = import_fails(&good, &out, &["--rate-hz", "1000"]);
+    assert!(
+        text.contains("topic /imu/data has 100.0 messages per second, and a grid of 1000 Hz would make up 90 % of its samples")
+            && text.contains("`--rate-hz 100`"),
+        "{text}"
+    );
+    ok(&[
+        "import",
+        "rosbag",
+        good.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--rate-hz",
+        "1000",
+        "--upsample",
+    ]);
+    std::fs::remove_dir_all(&out).unwrap();
+    // Compressed by rosbag2: a compressed file, and compressed messages.
+    let folder = d.join("zstd");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(
+        folder.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n",
+    )
+    .unwrap();
+    std::fs::write(
+        folder.join("zstd_0.mcap.zstd"),
+        [0x28, 0xb5, 0x2f, 0xfd, 0, 0],
+    )
+    .unwrap();
+    let text = import_fails(&folder, &out, &[]);
+    assert!(
+        text.contains("zstd_0.mcap.zstd: MCAP: a zstd-compressed file"),
+        "{text}"
+    );
+    let squeezed = d.join("squeezed.mcap");
+    {
+        let mut w = mcap::WriteOptions::new()
+            .profile("ros2")
+            .create(BufWriter::new(std::fs::File::create(&squeezed).unwrap()))
+            .unwrap();
+        let schema = w
+            .add_schema("sensor_msgs/msg/Imu", "ros2msg", IMU_DEFINITION.as_bytes())
+            .unwrap();
+        let channel = w
+            .add_channel(schema, "/imu/data", "cdr", &BTreeMap::new())
+            .unwrap();
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: 0,
+            log_time: 1,
+            publish_time: 1,
+        };
+        w.write_to_known_channel(&header, &[0x28, 0xb5, 0x2f, 0xfd, 1, 2, 3])
+            .unwrap();
+        w.finish().unwrap();
+    }
+    let text = import_fails(&squeezed, &out, &[]);
+    assert!(
+        text.contains("squeezed.mcap: topic /imu/data, message #0: a zstd-compressed message"),
         "{text}"
     );
     // A gap in the gyro messages beyond --max-gap, named by bag, topic and message.
@@ -449,7 +592,19 @@ fn an_exported_recording_has_a_message_per_sample_and_imports_back() {
         ]
         .map(|(a, b)| (a.to_owned(), b.to_owned()))
     );
-    // A folder: one bag per activation, a series that imports back.
+    // The single file re-imports: the labels it carries split it into its activations.
+    let from_file = d.join("from-file");
+    ok(&[
+        "import",
+        "rosbag",
+        file.to_str().unwrap(),
+        "-o",
+        from_file.to_str().unwrap(),
+    ]);
+    let name = format!("recordings/{}.mcap", original.unit_id);
+    let back = read_recording(&from_file.join(&name)).unwrap();
+    assert_round_trip(&original, &back);
+    // A folder: one rosbag2 bag folder per activation (metadata.yaml with the type hashes).
     let bags = d.join("bags");
     ok(&[
         "export",
@@ -458,7 +613,13 @@ fn an_exported_recording_has_a_message_per_sample_and_imports_back() {
         "-o",
         bags.to_str().unwrap(),
     ]);
-    assert!(bags.join("activation-005.mcap").is_file());
+    let yaml = std::fs::read_to_string(bags.join("activation-005/metadata.yaml")).unwrap();
+    assert!(
+        yaml.contains("relative_file_paths:\n    - activation-005_0.mcap")
+            && yaml.contains(drift_recording::ros2::IMU_TYPE_HASH)
+            && yaml.contains(drift_recording::ros2::TEMPERATURE_TYPE_HASH),
+        "{yaml}"
+    );
     let out = d.join("back");
     ok(&[
         "import",
@@ -467,8 +628,33 @@ fn an_exported_recording_has_a_message_per_sample_and_imports_back() {
         "-o",
         out.to_str().unwrap(),
     ]);
-    let back = read_recording(&out.join("recordings/ros2.mcap")).unwrap();
-    assert_same_samples(&original, &back);
+    let back = read_recording(&out.join(&name)).unwrap();
+    assert_round_trip(&original, &back);
+    // The second pass is byte-stable: exporting the import and importing that again gives the
+    // same bags and the same recording.
+    let bags2 = d.join("bags2");
+    let out2 = d.join("back2");
+    let bags3 = d.join("bags3");
+    for (from, to, verb) in [
+        (out.join(&name), bags2.clone(), "export"),
+        (bags2.clone(), out2.clone(), "import"),
+        (out2.join(&name), bags3.clone(), "export"),
+    ] {
+        let mut args = vec![verb, if verb == "export" { "ros2" } else { "rosbag" }];
+        args.extend([from.to_str().unwrap(), "-o", to.to_str().unwrap()]);
+        ok(&args);
+    }
+    for k in 1..=original.segments.len() {
+        let bag = format!("activation-{k:03}/activation-{k:03}_0.mcap");
+        assert!(
+            std::fs::read(bags2.join(&bag)).unwrap() == std::fs::read(bags3.join(&bag)).unwrap(),
+            "{bag} differs on the second pass"
+        );
+    }
+    assert_eq!(
+        read_recording(&out2.join(&name)).unwrap().segments,
+        back.segments
+    );
     // Exporting into an existing folder is refused.
     let (status, text) = gyrodrift(&[
         "export",
@@ -479,4 +665,40 @@ fn an_exported_recording_has_a_message_per_sample_and_imports_back() {
     ]);
     assert_eq!(status.status.code(), Some(2), "{text}");
     assert!(text.contains("not an empty folder"), "{text}");
+}
+
+/// An export imported back keeps the recording's unit, rate, set point and kind, and each
+/// activation's labels, switch-on time, rates (to the f32 rounding of rad/s) and per-axis
+/// temperatures.
+fn assert_round_trip(original: &Recording, back: &Recording) {
+    assert_eq!(back.unit_id, original.unit_id);
+    assert_eq!(back.sample_rate_hz, original.sample_rate_hz);
+    for key in [
+        "set_point_celsius",
+        "series_kind",
+        "unit_id",
+        "sample_rate_hz",
+    ] {
+        assert_eq!(
+            back.metadata
+                .get(key)
+                .map(|v| v.parse::<f64>().map_or(v.clone(), |f| f.to_string())),
+            original
+                .metadata
+                .get(key)
+                .map(|v| v.parse::<f64>().map_or(v.clone(), |f| f.to_string())),
+            "{key}"
+        );
+    }
+    assert_eq!(back.segments.len(), original.segments.len());
+    for (k, (a, b)) in original.segments.iter().zip(&back.segments).enumerate() {
+        assert_eq!(b.labels, a.labels, "activation {k}");
+        assert_eq!(b.power_on_ns, a.power_on_ns, "activation {k}");
+        assert_eq!(b.temperature_raw, a.temperature_raw, "activation {k}");
+        for axis in 0..3 {
+            for (x, y) in a.rate_dps[axis].iter().zip(&b.rate_dps[axis]) {
+                assert!((x - y).abs() <= 1e-6 * x.abs().max(1e-3), "{x} vs {y}");
+            }
+        }
+    }
 }

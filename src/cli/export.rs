@@ -3,15 +3,17 @@
 //! The recording format batches 100 samples per message, which ROS tools and Foxglove plot as one
 //! point per message. The export writes one `sensor_msgs/msg/Imu` per sample (`angular_velocity`,
 //! rad/s) and one `sensor_msgs/msg/Temperature` per sample and axis (°C), stamped with the
-//! sample's time on the recording clock (`drift_recording::ros2::write_ros2_bag`). Output: one
-//! `.mcap` file with every activation, or a new folder with one bag per activation (a series that
-//! `gyrodrift import rosbag` reads back, off-times included).
+//! sample's time on the recording clock (`drift_recording::ros2::write_ros2_bag`), and a metadata
+//! record with the recording's labels. Output: one `.mcap` file with every activation, or a new
+//! folder with one bag folder per activation (`metadata.yaml` and its `.mcap` file, as rosbag2
+//! writes them). `gyrodrift import rosbag` reads either back to the recording's unit, rate, set
+//! point, kind, series and off-times.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use drift_recording::read_recording;
-use drift_recording::ros2::{write_ros2_bag, ExportTopics};
+use drift_recording::ros2::{write_ros2_bag, write_ros2_bag_folder, ExportSource, ExportTopics};
 
 /// Options of `gyrodrift export`.
 #[derive(Debug, clap::Args)]
@@ -35,8 +37,8 @@ pub enum Format {
 pub struct Ros2Args {
     /// One recording (`.mcap` of the gyrodrift format, e.g. `<campaign>/recordings/<name>.mcap`).
     pub recording: PathBuf,
-    /// Output: a `.mcap` file (every activation in one bag), or a new folder with one bag per
-    /// activation (`activation-001.mcap`, ...).
+    /// Output: a `.mcap` file (every activation in one bag), or a new folder with one bag folder
+    /// per activation (`activation-001/` with `metadata.yaml` and `activation-001_0.mcap`, ...).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
     /// The `sensor_msgs/msg/Imu` topic.
@@ -76,10 +78,14 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
         temperature: args.temperature_topic.clone(),
     };
     let samples: usize = recording.segments.iter().map(|s| s.len()).sum();
-    let frame = recording.unit_id.as_str();
+    let source = ExportSource {
+        unit_id: &recording.unit_id,
+        sample_rate_hz: recording.sample_rate_hz,
+        metadata: &recording.metadata,
+    };
     if args.out.extension().is_some_and(|e| e == "mcap") {
         let segments: Vec<_> = recording.segments.iter().collect();
-        let bytes = write_ros2_bag(&args.out, &segments, frame, &topics)?;
+        let bytes = write_ros2_bag(&args.out, &segments, source, &topics)?.bytes;
         println!(
             "{}: {} activations, {samples} samples → {} (per sample one message on {} and on each of {}; {bytes} bytes)",
             args.recording.display(),
@@ -90,9 +96,9 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    super::import_campaign::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out)?;
     let stage = staging(&args.out);
-    let written = write_folder(&stage, &recording.segments, frame, &topics).and_then(|n| {
+    let written = write_folder(&stage, &recording.segments, source, &topics).and_then(|n| {
         std::fs::rename(&stage, &args.out)
             .with_context(|| format!("renaming {} to {}", stage.display(), args.out.display()))?;
         Ok(n)
@@ -124,7 +130,7 @@ fn staging(out: &Path) -> PathBuf {
 fn write_folder(
     folder: &Path,
     segments: &[drift_recording::Segment],
-    frame: &str,
+    source: ExportSource<'_>,
     topics: &ExportTopics,
 ) -> anyhow::Result<u64> {
     if let Some(parent) = folder.parent().filter(|p| !p.as_os_str().is_empty()) {
@@ -134,8 +140,8 @@ fn write_folder(
     std::fs::create_dir(folder).with_context(|| format!("creating {}", folder.display()))?;
     let mut bytes = 0;
     for (k, segment) in segments.iter().enumerate() {
-        let path = folder.join(format!("activation-{:03}.mcap", k + 1));
-        bytes += write_ros2_bag(&path, &[segment], frame, topics)?;
+        let path = folder.join(format!("activation-{:03}", k + 1));
+        bytes += write_ros2_bag_folder(&path, &[segment], source, topics)?;
     }
     Ok(bytes)
 }

@@ -49,7 +49,7 @@ pub struct UlogArgs {
 }
 
 /// The gyro topics of a log: (unit suffix, topic, rate fields, temperature field).
-fn gyros(log: &Ulog) -> Vec<(String, &UlogTopic, [&'static str; 3], &'static str)> {
+pub(super) fn gyros(log: &Ulog) -> Vec<(String, &UlogTopic, [&'static str; 3], &'static str)> {
     let gyro = log.topic("sensor_gyro");
     if !gyro.is_empty() {
         return gyro
@@ -81,7 +81,7 @@ fn gyros(log: &Ulog) -> Vec<(String, &UlogTopic, [&'static str; 3], &'static str
 
 /// One topic instance of one log as CSV text (time s, rates rad/s, temperature °C), read back by
 /// the CSV reader with resampling: one activation.
-fn activation(
+pub(super) fn activation(
     log: &Ulog,
     topic: &UlogTopic,
     rates: [&str; 3],
@@ -175,7 +175,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         )
     })?;
     let options = log_options(args.rate_hz, args.max_gap, args.set_point, kind);
-    super::import_campaign::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out)?;
     let files = logs(&args.path)?;
     let mut units: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
     let mut read = Vec::new();
@@ -246,7 +246,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         "off_times": "unknown: ULog headers carry boot time, not wall-clock time",
         "logs": read,
     });
-    let lines = super::import_campaign::write_campaign(&args.out, &recordings, &manifest)?;
+    let lines = super::campaign_out::write_campaign(&args.out, &recordings, &manifest)?;
     for line in lines {
         println!("{line}");
     }

@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 mod campaign_args;
+mod campaign_out;
 pub mod check;
 pub mod demo;
 pub mod diagnose;
@@ -19,6 +20,7 @@ mod measured;
 mod progress;
 mod reading;
 pub mod report;
+mod sheet_logs;
 pub mod simulate;
 
 /// Exit status of every command: 0 done (for `check`: every limit met), 1 `check` found a unit ×

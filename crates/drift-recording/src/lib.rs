@@ -49,6 +49,7 @@ pub use segment::{
     TEMPERATURE_MISSING_RAW,
 };
 pub use sheet::{
-    read_sheet, read_sheet_campaign, recording_stem, SheetError, SheetRow, SHEET_COLUMNS,
+    read_sheet, read_sheet_campaign, read_sheet_campaign_with, recording_stem, LogReader,
+    SheetError, SheetRow, SHEET_COLUMNS,
 };
 pub use write::{create_recording, write_recording};

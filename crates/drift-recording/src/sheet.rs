@@ -7,7 +7,7 @@
 //!
 //! | column | meaning | empty cell |
 //! |---|---|---|
-//! | `file` | the activation's CSV file, relative to the sheet's folder | error |
+//! | `file` | the activation's file (CSV, or a log the caller reads: a ROS 2 bag file or folder, a PX4 ULog), relative to the sheet's folder | error |
 //! | `unit` | unit id | error |
 //! | `set_point_celsius` | chamber set point of the session, °C | error |
 //! | `series` | series number (from 1) | error |
@@ -32,7 +32,7 @@ use crate::aux::fixed_aux_unit;
 use crate::csv_file::{read_csv, CsvError, CsvOptions};
 use crate::layout::AUX_RATE_HZ;
 use crate::read::Recording;
-use crate::segment::{AuxChannel, SeriesKind, RAW_PER_CELSIUS};
+use crate::segment::{AuxChannel, Segment, SeriesKind, RAW_PER_CELSIUS};
 
 /// The format's own auxiliary channel of the chamber's set point, °C.
 const SET_POINT_CHANNEL: &str = "chamber_set_point";
@@ -97,6 +97,19 @@ pub enum SheetError {
         line: u64,
         /// The activation file's error.
         source: Box<CsvError>,
+    },
+    /// An activation log (a ROS 2 bag, a ULog) failed to read: the sheet's row here, the log's
+    /// file, topic and message in the source error.
+    #[error("{sheet}: row {row} (line {line}), column `file`")]
+    Log {
+        /// The sheet.
+        sheet: PathBuf,
+        /// The sheet's data row naming the log.
+        row: u64,
+        /// Its line.
+        line: u64,
+        /// The log reader's error.
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// The sheet has no data row.
     #[error("{path}: no activations (the sheet has a header but no data rows)")]
@@ -216,7 +229,7 @@ pub fn read_sheet(path: &Path) -> Result<Vec<SheetRow>, SheetError> {
         };
         let file_text = required("file")?;
         let file = folder.join(file_text);
-        if !file.is_file() {
+        if !file.exists() {
             return Err(bad("file", format!("no such file `{}`", file.display())));
         }
         if let Some(first) = seen_files.insert(file.clone(), row) {
@@ -310,6 +323,40 @@ pub fn read_sheet(path: &Path) -> Result<Vec<SheetRow>, SheetError> {
     Ok(rows)
 }
 
+/// How far the sensor's temperature at switch-on may lie below the chamber's (a chamber still
+/// settling), and above it (heat left from the previous activation), °C.
+const SWITCH_ON_BELOW_C: f64 = 5.0;
+const SWITCH_ON_ABOVE_C: f64 = 30.0;
+
+/// The activation's first temperature reading against the sheet's ambient: a label of another
+/// set point, or a temperature in another unit than °C, is refused.
+fn check_switch_on_temperature(
+    segment: &Segment,
+    ambient: f64,
+    row: &SheetRow,
+) -> Result<(), String> {
+    let first = (0..3)
+        .filter_map(|axis| {
+            segment.temperature_raw[axis]
+                .iter()
+                .find(|&&r| r != crate::segment::TEMPERATURE_MISSING_RAW)
+                .map(|&r| f64::from(r) / RAW_PER_CELSIUS)
+        })
+        .fold(None, |m: Option<f64>, c| Some(m.map_or(c, |m| m.min(c))));
+    let Some(celsius) = first else {
+        return Ok(());
+    };
+    if celsius < ambient - SWITCH_ON_BELOW_C || celsius > ambient + SWITCH_ON_ABOVE_C {
+        return Err(format!(
+            "{ambient} °C, but the data of `{}` start at {celsius:.2} °C: a sensor switched on in this ambient reads between {:.0} and {:.0} °C; the label is another set point's, or the file's temperature is not in °C",
+            row.file.display(),
+            ambient - SWITCH_ON_BELOW_C,
+            ambient + SWITCH_ON_ABOVE_C
+        ));
+    }
+    Ok(())
+}
+
 /// The recording a sheet row goes into: unit, series kind and set point.
 fn recording_key(row: &SheetRow) -> (String, SeriesKind, u64) {
     (
@@ -344,6 +391,22 @@ pub fn recording_stem(unit: &str, set_point_celsius: f64, kind: SeriesKind) -> S
 pub fn read_sheet_campaign(
     sheet: &Path,
     options: &CsvOptions,
+) -> Result<Vec<(String, Recording)>, SheetError> {
+    read_sheet_campaign_with(sheet, options, &|_, _| None)
+}
+
+/// What reads an activation file that is not CSV: `Some` with the activation's samples (or why
+/// they cannot be read) for a file it knows (a ROS 2 bag, a ULog), `None` for a CSV file. It gets
+/// the row's file and the CSV options with the row's unit, set point and series kind.
+pub type LogReader<'a> = dyn Fn(&Path, &CsvOptions) -> Option<Result<Segment, Box<dyn std::error::Error + Send + Sync>>>
+    + 'a;
+
+/// [`read_sheet_campaign`], with `logs` reading the activation files that are logs of another
+/// tool; each activation's labels are the sheet's whatever the file says.
+pub fn read_sheet_campaign_with(
+    sheet: &Path,
+    options: &CsvOptions,
+    logs: &LogReader<'_>,
 ) -> Result<Vec<(String, Recording)>, SheetError> {
     let rows = read_sheet(sheet)?;
     let mut order: Vec<(String, SeriesKind, u64)> = Vec::new();
@@ -380,13 +443,25 @@ pub fn read_sheet_campaign(
             file_options.set_point_celsius =
                 Some(row.switch_on_ambient_celsius.unwrap_or(set_point));
             file_options.series_kind = *kind;
-            let read = read_csv(&row.file, &file_options).map_err(|source| SheetError::File {
-                sheet: sheet.to_path_buf(),
-                row: row_number,
-                line,
-                source: Box::new(source),
-            })?;
-            let Some(mut segment) = read.segments.into_iter().next() else {
+            let segment = match logs(&row.file, &file_options) {
+                Some(read) => Some(read.map_err(|source| SheetError::Log {
+                    sheet: sheet.to_path_buf(),
+                    row: row_number,
+                    line,
+                    source,
+                })?),
+                None => {
+                    let read =
+                        read_csv(&row.file, &file_options).map_err(|source| SheetError::File {
+                            sheet: sheet.to_path_buf(),
+                            row: row_number,
+                            line,
+                            source: Box::new(source),
+                        })?;
+                    read.segments.into_iter().next()
+                }
+            };
+            let Some(mut segment) = segment else {
                 return Err(SheetError::Row {
                     path: sheet.to_path_buf(),
                     row: row_number,
@@ -404,6 +479,25 @@ pub fn read_sheet_campaign(
                     end.saturating_add(off_ns)
                 }
             };
+            let ambient = row.switch_on_ambient_celsius.unwrap_or(set_point);
+            // A field session's chamber may ramp away from the sensor; a protocol's is settled.
+            let checked = if *kind == SeriesKind::Protocol {
+                check_switch_on_temperature(&segment, ambient, row)
+            } else {
+                Ok(())
+            };
+            checked.map_err(|reason| SheetError::Row {
+                path: sheet.to_path_buf(),
+                row: row_number,
+                line,
+                column: if row.switch_on_ambient_celsius.is_some() {
+                    "switch_on_ambient_celsius"
+                } else {
+                    "set_point_celsius"
+                }
+                .into(),
+                reason,
+            })?;
             if let Some((end, (prev_row, _))) = previous {
                 if power_on_ns <= end {
                     return Err(SheetError::Row {
@@ -419,9 +513,22 @@ pub fn read_sheet_campaign(
                         ),
                     });
                 }
+                if let (Some(off), Some(_)) = (row.off_before_s, row.switch_on_ns) {
+                    let gap = power_on_ns.saturating_sub(end) as f64 * 1e-9;
+                    if (off - gap).abs() > (0.05 * gap).max(1.0) {
+                        return Err(SheetError::Row {
+                            path: sheet.to_path_buf(),
+                            row: row_number,
+                            line,
+                            column: "off_before_s".into(),
+                            reason: format!(
+                                "{off} s, but `switch_on_s` puts this switch-on {gap:.1} s after the end of the previous activation (row {prev_row}); correct one of them"
+                            ),
+                        });
+                    }
+                }
             }
             segment.power_on_ns = power_on_ns;
-            let ambient = row.switch_on_ambient_celsius.unwrap_or(set_point);
             // The chamber's set point as the format's own channel, constant over the activation:
             // what the sheet knows of it (a bench logging it would give it per sample).
             if fs % AUX_RATE_HZ == 0 {

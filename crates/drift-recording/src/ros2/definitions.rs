@@ -4,6 +4,13 @@
 pub const IMU_SCHEMA: &str = "sensor_msgs/msg/Imu";
 /// Schema name of the standard temperature message.
 pub const TEMPERATURE_SCHEMA: &str = "sensor_msgs/msg/Temperature";
+/// The ROS 2 type description hash (REP-2011, `RIHS01`) of `sensor_msgs/msg/Imu`, as ROS 2 Jazzy
+/// and `rosbags` give it.
+pub const IMU_TYPE_HASH: &str =
+    "RIHS01_7d9a00ff131080897a5ec7e26e315954b8eae3353c3f995c55faf71574000b5b";
+/// The type description hash of `sensor_msgs/msg/Temperature`.
+pub const TEMPERATURE_TYPE_HASH: &str =
+    "RIHS01_72514a14126ab9f8a9abec974c78e5610a367b59db5da355ff1fb982d5bad4b8";
 /// MCAP profile of rosbag2's MCAP storage.
 pub const PROFILE_ROS2: &str = "ros2";
 

@@ -16,13 +16,16 @@
 
 mod decode;
 mod definitions;
+mod labels;
 mod msgdef;
 mod read;
 mod write;
 
-pub use decode::{decode_imu, decode_temperature};
+pub use decode::{decode_imu, decode_temperature, ImuMessage};
 pub use definitions::{
-    IMU_DEFINITION, IMU_SCHEMA, PROFILE_ROS2, TEMPERATURE_DEFINITION, TEMPERATURE_SCHEMA,
+    IMU_DEFINITION, IMU_SCHEMA, IMU_TYPE_HASH, PROFILE_ROS2, TEMPERATURE_DEFINITION,
+    TEMPERATURE_SCHEMA, TEMPERATURE_TYPE_HASH,
 };
+pub use labels::{read_labels, ExportedActivation, ExportedLabels, LABELS_RECORD};
 pub use read::{bag_files, read_bag, Bag, BagClock, BagError, BagRows, BagTopics};
-pub use write::{write_ros2_bag, ExportTopics};
+pub use write::{write_ros2_bag, write_ros2_bag_folder, ExportSource, ExportTopics, WrittenBag};

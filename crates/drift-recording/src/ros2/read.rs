@@ -4,8 +4,9 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::decode::{decode_imu, decode_temperature};
+use super::decode::{decode_imu, decode_temperature, ImuMessage};
 use super::definitions::{IMU_DEFINITION, IMU_SCHEMA, TEMPERATURE_DEFINITION, TEMPERATURE_SCHEMA};
+use super::labels::{read_labels, ExportedLabels};
 use super::msgdef::check_channel;
 use crate::messages::ChannelInfo;
 
@@ -68,6 +69,8 @@ pub struct BagTopics {
     pub gyro: String,
     /// The `sensor_msgs/msg/Temperature` topic.
     pub temperature: String,
+    /// Accept a temperature whose `header.frame_id` is not the gyro's.
+    pub any_temperature_frame: bool,
 }
 
 /// One bag's gyro and temperature messages, in time order.
@@ -81,15 +84,20 @@ pub struct Bag {
     pub gyro: Vec<(i64, [f64; 3])>,
     /// Per temperature message: time (ns) and temperature (°C).
     pub temperature: Vec<(i64, f64)>,
+    /// The Y and Z axes' own temperatures (`<temperature topic>/y`, `/z`), when the bag has both.
+    pub temperature_yz: Option<[Vec<(i64, f64)>; 2]>,
     /// Every topic of the bag with its schema name, for messages and listings.
     pub all_topics: BTreeMap<String, String>,
+    /// The labels `export ros2` wrote into the bag's first file, if it did.
+    pub labels: Option<ExportedLabels>,
 }
 
 /// Rows of one bag ([`Bag::rows`]): what the CSV reader resamples.
 #[derive(Debug, Clone)]
 pub struct BagRows {
-    /// CSV text with the header `t_s,gx,gy,gz,temp_c`: time since `start_ns` (s), angular velocity
-    /// (rad/s), temperature (°C); one row per gyro message.
+    /// CSV text with the header `t_s,gx,gy,gz,temp_c,temp_y,temp_z`: time since `start_ns` (s),
+    /// angular velocity (rad/s), temperature (°C; the Y and Z axes' own where the bag has them,
+    /// else the same as `temp_c`); one row per gyro message.
     pub csv: String,
     /// Time of the first row, ns on the bag's clock.
     pub start_ns: i64,
@@ -103,6 +111,33 @@ pub struct BagRows {
 }
 
 impl Bag {
+    /// The messages with times in `from_ns..to_ns` (one activation of an exported bag).
+    pub fn between(&self, from_ns: i64, to_ns: i64) -> Bag {
+        let keep = |s: &[(i64, f64)]| -> Vec<(i64, f64)> {
+            s.iter()
+                .copied()
+                .filter(|m| (from_ns..to_ns).contains(&m.0))
+                .collect()
+        };
+        Bag {
+            path: self.path.clone(),
+            topics: self.topics.clone(),
+            gyro: self
+                .gyro
+                .iter()
+                .copied()
+                .filter(|m| (from_ns..to_ns).contains(&m.0))
+                .collect(),
+            temperature: keep(&self.temperature),
+            temperature_yz: self
+                .temperature_yz
+                .as_ref()
+                .map(|[y, z]| [keep(y), keep(z)]),
+            all_topics: self.all_topics.clone(),
+            labels: None,
+        }
+    }
+
     /// Pairs each gyro message inside the temperature topic's span with the temperature
     /// interpolated linearly at its time. A step between temperature messages longer than
     /// `max_temperature_gap_s` seconds is an error naming the message after it.
@@ -147,34 +182,33 @@ impl Bag {
             ));
         };
         let (start_ns, end_ns) = (first.0, last.0);
-        let mut csv = String::with_capacity(kept.len() * 64 + 32);
-        csv.push_str("t_s,gx,gy,gz,temp_c\n");
-        let mut j = 0usize;
+        let mut csv = String::with_capacity(kept.len() * 96 + 32);
+        csv.push_str("t_s,gx,gy,gz,temp_c,temp_y,temp_z\n");
+        let series: Vec<&[(i64, f64)]> = match &self.temperature_yz {
+            Some([y, z]) => vec![&self.temperature, y, z],
+            None => vec![&self.temperature],
+        };
+        let mut at = vec![0usize; series.len()];
         for (t, w) in kept.iter().map(|g| (g.0, g.1)) {
-            while j + 2 < self.temperature.len() && self.temperature[j + 1].0 <= t {
-                j += 1;
-            }
-            let (ta, a) = self.temperature[j];
-            let (tb, b) = self.temperature.get(j + 1).copied().unwrap_or((ta, a));
-            let c = if tb > ta && t > ta {
-                let f = ((t - ta) as f64 / (tb - ta) as f64).clamp(0.0, 1.0);
-                if f >= 1.0 {
-                    b
-                } else {
-                    a + (b - a) * f
-                }
+            let c: Vec<f64> = series
+                .iter()
+                .zip(&mut at)
+                .map(|(s, j)| interpolate(s, t, j))
+                .collect();
+            let (y, z) = if c.len() == 3 {
+                (c[1], c[2])
             } else {
-                a
+                (c[0], c[0])
             };
             // Time from the first row in ns, exact in f64 up to 104 days.
             let _ = writeln!(
                 csv,
-                "{},{},{},{},{}",
+                "{},{},{},{},{},{y},{z}",
                 (t - start_ns) as f64 * 1e-9,
                 w[0],
                 w[1],
                 w[2],
-                c
+                c[0]
             );
         }
         Ok(BagRows {
@@ -184,6 +218,28 @@ impl Bag {
             first_message,
             rows: kept.len(),
         })
+    }
+}
+
+/// The value of `series` (time-ordered) at `t`, linear between its neighbours and held beyond its
+/// ends; `j` is where the previous call stopped (times asked for increase).
+fn interpolate(series: &[(i64, f64)], t: i64, j: &mut usize) -> f64 {
+    while *j + 2 < series.len() && series[*j + 1].0 <= t {
+        *j += 1;
+    }
+    let Some(&(ta, a)) = series.get(*j) else {
+        return f64::NAN;
+    };
+    let (tb, b) = series.get(*j + 1).copied().unwrap_or((ta, a));
+    if tb > ta && t > ta {
+        let f = ((t - ta) as f64 / (tb - ta) as f64).clamp(0.0, 1.0);
+        if f >= 1.0 {
+            b
+        } else {
+            a + (b - a) * f
+        }
+    } else {
+        a
     }
 }
 
@@ -201,7 +257,13 @@ pub fn bag_files(path: &Path) -> Result<Vec<PathBuf>, BagError> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(path)
         .map_err(io)?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
+        .filter(|p| {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy())
+                .unwrap_or_default();
+            name.ends_with(".mcap") || name.ends_with(".mcap.zstd")
+        })
         .filter(|p| {
             !p.file_name()
                 .is_some_and(|n| n.to_string_lossy().starts_with('.'))
@@ -238,6 +300,13 @@ pub fn bag_files(path: &Path) -> Result<Vec<PathBuf>, BagError> {
     Ok(files)
 }
 
+/// `t_ns` as seconds with every digit: two times that differ print differently.
+fn seconds(t_ns: i64) -> String {
+    let sign = if t_ns < 0 { "-" } else { "" };
+    let t = t_ns.unsigned_abs();
+    format!("{sign}{}.{:09} s", t / 1_000_000_000, t % 1_000_000_000)
+}
+
 struct TopicReader {
     topic: String,
     expected: (&'static str, &'static str),
@@ -245,6 +314,10 @@ struct TopicReader {
     accepted: Option<(Option<String>, Vec<u8>)>,
     count: usize,
     last_ns: Option<i64>,
+    /// The other clock's last time, and whether it has increased so far.
+    other: (Option<i64>, bool),
+    /// The first message's `header.frame_id` and the frame of every message after it.
+    frame: Option<String>,
 }
 
 impl TopicReader {
@@ -255,16 +328,20 @@ impl TopicReader {
             accepted: None,
             count: 0,
             last_ns: None,
+            other: (None, true),
+            frame: None,
         }
     }
 
-    /// Checks the channel (once per schema text) and the message's time; returns its index.
+    /// Checks the channel (once per schema text), the message's time on `clock` (`t_ns`; the
+    /// other clock's time is `other_ns`) and its frame; returns its index.
     fn next(
         &mut self,
         path: &Path,
         channel: &ChannelInfo,
-        t_ns: i64,
+        (t_ns, other_ns): (i64, i64),
         clock: BagClock,
+        frame: &str,
     ) -> Result<usize, BagError> {
         let index = self.count;
         let same = self
@@ -281,35 +358,68 @@ impl TopicReader {
             }
             self.accepted = Some((channel.schema.clone(), channel.schema_data.clone()));
         }
+        let message_error = |reason: String| BagError::Message {
+            path: path.to_path_buf(),
+            topic: self.topic.clone(),
+            index,
+            reason,
+        };
+        match &self.frame {
+            None => self.frame = Some(frame.to_owned()),
+            Some(first) if first != frame => {
+                return Err(message_error(format!(
+                    "header.frame_id `{frame}` differs from the topic's first message's `{first}`: two sensors publish on this topic, and their messages would be merged into one signal; record each sensor on its own topic (or filter one frame out with `ros2 bag convert`/`mcap filter`) and import that topic"
+                )));
+            }
+            Some(_) => {}
+        }
+        let other_increasing = self.other.1 && self.other.0.is_none_or(|last| other_ns > last);
         if let Some(last) = self.last_ns.filter(|&last| t_ns <= last) {
             let (what, fix) = match clock {
-                BagClock::Header => (
+                BagClock::Header if t_ns < last - 1_000_000_000 && other_increasing => (
                     "header.stamp",
-                    "import with `--timestamps log` to use the recorder's receive times",
+                    "the driver's clock went back (it restarts at boot, or was set): import with `--timestamps log` to use the recorder's receive times, which increase here".to_owned(),
                 ),
-                BagClock::Log => (
+                BagClock::Header if other_increasing => (
+                    "header.stamp",
+                    "import with `--timestamps log` to use the recorder's receive times, which increase here".to_owned(),
+                ),
+                BagClock::Log if other_increasing => (
                     "log time",
-                    "the recorder wrote messages out of order; import with `--timestamps header`",
+                    "the recorder wrote messages out of order; import with `--timestamps header`, whose stamps increase here".to_owned(),
+                ),
+                _ => (
+                    if clock == BagClock::Header { "header.stamp" } else { "log time" },
+                    "neither the header stamps nor the recorder's log times increase here: the topic mixes messages of different sources or the bag was merged out of order; split or reorder it (e.g. `ros2 bag convert`) before importing".to_owned(),
                 ),
             };
-            return Err(BagError::Message {
-                path: path.to_path_buf(),
-                topic: self.topic.clone(),
-                index,
-                reason: format!(
-                    "{what} {t_ns} ns is not after the previous message's ({last} ns): the times must increase; {fix}"
-                ),
-            });
+            return Err(message_error(format!(
+                "{what} {} is not after the previous message's ({}): the times must increase; {fix}",
+                seconds(t_ns),
+                seconds(last)
+            )));
         }
+        self.other = (Some(other_ns), other_increasing);
         self.last_ns = Some(t_ns);
         self.count += 1;
         Ok(index)
     }
 }
 
+/// What one message of a read topic holds.
+enum Decoded {
+    Gyro(ImuMessage),
+    /// Axis (0 = the temperature topic, 1 and 2 its `/y` and `/z`), stamp, frame, °C.
+    Temperature(usize, i64, String, f64),
+}
+
 /// Reads one bag (`files`: its MCAP files in order, from [`bag_files`]; `bag` names it): the gyro
-/// and temperature topics' messages, timed by `clock`. Errors name the file, the topic and the
-/// message's index within its topic; a missing or empty topic is named with the bag's topics.
+/// and temperature topics' messages, timed by `clock`, with the temperature topic's `/y` and `/z`
+/// (per-axis sensors, as `export ros2` writes them) where the bag has them. Errors name the file,
+/// the topic and the message's index within its topic; a missing or empty topic is named with the
+/// bag's topics. Refused: rates the message says it does not provide
+/// (`angular_velocity_covariance[0] = −1`, REP-145), two `header.frame_id`s on one topic, and a
+/// temperature of another frame than the gyro's unless `topics.any_temperature_frame`.
 pub fn read_bag(
     bag: &Path,
     files: &[PathBuf],
@@ -317,14 +427,19 @@ pub fn read_bag(
     clock: BagClock,
 ) -> Result<Bag, BagError> {
     let mut gyro_reader = TopicReader::new(&topics.gyro, (IMU_SCHEMA, IMU_DEFINITION));
-    let mut temperature_reader = TopicReader::new(
-        &topics.temperature,
-        (TEMPERATURE_SCHEMA, TEMPERATURE_DEFINITION),
-    );
+    let axis_topics = [
+        topics.temperature.clone(),
+        format!("{}/y", topics.temperature),
+        format!("{}/z", topics.temperature),
+    ];
+    let mut temperature_readers = axis_topics
+        .clone()
+        .map(|t| TopicReader::new(&t, (TEMPERATURE_SCHEMA, TEMPERATURE_DEFINITION)));
     let mut gyro = Vec::new();
-    let mut temperature = Vec::new();
+    let mut temperatures: [Vec<(i64, f64)>; 3] = Default::default();
     let mut all_topics = BTreeMap::new();
-    for file in files {
+    let mut labels = None;
+    for (n, file) in files.iter().enumerate() {
         let buf = std::fs::read(file).map_err(|source| BagError::Io {
             path: file.clone(),
             source,
@@ -333,6 +448,11 @@ pub fn read_bag(
             path: file.clone(),
             reason,
         };
+        if buf.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
+            return Err(mcap_error(
+                "a zstd-compressed file (rosbag2's file compression): decompress it first (`zstd -d`, or `ros2 bag decompress`), then import the .mcap file".into(),
+            ));
+        }
         if !buf.starts_with(mcap::MAGIC) {
             return Err(mcap_error(
                 "not an MCAP file (only rosbag2's MCAP storage is read; convert a .db3 bag with `ros2 bag convert`)".into(),
@@ -345,28 +465,31 @@ pub fn read_bag(
             )));
         }
         crate::messages::check_uncompressed_chunks(&buf).map_err(|e| mcap_error(e.to_string()))?;
+        if n == 0 {
+            labels = read_labels(file, &buf).map_err(mcap_error)?;
+        }
         crate::messages::for_each_message(&buf, |channel, log_ns, data| {
             let topic = channel.topic.as_str();
-            let is_gyro = topic == topics.gyro;
-            let is_temperature = topic == topics.temperature;
             if !all_topics.contains_key(topic) {
                 all_topics.insert(
                     topic.to_owned(),
                     channel.schema.clone().unwrap_or_else(|| "no schema".into()),
                 );
             }
-            if !is_gyro && !is_temperature {
+            let is_gyro = topic == topics.gyro;
+            let axis = axis_topics.iter().position(|t| t == topic);
+            if !is_gyro && axis.is_none() {
                 return Ok(());
             }
-            let decoded = if is_gyro {
-                decode_imu(data).map(|(stamp, w)| (stamp, Some(w), 0.0))
-            } else {
-                decode_temperature(data).map(|(stamp, c)| (stamp, None, c))
+            let reader = match axis {
+                Some(a) if !is_gyro => &mut temperature_readers[a],
+                _ => &mut gyro_reader,
             };
-            let reader = if is_gyro {
-                &mut gyro_reader
+            let decoded = if is_gyro {
+                decode_imu(data).map(Decoded::Gyro)
             } else {
-                &mut temperature_reader
+                decode_temperature(data)
+                    .map(|(s, f, c)| Decoded::Temperature(axis.unwrap_or(0), s, f, c))
             };
             let message_error = |index: usize, reason: String| BagError::Message {
                 path: file.clone(),
@@ -375,9 +498,15 @@ pub fn read_bag(
                 reason,
             };
             // The schema first: a message of another type would decode to nonsense.
-            let (stamp, w, celsius) = match decoded {
+            let decoded = match decoded {
                 Ok(d) => d,
                 Err(reason) => {
+                    if data.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
+                        return Err(message_error(
+                            reader.count,
+                            "a zstd-compressed message (rosbag2's message compression): decompress the bag first (`ros2 bag decompress`, or `ros2 bag convert` without compression)".into(),
+                        ));
+                    }
                     if let Some(reason) = check_channel(channel, reader.expected) {
                         return Err(BagError::Topic {
                             path: file.clone(),
@@ -388,27 +517,42 @@ pub fn read_bag(
                     return Err(message_error(reader.count, reason));
                 }
             };
-            let t_ns = match clock {
-                BagClock::Header => stamp,
-                BagClock::Log => i64::try_from(log_ns).map_err(|_| {
-                    message_error(
-                        reader.count,
-                        format!("log time {log_ns} ns is beyond the i64 clock"),
-                    )
-                })?,
+            let (stamp, frame) = match &decoded {
+                Decoded::Gyro(m) => (m.stamp_ns, m.frame_id.as_str()),
+                Decoded::Temperature(_, s, f, _) => (*s, f.as_str()),
             };
-            let index = reader.next(file, channel, t_ns, clock)?;
-            match w {
-                Some(w) => {
-                    if let Some(axis) = w.iter().position(|v| !v.is_finite()) {
+            let log_ns = i64::try_from(log_ns).map_err(|_| {
+                message_error(
+                    reader.count,
+                    format!("log time {log_ns} ns is beyond the i64 clock"),
+                )
+            })?;
+            let times = match clock {
+                BagClock::Header => (stamp, log_ns),
+                BagClock::Log => (log_ns, stamp),
+            };
+            let index = reader.next(file, channel, times, clock, frame)?;
+            match decoded {
+                Decoded::Gyro(m) => {
+                    if m.rate_covariance_0 == -1.0 {
                         return Err(message_error(
                             index,
-                            format!("angular_velocity.{} is {}", ["x", "y", "z"][axis], w[axis]),
+                            "angular_velocity_covariance[0] is −1: the driver says this message carries no angular velocity (REP-145); publish the gyro's rates, or name the topic that has them with `--gyro-topic`".into(),
                         ));
                     }
-                    gyro.push((t_ns, w));
+                    if let Some(axis) = m.rate.iter().position(|v| !v.is_finite()) {
+                        return Err(message_error(
+                            index,
+                            format!(
+                                "angular_velocity.{} is {}",
+                                ["x", "y", "z"][axis],
+                                m.rate[axis]
+                            ),
+                        ));
+                    }
+                    gyro.push((times.0, m.rate));
                 }
-                None => temperature.push((t_ns, celsius)),
+                Decoded::Temperature(a, _, _, celsius) => temperatures[a].push((times.0, celsius)),
             }
             Ok(())
         })
@@ -435,7 +579,7 @@ pub fn read_bag(
         (&topics.gyro, gyro.is_empty(), "--gyro-topic"),
         (
             &topics.temperature,
-            temperature.is_empty(),
+            temperatures[0].is_empty(),
             "--temperature-topic",
         ),
     ] {
@@ -450,11 +594,31 @@ pub fn read_bag(
             });
         }
     }
+    if let (Some(g), Some(t)) = (&gyro_reader.frame, &temperature_readers[0].frame) {
+        if g != t && !topics.any_temperature_frame {
+            return Err(BagError::Topic {
+                path: bag.to_path_buf(),
+                topic: topics.temperature.clone(),
+                reason: format!(
+                    "header.frame_id `{t}` is not the gyro's (`{g}` on {}): this temperature may be another sensor's; name the gyro's own temperature topic with `--temperature-topic`, or accept this one with `--any-temperature-frame`",
+                    topics.gyro
+                ),
+            });
+        }
+    }
+    let [x, y, z] = temperatures;
+    let per_axis = if y.is_empty() || z.is_empty() {
+        None
+    } else {
+        Some([y, z])
+    };
     Ok(Bag {
         path: bag.to_path_buf(),
         topics: topics.clone(),
         gyro,
-        temperature,
+        temperature: x,
+        temperature_yz: per_axis,
         all_topics,
+        labels,
     })
 }
