@@ -80,6 +80,18 @@ fn activations(source: Source) -> Result<Vec<Arc<Segment>>, Error> {
     }
 }
 
+/// What `FittedUnit.diagnose` was asked beyond its data.
+pub struct Asked {
+    /// Build, guard and measure the extended model.
+    pub extend: bool,
+    /// Set points whose series are the diagnosis data, cross-fitted.
+    pub diagnose_on: Vec<f64>,
+    /// The half of the diagnosis series this loop ranks on.
+    pub half: usize,
+    /// Channels of the bench, never ranked (beside the default ones).
+    pub bench_channels: Vec<String>,
+}
+
 /// Runs the loop for `unit` on its activations among `segments`.
 pub fn diagnose_unit(
     py: Python<'_>,
@@ -87,8 +99,9 @@ pub fn diagnose_unit(
     settings: &FitSettings,
     segments: &Bound<'_, PyAny>,
     calibration: Option<&Bound<'_, PyAny>>,
-    extend: bool,
+    asked: Asked,
 ) -> PyResult<PyDiagnosis> {
+    let extend = asked.extend;
     let source = sources::source(py, "segments", segments)?;
     let set_points = match calibration {
         Some(v) if !v.is_none() => sources::set_points("calibration", v, false)?,
@@ -112,10 +125,15 @@ pub fn diagnose_unit(
                 all.len()
             )));
         }
-        let options = LoopOptions {
+        let mut options = LoopOptions {
             extend,
+            diagnose_on: asked.diagnose_on.clone(),
+            half: asked.half,
             ..LoopOptions::new(&set_points)
         };
+        options
+            .bench_channels
+            .extend(asked.bench_channels.iter().cloned());
         let closed = close(unit, own, &[], &options, settings)?;
         if closed.series.is_empty() {
             return Err(Error::Input(format!(

@@ -272,22 +272,40 @@ impl PyFittedUnit {
     /// `gyrodrift diagnose` does: candidates ranked on the field-like activations at the
     /// calibration set points inside the calibrated ambient range (else on every activation the
     /// fit did not see); with `extend`, the guarded extended model and its error before and after
-    /// on the held-out activations. The GIL is released.
-    #[pyo3(signature = (segments, *, calibration = None, extend = false))]
+    /// on the held-out activations. `diagnose_on` names set points whose series (field and
+    /// protocol) are the diagnosis data, cross-fitted by series: `half` (0 or 1) is the half this
+    /// loop ranks and fits on, the other half judges. `bench_channels` are context, never ranked
+    /// (the chamber's set point and air always are). The GIL is released.
+    #[pyo3(signature = (segments, *, calibration = None, extend = false, diagnose_on = Vec::new(), half = 0, bench_channels = Vec::new()))]
+    #[allow(clippy::too_many_arguments)]
     fn diagnose(
         &self,
         py: Python<'_>,
         segments: &Bound<'_, PyAny>,
         calibration: Option<&Bound<'_, PyAny>>,
         extend: bool,
+        diagnose_on: Vec<f64>,
+        half: usize,
+        bench_channels: Vec<String>,
     ) -> PyResult<crate::diagnosis::PyDiagnosis> {
+        if half > 1 {
+            return Err(crate::errors::Error::Input(format!(
+                "`half` must be 0 or 1 (which half of the diagnosis series ranks), got {half}"
+            ))
+            .into());
+        }
         crate::diagnosis::diagnose_unit(
             py,
             &self.unit,
             &self.settings,
             segments,
             calibration,
-            extend,
+            crate::diagnosis::Asked {
+                extend,
+                diagnose_on,
+                half,
+                bench_channels,
+            },
         )
     }
 

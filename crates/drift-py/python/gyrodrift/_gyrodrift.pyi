@@ -983,14 +983,21 @@ class FittedUnit:
         *,
         calibration: Sequence[float] | str | None = None,
         extend: bool = False,
+        diagnose_on: Sequence[float] = (),
+        half: int = 0,
+        bench_channels: Sequence[str] = (),
     ) -> Diagnosis:
         """Diagnoses what the paper's model leaves in the residual of this unit's activations among
         `segments` (recordings, segments or files; other units' activations are skipped), as
         `gyrodrift diagnose` does: candidates ranked on the field-like activations at the
         calibration set points inside the calibrated ambient range (else on every activation the
         fit did not see); with `extend`, the guarded extended model and its error before and after
-        on the held-out activations. The GIL is released. Raises `InputError` (no activation of
-        this unit to diagnose) or `FitError`."""
+        on the held-out activations. `diagnose_on` names set points whose series (field and
+        protocol) are the diagnosis data, cross-fitted by series: `half` (0 or 1) is the half this
+        loop ranks and fits on, the other half is held out and judges (run both halves, as
+        `gyrodrift diagnose --diagnose-on` does). `bench_channels` describe the bench and are never
+        ranked (the chamber's set point and air always are). The GIL is released. Raises
+        `InputError` (no activation of this unit to diagnose, `half` not 0 or 1) or `FitError`."""
     def save(self, folder: _Path) -> Path:
         """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} through
         the command line's own writer (the same bytes as `gyrodrift fit`); returns the unit's
