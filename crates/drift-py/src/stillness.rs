@@ -26,6 +26,9 @@ type Learned<'py> = (
     Bound<'py, PyArray1<bool>>,
 );
 
+/// `update`'s result: the rate less the offset, still, learning.
+type Learned1 = ((f32, f32, f32), bool, bool);
+
 fn rows(rows: &Rows<'_>) -> Vec<[f32; 3]> {
     let view = rows.view();
     let mut out = vec![[0.0f32; 3]; view.len()];
@@ -101,10 +104,7 @@ impl PyStillnessLearner {
     }
 
     /// One rate sample, °/s: `(rate less the offset, still, learning)`.
-    fn update(
-        &mut self,
-        rate_dps: &Bound<'_, PyAny>,
-    ) -> Result<((f32, f32, f32), bool, bool), Error> {
+    fn update(&mut self, rate_dps: &Bound<'_, PyAny>) -> Result<Learned1, Error> {
         let out = self.learner.update(per_axis("rate_dps", rate_dps)?);
         let [x, y, z] = out.rate_dps;
         Ok(((x, y, z), out.still, out.learning))
