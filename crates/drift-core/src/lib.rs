@@ -30,6 +30,7 @@ mod modified;
 mod polynomial;
 mod settings;
 mod stage;
+mod stillness;
 mod table;
 mod warm_start;
 
@@ -52,6 +53,7 @@ pub use polynomial::{
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};
+pub use stillness::{StillnessLearner, StillnessOutput, StillnessSettings};
 pub use table::{
     AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, MAX_PLAUSIBLE_K,
     MAX_PLAUSIBLE_RISE_CELSIUS, MAX_PLAUSIBLE_STORED_DRIFT_DPS,

@@ -27,6 +27,7 @@ mod segment;
 mod settings;
 mod simulate;
 mod sources;
+mod stillness;
 mod tables;
 
 use pyo3::prelude::*;
@@ -44,6 +45,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<tables::PyRelativePolynomialTables>()?;
     module.add_class::<corrector::PyCorrector>()?;
     module.add_class::<corrector::PyOutput>()?;
+    module.add_class::<stillness::PyStillnessLearner>()?;
     module.add_class::<labels::PyLabels>()?;
     module.add_class::<segment::PyAuxChannel>()?;
     module.add_class::<segment::PySegment>()?;

@@ -4,6 +4,7 @@
 use crate::error::SimError;
 use crate::faults::SensorFaults;
 use crate::hidden::HiddenEffects;
+use crate::motion::Motion;
 use crate::unit::UnitModel;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -125,6 +126,9 @@ pub struct Field {
     pub heating_scatter: f64,
     /// Off-time before each session (min).
     pub rest_min: f64,
+    /// Rotations with still gaps during each activation; `None` holds the unit static.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motion: Option<Motion>,
 }
 
 impl Default for Field {
@@ -142,6 +146,7 @@ impl Default for Field {
             orientation_change_probability: 0.5,
             heating_scatter: 0.03,
             rest_min: 60.0,
+            motion: None,
         }
     }
 }
@@ -350,6 +355,19 @@ impl Campaign {
                 f.orientation_change_probability,
             )?;
             check_fraction("field.heating_scatter", f.heating_scatter)?;
+            if let Some(m) = &f.motion {
+                for d in m.rotation_s {
+                    check_duration("field.motion.rotation_s", d)?;
+                }
+                check_ordered("field.motion.rotation_s", m.rotation_s)?;
+                check_ordered("field.motion.rate_dps", m.rate_dps)?;
+                check_nonneg("field.motion.rate_dps", m.rate_dps[0])?;
+                check_ordered("field.motion.still_s", m.still_s)?;
+                check_nonneg("field.motion.still_s", m.still_s[0])?;
+                if m.still_s[1] > 86_400.0 {
+                    return Err(bad("field.motion.still_s", "must be ≤ 24 h"));
+                }
+            }
         }
         Ok(())
     }

@@ -6,6 +6,7 @@ use crate::bias::{self, BiasInputs};
 use crate::campaign::{Campaign, TruthBias};
 use crate::error::SimError;
 use crate::faults::{FaultEvent, Injector, FAULTS_METADATA};
+use crate::motion;
 use crate::rng;
 use crate::schedule::{ActivationPlan, FilePlan};
 use crate::thermal::network::{asic, capsule, element, NODES};
@@ -432,7 +433,8 @@ impl FileSim<'_> {
         self.step
             .forcing(&power, act.ambient_on_c + 0.5 * h * ramp, &mut forcing);
         let mut next = [0.0; NODES];
-        let accel_true = act.gravity_body;
+        let mut accel_true = act.gravity_body;
+        let mut rotation = 0usize;
 
         let grid_s = f64::from(aux_every) * h;
         let mut inject = (!faults.is_empty()).then(|| Injector::new(faults));
@@ -460,6 +462,7 @@ impl FileSim<'_> {
         }
         for i in 0..act.samples {
             let t = f64::from(i) * h;
+            let body_dps = motion::rate_from(&act.motion, &mut rotation, i);
             let ambient = act.ambient_on_c + ramp * t;
             let phase = i % aux_every;
             if phase == 0 {
@@ -517,6 +520,9 @@ impl FileSim<'_> {
                     buf.truth_asic[a].push(x[asic(a)] as f32);
                     buf.truth_instability[a].push(instability[a] as f32);
                 }
+                if !act.motion.is_empty() {
+                    accel_true = motion::turn_gravity(accel_true, body_dps, grid_s);
+                }
                 buf.supply
                     .push((act.supply_v + SUPPLY_NOISE_V * noise * normal(r)) as f32);
                 buf.set_point.push(if protocol_bench {
@@ -549,7 +555,7 @@ impl FileSim<'_> {
                 if runtime.is_some() {
                     systematic += extra_now[a] + frac * (extra_next[a] - extra_now[a]);
                 }
-                let rate = (systematic + instability[a] + white[a] * normal(r))
+                let rate = (systematic + instability[a] + white[a] * normal(r) + body_dps[a])
                     .clamp(-RANGE_DPS, RANGE_DPS);
                 let mut raw = (asic_c + axis.temperature_offset_c) * RAW_PER_CELSIUS
                     + temp_noise[a] * normal(r);

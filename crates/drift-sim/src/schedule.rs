@@ -3,6 +3,7 @@
 //! drawn up front from seeded streams. The engine then only integrates physics.
 
 use crate::campaign::{Campaign, Field, Protocol};
+use crate::motion::{self, Rotation};
 use crate::rng;
 use crate::unit::NOMINAL_SUPPLY_V;
 use rand::rngs::ChaCha8Rng;
@@ -38,6 +39,8 @@ pub struct ActivationPlan {
     pub gravity_body: [f64; 3],
     /// Relative ASIC heating power per axis (1 = nominal).
     pub heating_scale: [f64; 3],
+    /// Rotations during the activation, in order (none: held static).
+    pub motion: Vec<Rotation>,
 }
 
 /// One MCAP file: one unit at one chamber set point, one kind of series.
@@ -99,11 +102,31 @@ pub fn plan(c: &Campaign) -> Vec<FilePlan> {
                     c.seed,
                     &[rng::tag("schedule"), u64::from(unit), u64::from(file_index)],
                 );
-                let activations = match (kind, &c.protocol, &c.field) {
+                let mut activations = match (kind, &c.protocol, &c.field) {
                     (SeriesKind::Protocol, Some(p), _) => protocol(p, sp, c, &mut r),
                     (SeriesKind::Field, _, Some(f)) => field(f, sp, c, &mut r),
                     _ => Vec::new(),
                 };
+                if let (
+                    SeriesKind::Field,
+                    Some(Field {
+                        motion: Some(m), ..
+                    }),
+                ) = (kind, &c.field)
+                {
+                    for (k, act) in activations.iter_mut().enumerate() {
+                        let mut r = rng::stream(
+                            c.seed,
+                            &[
+                                rng::tag("motion"),
+                                u64::from(unit),
+                                u64::from(file_index),
+                                k as u64,
+                            ],
+                        );
+                        act.motion = motion::plan(m, act.samples, c.sample_rate_hz, &mut r);
+                    }
+                }
                 let stem = format!("GIU-{:02}_sp{:+.1}C_{}", unit + 1, sp, kind.as_str());
                 let file = FilePlan {
                     unit_index: unit,
@@ -174,6 +197,7 @@ fn protocol(p: &Protocol, sp: f64, c: &Campaign, r: &mut ChaCha8Rng) -> Vec<Acti
                     supply_v: NOMINAL_SUPPLY_V,
                     gravity_body: Z_UP,
                     heating_scale: scatter(r, p.heating_scatter * c.noise_scale),
+                    motion: Vec::new(),
                 });
             }
         }
@@ -265,6 +289,7 @@ fn field(f: &Field, sp: f64, c: &Campaign, r: &mut ChaCha8Rng) -> Vec<Activation
                 supply_v,
                 gravity_body: gravity,
                 heating_scale: scatter(r, f.heating_scatter * c.noise_scale),
+                motion: Vec::new(),
             });
         }
     }

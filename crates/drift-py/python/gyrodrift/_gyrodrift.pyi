@@ -57,6 +57,7 @@ __all__ = [
     "RelativePolynomialTables",
     "Segment",
     "Settings",
+    "StillnessLearner",
     "TableError",
     "__version__",
     "analyse",
@@ -426,6 +427,56 @@ class Output:
     def flags(self) -> tuple[int, int, int]:
         """Status flags per axis (bits of `gyrodrift.Flags`)."""
     def __eq__(self, other: object, /) -> bool: ...
+
+@final
+class StillnessLearner:
+    """Learns the rate's offset while the instrument stands still: drift-core's learner (x-io
+    Fusion's gyroscope offset correction with rate and acceleration variance tests).
+
+    Feed it the tables' corrected rate (`Corrector`) to learn the slow offset the tables cannot
+    know, or the raw rate for the learner alone. Results are bit for bit those of the Rust learner.
+    """
+
+    def __new__(
+        cls,
+        *,
+        sample_rate_hz: float = 1000.0,
+        accel_rate_hz: float = 100.0,
+        rate_threshold_dps: float = 3.0,
+        rate_sd_threshold_dps: float = 0.1,
+        accel_sd_threshold_g: float = 0.01,
+        variance_time_constant_s: float = 0.5,
+        still_for_s: float = 5.0,
+        time_constant_s: float | None = None,
+    ) -> StillnessLearner:
+        """A learner with no offset learned. `time_constant_s` defaults to Fusion's 0.02 Hz
+        cut-off (about 8 s). A non-finite or non-positive setting raises `InputError` naming it."""
+    @property
+    def offset_dps(self) -> tuple[float, float, float]:
+        """The offset learned so far, °/s, X, Y, Z."""
+    @property
+    def time_constant_s(self) -> float:
+        """The time constant of the offset's low-pass, s."""
+    def set_offset(self, offset_dps: _Floats3) -> None:
+        """Starts from a kept offset, °/s, with the detector cleared."""
+    def reset_detector(self) -> None:
+        """Clears the still detector and keeps the offset (call it at switch-on)."""
+    def accelerometer(self, accel_g: _Floats3) -> None:
+        """One accelerometer reading, g, at `accel_rate_hz`; a non-finite reading is skipped."""
+    def update(
+        self, rate_dps: _Floats3
+    ) -> tuple[tuple[float, float, float], bool, bool]:
+        """One rate sample, °/s: `(rate less the offset learned before it, still, learning)`."""
+    def update_batch(
+        self,
+        rate_dps: NDArray[np.float32] | NDArray[np.float64],
+        accel_g: NDArray[np.float32] | NDArray[np.float64] | None = None,
+        *,
+        accel_every: int = 10,
+    ) -> tuple[NDArray[np.float32], NDArray[np.bool_], NDArray[np.bool_]]:
+        """n rate samples `(n, 3)` in order; accelerometer row k `(m, 3)` is read before rate
+        sample `k · accel_every`. Returns the rates less the offset `(n, 3)`, and per sample
+        whether it was still and whether it moved the offset."""
 
 @final
 class Corrector:
