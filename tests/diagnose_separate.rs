@@ -132,3 +132,51 @@ fn diagnose_fits_and_ranks_on_one_source_and_judges_on_another() {
         "{text}"
     );
 }
+
+/// `--diagnosis-data`: another source's series are the diagnosis data, cross-fitted by series.
+/// Each half ranks on its own series and is judged on the other's (every activation of the
+/// diagnosis data is in exactly one half's diagnosis), both halves are reported with whether they
+/// agree, and nothing of the calibration source's protocol is diagnosed.
+#[test]
+fn diagnosis_data_are_cross_fitted_by_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = simulate(d, "campaign", 5, "30, 40, 33");
+    let b = simulate(d, "diagnosis", 5, "33");
+    let out_dir = d.join("crossfit");
+    let (out, text) = gyrodrift(&[
+        "diagnose",
+        "-q",
+        &a,
+        "--calibration",
+        "30,40",
+        "--diagnosis-data",
+        &b,
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    let md = std::fs::read_to_string(out_dir.join("diagnosis.md")).unwrap();
+    for needle in ["half 1 of 2", "half 2 of 2", "do the halves agree?"] {
+        assert!(md.contains(needle), "no `{needle}` in {md}");
+    }
+    let halves = json(&out_dir.join("diagnosis.json"));
+    let halves = halves.as_array().unwrap();
+    assert_eq!(halves.len(), 2, "{halves:#?}");
+    assert_eq!(halves[0]["half"], 0);
+    assert_eq!(halves[1]["half"], 1);
+    // Every activation of the diagnosis data is ranked by one half or the other, never by both.
+    let named: u64 = read_campaign_dir(Path::new(&b))
+        .unwrap()
+        .iter()
+        .map(|r| r.segments.len() as u64)
+        .sum();
+    let diagnosed: Vec<u64> = halves
+        .iter()
+        .map(|h| h["axes"][0]["activations"].as_u64().unwrap())
+        .collect();
+    let training = |h: &serde_json::Value| h["stage3"][0]["training_activations"].as_u64().unwrap();
+    let own = |i: usize| diagnosed[i] - training(&halves[i]);
+    assert_eq!(own(0) + own(1), named, "{diagnosed:?}");
+    assert!(own(0) > 0 && own(1) > 0, "{diagnosed:?}");
+}

@@ -604,3 +604,26 @@ fn long_numbers_are_shortened() {
     );
     assert!(text.len() < 300, "{text}");
 }
+
+#[test]
+fn diagnose_refuses_diagnosis_data_at_a_calibration_set_point() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &[
+            "diagnose",
+            s(campaign()),
+            "-q",
+            "--calibration",
+            "30,40",
+            "--diagnose-on",
+            "40",
+            "-o",
+            s(&dir.path().join("diagnosis")),
+        ],
+        &[
+            "--diagnose-on 40: a calibration set point",
+            "--diagnosis-data",
+        ],
+    );
+    assert!(!dir.path().join("diagnosis").exists());
+}

@@ -500,6 +500,16 @@ Each half ranked, fitted and guarded on its own series and was judged on the oth
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
     let options = input.options(&[], false)?;
+    if let Some(shared) = args
+        .diagnose_on
+        .iter()
+        .find(|t| pipeline::is_one_of(**t, &options.calibration_set_points))
+    {
+        anyhow::bail!(
+            "--diagnose-on {shared}: a calibration set point ({:?} °C); its protocol is the tables' and its field activations already rank as training. Name set points the calibration does not use, or give the data with --diagnosis-data",
+            options.calibration_set_points
+        );
+    }
     let files = pipeline::recording_files(input.source())?;
     let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
