@@ -236,7 +236,7 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         });
     }
     let step = ((f64::from(settings.grid_ms) * samples_per_ms).round() as usize).max(1);
-    let window = settings.lowpass_window_samples;
+    let window = settings.lowpass_window(segment.sample_rate_hz);
     let mut out = Analysed {
         labels: segment.labels.clone(),
         grid_ms: settings.grid_ms,

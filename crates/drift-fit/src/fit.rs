@@ -63,8 +63,11 @@ fn check(settings: &FitSettings) -> Result<(), FitError> {
             problem: problem.into(),
         })
     };
-    if settings.lowpass_window_samples == 0 {
-        return bad("lowpass_window_samples", "must be at least 1");
+    if !(settings.lowpass_window_s.is_finite() && settings.lowpass_window_s > 0.0) {
+        return bad(
+            "lowpass_window_s",
+            "must be a positive number of seconds (1 in the paper)",
+        );
     }
     if settings.grid_ms == 0 {
         return bad("grid_ms", "must be at least 1");

@@ -745,7 +745,7 @@ class FitSettings:
     def __new__(
         cls,
         *,
-        lowpass_window_samples: int | None = None,
+        lowpass_window_s: float | None = None,
         grid_ms: int | None = None,
         initial_bias_window_s: float | None = None,
         switch_on_window_ms: int | None = None,
@@ -761,8 +761,9 @@ class FitSettings:
     def to_json(self) -> str:
         """The JSON form."""
     @property
-    def lowpass_window_samples(self) -> int:
-        """Low-pass: centred moving average of this many samples (default 1000: 1 s at 1 kHz)."""
+    def lowpass_window_s(self) -> float:
+        """Low-pass: centred moving average over this many seconds of each recording's own samples
+        (default 1.0)."""
     @property
     def grid_ms(self) -> int:
         """Analysis grid: curves kept every this many ms (default 10)."""
