@@ -447,6 +447,7 @@ mod tests {
             since_power_on: vec![0, 1, 2],
             rate_dps: [vec![0.0; 3], vec![0.0; 3], vec![0.0; 3]],
             temperature_raw: [0, 1, 2].map(|_| temperatures.clone()),
+            temperature_scale: drift_recording::TemperatureScale::default(),
             aux: BTreeMap::new(),
         }
     }

@@ -16,6 +16,7 @@ use crate::history_order::{crossings, Crossing};
 use crate::knots::{choose, k_window, mean_window};
 use crate::parallel::per_axis;
 use crate::settings::FitSettings;
+use drift_recording::{SCALE_KEY, ZERO_KEY};
 
 /// Capacities of the host table type (`ModifiedTables`'s defaults).
 const MAX_REFERENCES: usize = 16;
@@ -338,6 +339,20 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
             other.labels.unit_id
         )));
     }
+    let scale = activations
+        .first()
+        .map(|a| a.temperature_scale)
+        .unwrap_or_default();
+    if let Some(other) = activations.iter().find(|a| a.temperature_scale != scale) {
+        return Err(insufficient(format!(
+            "its recordings give two temperature scales ({} and {} raw/°C, {} and {} raw at \
+             0 °C; {SCALE_KEY} and {ZERO_KEY} in the recording metadata): one sensor has one",
+            scale.raw_per_celsius,
+            other.temperature_scale.raw_per_celsius,
+            scale.raw_at_zero_celsius,
+            other.temperature_scale.raw_at_zero_celsius,
+        )));
+    }
     let mut set_points = group(activations, settings);
     let mut notes = Vec::new();
     if set_points.is_empty() {
@@ -421,7 +436,12 @@ pub fn fit_unit(activations: &[Analysed], settings: &FitSettings) -> Result<Fitt
                 .collect()
         })
         .collect();
-    let core_settings = Settings::default();
+    // The tables convert raw readings as the calibration recordings did.
+    let core_settings = Settings {
+        raw_per_celsius: scale.raw_per_celsius as f32,
+        raw_at_zero_celsius: scale.raw_at_zero_celsius as f32,
+        ..Settings::default()
+    };
     // The axes' tables and the baselines are independent: all on rayon's threads at once.
     let (tables, ((standard, third_order), (relative, relative_orders))) = rayon::join(
         || {
