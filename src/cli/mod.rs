@@ -19,6 +19,7 @@ mod measured;
 mod progress;
 mod reading;
 pub mod report;
+mod shared_data;
 pub mod simulate;
 
 /// Exit status of every command: 0 done (for `check`: every limit met), 1 `check` found a unit ×
