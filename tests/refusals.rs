@@ -179,6 +179,23 @@ fn report_refuses_a_copy_of_the_calibration_data_as_evaluation_data() {
 }
 
 #[test]
+fn simulate_refuses_set_points_that_name_the_same_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for list in ["30,30", "30,30.04"] {
+        let out = dir.path().join(list);
+        refused(
+            &["simulate", "-q", "-o", s(&out), "--set-points", list],
+            &[
+                "set_points_celsius[1]",
+                "names the same recording files (+30.0 °C) as set_points_celsius[0] = 30 °C",
+                "--set-points",
+            ],
+        );
+        assert!(!out.join("summary.json").exists());
+    }
+}
+
+#[test]
 fn report_refuses_a_validation_set_point_without_data() {
     let dir = tempfile::tempdir().unwrap();
     refused(
