@@ -131,6 +131,71 @@ fn report_refuses_a_validation_set_point_the_fit_sees() {
 }
 
 #[test]
+fn report_refuses_the_campaign_as_its_own_noise_floor() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &[
+            "report",
+            s(campaign()),
+            "-q",
+            "--noise-floor",
+            s(campaign()),
+            "-o",
+            s(&dir.path().join("report")),
+        ],
+        &[
+            "(--noise-floor) holds the same recording as",
+            "(the campaign)",
+            "zero-drift twin",
+        ],
+    );
+    assert!(!dir.path().join("report").exists());
+}
+
+#[test]
+fn report_refuses_a_copy_of_the_calibration_data_as_evaluation_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("copy");
+    copy_tree(campaign(), &copy);
+    // A copy under another name, given by its recordings folder: the same recordings by content.
+    refused(
+        &[
+            "report",
+            "--calibration-data",
+            s(campaign()),
+            "--evaluation-data",
+            s(&copy.join("recordings")),
+            "-q",
+            "-o",
+            s(&dir.path().join("report")),
+        ],
+        &[
+            "(--evaluation-data) holds the same recording as",
+            "(--calibration-data)",
+            "recordings the fit does not see",
+        ],
+    );
+    assert!(!dir.path().join("report").exists());
+}
+
+#[test]
+fn simulate_refuses_set_points_that_name_the_same_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for list in ["30,30", "30,30.04"] {
+        let out = dir.path().join(list);
+        refused(
+            &["simulate", "-q", "-o", s(&out), "--set-points", list],
+            &[
+                "set_points_celsius[1]",
+                "names the same recording files (+30.0 °C) as set_points_celsius[0] = 30 °C",
+                "--set-points",
+            ],
+        );
+        assert!(!out.join("summary.json").exists());
+    }
+}
+
+#[test]
 fn report_refuses_a_validation_set_point_without_data() {
     let dir = tempfile::tempdir().unwrap();
     refused(

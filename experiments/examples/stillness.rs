@@ -178,7 +178,7 @@ fn evaluate(
             .is_some_and(|s| s < settings.independent_after_min * 60.0);
         for &way in ways {
             let r = residual(way, fitted.get(unit), segment, rotations, settings)?;
-            let (_, rms) = metric(&r, settings.lowpass_window_samples);
+            let (_, rms) = metric(&r, settings.lowpass_window(segment.sample_rate_hz));
             for (axis, rms) in rms.iter().enumerate() {
                 cells
                     .entry((unit.clone(), axis, warm, way))
@@ -219,7 +219,7 @@ fn floor(twin: &[(Segment, Vec<Rotation>)], settings: &FitSettings) -> anyhow::R
                 .map(|&v| (f64::from(v) - sum[a] / n as f64) as f32)
                 .collect()
         });
-        let (_, rms) = metric(&centred, settings.lowpass_window_samples);
+        let (_, rms) = metric(&centred, settings.lowpass_window(segment.sample_rate_hz));
         let warm = segment
             .labels
             .off_before_s

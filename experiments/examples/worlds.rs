@@ -113,7 +113,7 @@ fn child_part(args: &[String]) -> anyhow::Result<()> {
         serde_json::to_string(&record(kind, seed, &paths, small(4))?)?
     } else {
         // Sees the two recordings folders and nothing else.
-        let settings = fit_settings(small(3));
+        let settings = fit_settings();
         serde_json::to_string(&close_blind(
             Path::new(arg(1)?),
             Path::new(arg(2)?),

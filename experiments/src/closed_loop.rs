@@ -540,8 +540,7 @@ pub fn run(
                 && is(VALIDATION, s.labels.nominal_set_point_celsius())
         })
         .collect();
-    let twin_floor =
-        evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_samples);
+    let twin_floor = evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_s);
     let floor = evaluate::mean_floor(&twin_floor);
     let twin_drift: [Vec<f64>; 3] =
         std::array::from_fn(|a| twin_floor.iter().map(|p| p[a].0).collect());

@@ -107,12 +107,10 @@ pub fn world_campaign(small: bool) -> WorldCampaign {
     }
 }
 
-/// The fit's settings for [`world_campaign`]: the 1-s low-pass at its sample rate.
-pub fn fit_settings(small: bool) -> FitSettings {
-    FitSettings {
-        lowpass_window_samples: world_campaign(small).sample_rate_hz as usize,
-        ..FitSettings::default()
-    }
+/// The fit's settings for [`world_campaign`]: the defaults (the 1-s low-pass is converted with
+/// each recording's own rate).
+pub fn fit_settings() -> FitSettings {
+    FitSettings::default()
 }
 
 /// Peak resident memory of this process so far (`VmHWM`), MB; NaN where `/proc` has none.
@@ -307,7 +305,7 @@ pub fn close_blind(
                 && is(VALIDATION, s.labels.nominal_set_point_celsius())
         })
         .collect();
-    let floor = evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_samples);
+    let floor = evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_s);
     let axes = (0..3)
         .map(|a| {
             let diagnosis = &closed.axes[a];
@@ -562,7 +560,7 @@ pub fn run_world(kind: Kind, seed: u64, work: &Path, small: bool) -> anyhow::Res
     let outcome = recorded
         .as_ref()
         .ok()
-        .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(small), false));
+        .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(), false));
     paths.remove_recordings();
     let result = match (recorded, outcome) {
         (Ok(r), Some(Ok(o))) => score(kind, seed, &paths.truth, &r, &o),

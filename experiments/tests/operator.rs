@@ -86,10 +86,7 @@ fn residuals(
 
 #[test]
 fn the_tables_leave_of_g_plus_cx_what_they_leave_of_g_plus_c_times_x_less_lx() {
-    let settings = FitSettings {
-        lowpass_window_samples: 100,
-        ..FitSettings::default()
-    };
+    let settings = FitSettings::default();
     let g = calibration();
     let c = 0.004f32;
     let with_x: Vec<Segment> = g

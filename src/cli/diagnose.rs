@@ -602,7 +602,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             steps.update("measuring the noise floor", 0, 1);
             Some(drift_evaluate::noise_floor::measure(
                 dir,
-                options.fit.lowpass_window_samples,
+                options.fit.lowpass_window_s,
             )?)
         }
         None => None,

@@ -20,6 +20,7 @@ mod measured;
 mod progress;
 mod reading;
 pub mod report;
+mod shared_data;
 mod sheet_logs;
 pub mod simulate;
 

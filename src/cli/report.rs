@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use super::campaign_args::CampaignArgs;
 use super::measured;
 use super::progress::Steps;
+use super::shared_data::refuse_shared;
 use drift_evaluate::pipeline::PipelineError;
 use drift_evaluate::pipeline::{self, Options, Outcome};
 use drift_recording::paper;
@@ -53,6 +54,13 @@ pub fn make(
     let steps = Steps::new(quiet);
     let files = pipeline::recording_files(campaign)?;
     let noise_files = noise_floor.map(pipeline::recording_files).transpose()?;
+    if let Some(noise) = &noise_files {
+        refuse_shared(
+            ("the campaign", &files),
+            ("--noise-floor", noise),
+            NOISE_FLOOR_APART,
+        )?;
+    }
     let made = drift_report::make(
         &files,
         noise_files.as_deref(),
@@ -64,6 +72,11 @@ pub fn make(
     steps.finish();
     made
 }
+
+/// Why a noise floor must be other recordings than the data it is set beside.
+const NOISE_FLOOR_APART: &str = "the noise floor is a zero-drift twin recorded like the data \
+     (`gyrodrift simulate --zero-drift`, or a unit without a temperature effect), never the data \
+     itself; give such a campaign as --noise-floor, or leave the flag out";
 
 /// Prints the headline table of a finished report.
 pub fn print_headline(outcome: &Outcome) {
@@ -154,6 +167,20 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
         .as_deref()
         .map(pipeline::recording_files)
         .transpose()?;
+    refuse_shared(
+        ("--calibration-data", &calibration),
+        ("--evaluation-data", &evaluated),
+        "the evaluation data must be recordings the fit does not see; give other recordings of the \
+         fitted units as --evaluation-data",
+    )?;
+    if let Some(noise) = &noise_files {
+        for (flag, files) in [
+            ("--calibration-data", &calibration),
+            ("--evaluation-data", &evaluated),
+        ] {
+            refuse_shared((flag, files), ("--noise-floor", noise), NOISE_FLOOR_APART)?;
+        }
+    }
     let made = drift_report::make_separate(
         &calibration,
         &evaluated,

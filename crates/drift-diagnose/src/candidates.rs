@@ -6,7 +6,7 @@
 //! absorb of each, [`crate::absorb`]) and on the activations being diagnosed, so a kind is defined
 //! once, by what it computes, not by where it is used.
 
-use drift_recording::{Segment, RAW_PER_CELSIUS};
+use drift_recording::Segment;
 
 use drift_fit::lowpass::centred_moving_average;
 
@@ -243,7 +243,8 @@ impl Kind {
     ) -> Option<[Vec<f32>; 3]> {
         let n = segment.len();
         let rate_hz = f64::from(segment.sample_rate_hz.max(1));
-        let on_celsius = switch_on.map(|r| f64::from(r) / RAW_PER_CELSIUS);
+        let scale = segment.temperature_scale;
+        let on_celsius = switch_on.map(|r| scale.celsius(f64::from(r)));
         let same = |values: Vec<f32>| Some([values.clone(), values.clone(), values]);
         let per_axis = |f: &dyn Fn(usize) -> Vec<f32>| Some([f(0), f(1), f(2)]);
         let rise = |axis: usize| -> Vec<f64> {
@@ -253,7 +254,7 @@ impl Kind {
                 segment.sample_rate_hz as usize,
             )
             .into_iter()
-            .map(|r| r / RAW_PER_CELSIUS - on_celsius[axis])
+            .map(|r| scale.celsius(r) - on_celsius[axis])
             .collect()
         };
         let aux = |name: &str| -> Option<Vec<f64>> {

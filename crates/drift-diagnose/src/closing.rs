@@ -221,12 +221,12 @@ fn choose_stage3(
     kept: &[[Previous; 3]],
     settings: &FitSettings,
 ) -> [Stage3Choice; 3] {
-    let window = settings.lowpass_window_samples;
     let per_activation: Vec<([f64; 3], [f64; 3])> = training
         .par_iter()
         .zip(kept)
         .map(|(segment, previous)| {
             let on = switch_on_raw(segment, settings);
+            let window = settings.lowpass_window(segment.sample_rate_hz);
             let (rise, _) = metric(
                 &correct_segment_after(&fitted.modified, segment, on, None).0,
                 window,
@@ -695,7 +695,7 @@ impl Closed<'_> {
                     off_before_s: segment.labels.off_before_s,
                     after_dps: profile(
                         &after,
-                        settings.lowpass_window_samples,
+                        settings.lowpass_window(segment.sample_rate_hz),
                         f64::from(segment.sample_rate_hz),
                         &PROFILE_EDGES_S,
                     ),
@@ -712,7 +712,6 @@ impl Closed<'_> {
     /// firmware would have lived it ([`Closed::keying`]).
     pub fn before_after(&self, fitted: &FittedUnit, settings: &FitSettings) -> Vec<BeforeAfter> {
         let plan = self.admitted();
-        let window = settings.lowpass_window_samples;
         let every_axis = self.keying.with_by_history([true; 3]);
         let model = self.model(fitted);
         self.roles
@@ -720,6 +719,7 @@ impl Closed<'_> {
             .iter()
             .map(|segment| {
                 let on = switch_on_raw(segment, settings);
+                let window = settings.lowpass_window(segment.sample_rate_hz);
                 let (history_drift, history_rms) = metric(
                     &every_axis.correct(&fitted.by_history, segment, on).0,
                     window,

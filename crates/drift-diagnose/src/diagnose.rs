@@ -159,7 +159,7 @@ impl Diagnoser {
 
     /// Puts one activation, corrected by the paper's model, on the diagnosis grid.
     pub fn series(&self, segment: &Segment) -> ActivationSeries {
-        let window = self.settings.lowpass_window_samples;
+        let window = self.settings.lowpass_window(segment.sample_rate_hz);
         let step = (segment.sample_rate_hz as usize * GRID_MS as usize / 1000).max(1);
         let switch_on = switch_on_raw(segment, &self.settings);
         let (corrected, _) = self.keying.correct(&self.tables, segment, switch_on);

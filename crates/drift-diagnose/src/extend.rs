@@ -435,7 +435,7 @@ fn training_series(
     segment: &Segment,
     settings: &FitSettings,
 ) -> TrainingSeries {
-    let window = settings.lowpass_window_samples;
+    let window = settings.lowpass_window(segment.sample_rate_hz);
     let step = (segment.sample_rate_hz as usize / 10).max(1);
     let grid = |v: &[f32]| -> Vec<f64> {
         centred_moving_average(v, window)
@@ -594,7 +594,7 @@ fn errors(
 ) -> [(f64, f64); 3] {
     let on = switch_on_raw(segment, settings);
     let corrected = correct_with_terms(tables, plan, segment, on, keying.previous(segment));
-    let (drift, rms) = metric(&corrected, settings.lowpass_window_samples);
+    let (drift, rms) = metric(&corrected, settings.lowpass_window(segment.sample_rate_hz));
     std::array::from_fn(|a| (rms[a] * rms[a], drift[a]))
 }
 

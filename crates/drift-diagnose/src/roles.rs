@@ -205,6 +205,7 @@ mod tests {
             since_power_on: vec![0],
             rate_dps: [vec![0.0], vec![0.0], vec![0.0]],
             temperature_raw: [vec![6000], vec![6000], vec![6000]],
+            temperature_scale: drift_recording::TemperatureScale::default(),
             aux: BTreeMap::new(),
         }
     }

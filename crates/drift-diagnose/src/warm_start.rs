@@ -46,7 +46,6 @@ pub fn choose(
     training: &[&Segment],
     settings: &FitSettings,
 ) -> [WarmStartChoice; 3] {
-    let window = settings.lowpass_window_samples;
     let cold = keying.with_warm_start([false; 3]);
     let warm = keying.with_warm_start([true; 3]);
     let (cold_tables, warm_tables) = (
@@ -57,6 +56,7 @@ pub fn choose(
         .par_iter()
         .map(|segment| {
             let on = switch_on_raw(segment, settings);
+            let window = settings.lowpass_window(segment.sample_rate_hz);
             let (_, rms_cold) = metric(&cold.correct(&cold_tables, segment, on).0, window);
             let (_, rms_warm) = metric(&warm.correct(&warm_tables, segment, on).0, window);
             (rms_cold.map(|r| r * r), rms_warm.map(|r| r * r))

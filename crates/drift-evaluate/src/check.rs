@@ -182,7 +182,7 @@ impl<M: Model> UnitCheck<M> {
     /// switch-on (`power_on_after`; only tables keyed by history read it), and knows from the
     /// recording's off-time when the unit cooled fully ([`cooled_before`]).
     pub fn add(&mut self, segment: &Segment) {
-        let window = self.settings.lowpass_window_samples;
+        let window = self.settings.lowpass_window(segment.sample_rate_hz);
         let (uncorrected_drift_dps, _) = metric(&segment.rate_dps, window);
         let switch_on = switch_on_raw(segment, &self.settings);
         if cooled_before(segment, &self.settings) {

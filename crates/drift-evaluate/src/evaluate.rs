@@ -143,8 +143,8 @@ pub fn profile(
 /// beside): per axis, the mean over them of [`metric`]'s drift and RMS of the uncorrected rate
 /// less the unit's constant bias (its mean over every one of them). What a perfect model would
 /// leave: white noise and bias instability through the 1-s window.
-pub fn noise_floor(activations: &[&Segment], window: usize) -> [(f64, f64); 3] {
-    mean_floor(&noise_floor_per_activation(activations, window))
+pub fn noise_floor(activations: &[&Segment], window_s: f64) -> [(f64, f64); 3] {
+    mean_floor(&noise_floor_per_activation(activations, window_s))
 }
 
 /// The mean over activations of [`noise_floor_per_activation`]'s figures: [`noise_floor`] for a
@@ -162,8 +162,9 @@ pub fn mean_floor(per_activation: &[[(f64, f64); 3]]) -> [(f64, f64); 3] {
 }
 
 /// [`noise_floor`] activation by activation: per activation and axis, the drift and RMS (what an
-/// interval over the activations resamples, [`crate::excess`]).
-pub fn noise_floor_per_activation(activations: &[&Segment], window: usize) -> Vec<[(f64, f64); 3]> {
+/// interval over the activations resamples, [`crate::excess`]). The low-pass is `window_s`
+/// seconds of each activation's own samples.
+pub fn noise_floor_per_activation(activations: &[&Segment], window_s: f64) -> Vec<[(f64, f64); 3]> {
     let n = activations.len().max(1) as f64;
     let offset: [f64; 3] = std::array::from_fn(|a| {
         activations
@@ -183,6 +184,11 @@ pub fn noise_floor_per_activation(activations: &[&Segment], window: usize) -> Ve
                     .map(|&v| (f64::from(v) - offset[a]) as f32)
                     .collect()
             });
+            let window = FitSettings {
+                lowpass_window_s: window_s,
+                ..FitSettings::default()
+            }
+            .lowpass_window(s.sample_rate_hz);
             let (drift, rms) = metric(&centred, window);
             std::array::from_fn(|a| (drift[a], rms[a]))
         })
@@ -368,7 +374,7 @@ pub fn evaluate_after(
     settings: &FitSettings,
     previous: &[Previous; 3],
 ) -> ActivationResult {
-    let window = settings.lowpass_window_samples;
+    let window = settings.lowpass_window(segment.sample_rate_hz);
     let switch_on = switch_on_raw(segment, settings);
     let models = ModelKind::ALL
         .iter()
@@ -441,6 +447,7 @@ mod tests {
             since_power_on: vec![0, 1, 2],
             rate_dps: [vec![0.0; 3], vec![0.0; 3], vec![0.0; 3]],
             temperature_raw: [0, 1, 2].map(|_| temperatures.clone()),
+            temperature_scale: drift_recording::TemperatureScale::default(),
             aux: BTreeMap::new(),
         }
     }
@@ -456,7 +463,7 @@ mod tests {
             second.rate_dps[axis] = vec![0.5; 3];
         }
         second.rate_dps[0] = vec![0.51; 3];
-        let floor = noise_floor(&[&first, &second], 1);
+        let floor = noise_floor(&[&first, &second], 0.001);
         // X: each activation is 0.005 °/s off the unit's mean, flat within itself.
         assert!((floor[0].1 - 0.005).abs() < 1e-6, "{floor:?}");
         assert!(floor[0].0.abs() < 1e-9, "{floor:?}");

@@ -638,6 +638,7 @@ mod tests {
             since_power_on: (0..n as u32).collect(),
             rate_dps: [r.clone(), r.clone(), r],
             temperature_raw: [raw.clone(), raw.clone(), raw],
+            temperature_scale: drift_recording::TemperatureScale::default(),
             aux: Default::default(),
         }
     }

@@ -33,7 +33,7 @@ pub fn group_name(set_point_celsius: f64, series_kind: &str) -> String {
 /// per unit, set point and series kind, its activations uncorrected, less the unit's constant bias
 /// ([`crate::evaluate::noise_floor`]); the mean
 /// over its units.
-pub fn measure(dir: &Path, window: usize) -> Result<Floor, PipelineError> {
+pub fn measure(dir: &Path, window_s: f64) -> Result<Floor, PipelineError> {
     let mut groups: BTreeMap<(String, String), Vec<Segment>> = BTreeMap::new();
     for path in pipeline::recording_files(dir)? {
         let recording = read_recording(&path)?;
@@ -51,7 +51,7 @@ pub fn measure(dir: &Path, window: usize) -> Result<Floor, PipelineError> {
     let mut sums: BTreeMap<String, (FloorGroup, usize)> = BTreeMap::new();
     for ((key, _unit), segments) in &groups {
         let refs: Vec<&Segment> = segments.iter().collect();
-        let per_activation = noise_floor_per_activation(&refs, window);
+        let per_activation = noise_floor_per_activation(&refs, window_s);
         let entry = sums.entry(key.clone()).or_default();
         for (sum, (drift, rms)) in entry.0.mean.iter_mut().zip(mean_floor(&per_activation)) {
             sum.0 += drift;

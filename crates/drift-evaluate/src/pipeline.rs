@@ -14,7 +14,7 @@ use std::sync::mpsc::{channel, sync_channel, Receiver};
 use std::time::Instant;
 
 use drift_recording::{
-    paper, read_metadata, read_recording, OpenRecording, ReadError, Segment, SeriesKind,
+    paper, read_metadata, read_recording, OpenRecording, ReadError, Recording, Segment, SeriesKind,
     COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR,
 };
 use rayon::prelude::*;
@@ -101,6 +101,24 @@ pub enum PipelineError {
         found: Vec<f64>,
         /// How many recordings were looked at.
         files: usize,
+    },
+    /// A recording to evaluate gives its unit's temperature sensor another scale than the
+    /// calibration recordings the tables were fitted on: the tables would read its temperatures
+    /// wrong.
+    #[error("{path}: temperature scale {raw_per_celsius} raw/°C, {raw_at_zero_celsius} raw at 0 °C, but unit {unit}'s tables were fitted on recordings at {tables_per_celsius} raw/°C, {tables_at_zero} raw at 0 °C (metadata temperature_raw_per_celsius, temperature_raw_at_zero_celsius): record both at one scale, or correct the metadata")]
+    OtherTemperatureScale {
+        /// The recording.
+        path: PathBuf,
+        /// The unit.
+        unit: String,
+        /// The recording's scale, raw units per °C.
+        raw_per_celsius: f64,
+        /// The recording's raw reading at 0 °C.
+        raw_at_zero_celsius: f64,
+        /// The tables' scale, raw units per °C.
+        tables_per_celsius: f32,
+        /// The tables' raw reading at 0 °C.
+        tables_at_zero: f32,
     },
     /// None of the recordings has protocol activations at the calibration set points.
     #[error("no protocol activations at the calibration set points {set_points:?} °C in {files} recordings")]
@@ -420,6 +438,11 @@ fn evaluate_files<'a>(
         else {
             continue;
         };
+        for (segment, chosen) in recording.segments.iter().zip(&chosen) {
+            if let Some((_, fitted)) = chosen {
+                same_scale(&recording, segment, fitted)?;
+            }
+        }
         let segments: Vec<&Segment> = recording.segments.iter().collect();
         let kept = kept_before(&segments, settings, by_history, true);
         let results: Vec<(Split, ActivationResult)> = recording
@@ -440,6 +463,30 @@ fn evaluate_files<'a>(
         files.len() as u64,
     );
     Ok(out)
+}
+
+/// Refuses `segment` (of `recording`) when its temperature scale is not the one `fitted`'s tables
+/// convert raw readings with.
+fn same_scale(
+    recording: &Recording,
+    segment: &Segment,
+    fitted: &FittedUnit,
+) -> Result<(), PipelineError> {
+    let tables = fitted.modified.settings;
+    let scale = segment.temperature_scale;
+    if scale.raw_per_celsius as f32 == tables.raw_per_celsius
+        && scale.raw_at_zero_celsius as f32 == tables.raw_at_zero_celsius
+    {
+        return Ok(());
+    }
+    Err(PipelineError::OtherTemperatureScale {
+        path: recording.path.clone(),
+        unit: recording.unit_id.clone(),
+        raw_per_celsius: scale.raw_per_celsius,
+        raw_at_zero_celsius: scale.raw_at_zero_celsius,
+        tables_per_celsius: tables.raw_per_celsius,
+        tables_at_zero: tables.raw_at_zero_celsius,
+    })
 }
 
 /// The progress step of pass 1.
@@ -788,6 +835,9 @@ pub fn run(
         // What firmware keeping its history across power-off knows at each switch-on: the
         // recording's activations in order (one unit per recording), with a clock that tells a
         // full cool-down; nothing is known of the time between recordings.
+        for segment in &recording.segments {
+            same_scale(&recording, segment, fitted)?;
+        }
         let segments: Vec<&Segment> = recording.segments.iter().collect();
         let kept = kept_before(&segments, settings, &fitted.by_history.settings, true);
         let results: Vec<(Split, ActivationResult)> = recording

@@ -57,6 +57,7 @@ fn segment(set_point: f64, interval_min: f64, activation: u32) -> Segment {
         since_power_on: (0..n as u32).collect(),
         rate_dps: rate,
         temperature_raw: raw,
+        temperature_scale: drift_recording::TemperatureScale::default(),
         aux: BTreeMap::new(),
     }
 }

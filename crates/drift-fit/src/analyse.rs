@@ -1,7 +1,7 @@
 //! One activation → its low-frequency drift and temperature-rise curves (the paper's `g` and the
 //! temperature "excluding initial bias"), on a coarse time grid.
 
-use drift_recording::{Segment, SegmentLabels, RAW_PER_CELSIUS};
+use drift_recording::{Segment, SegmentLabels, TemperatureScale};
 
 use crate::error::FitError;
 use crate::settings::FitSettings;
@@ -25,6 +25,9 @@ pub struct Analysed {
     pub drift_dps: [Vec<f32>; 3],
     /// Temperature rise since switch-on (low-passed), °C.
     pub rise_celsius: [Vec<f32>; 3],
+    /// The sensor scale of the activation's raw temperatures (`switch_on_raw`): the fitted
+    /// tables convert raw readings with it.
+    pub temperature_scale: TemperatureScale,
 }
 
 impl Analysed {
@@ -236,7 +239,7 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         });
     }
     let step = ((f64::from(settings.grid_ms) * samples_per_ms).round() as usize).max(1);
-    let window = settings.lowpass_window_samples;
+    let window = settings.lowpass_window(segment.sample_rate_hz);
     let mut out = Analysed {
         labels: segment.labels.clone(),
         grid_ms: settings.grid_ms,
@@ -245,8 +248,10 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
         initial_bias_dps: [0.0; 3],
         drift_dps: Default::default(),
         rise_celsius: Default::default(),
+        temperature_scale: segment.temperature_scale,
     };
     let raw = &segment.temperature_raw;
+    let scale = segment.temperature_scale;
     let mut on_raw = [0.0; 3];
     for axis in 0..3 {
         on_raw[axis] = raw[axis][..switch_on]
@@ -255,7 +260,7 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
             .sum::<f64>()
             / switch_on as f64;
         out.switch_on_raw[axis] = on_raw[axis] as f32;
-        out.switch_on_celsius[axis] = on_raw[axis] / RAW_PER_CELSIUS;
+        out.switch_on_celsius[axis] = scale.celsius(on_raw[axis]);
     }
     // The initial bias is where the rate would be at zero rise: the intercept of rate against
     // rise over the first seconds, which uses thousands of samples instead of the few around
@@ -264,7 +269,9 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
     let records = temperature_records(raw, &head);
     for axis in 0..3 {
         let on_raw = on_raw[axis];
-        let rise_head = head.averages(&records[axis], move |t| (t - on_raw) / RAW_PER_CELSIUS);
+        let rise_head = head.averages(&records[axis], move |t| {
+            scale.celsius_difference(t - on_raw)
+        });
         out.initial_bias_dps[axis] = intercept(&rise_head, &segment.rate_dps[axis][..initial]);
     }
     // Every channel's low-pass on the grid, from one pass over the samples.
@@ -273,7 +280,7 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
     for axis in 0..3 {
         let (on_raw, bias) = (on_raw[axis], out.initial_bias_dps[axis]);
         out.rise_celsius[axis] = grid.averages(&records[axis], move |t| {
-            ((t - on_raw) / RAW_PER_CELSIUS) as f32
+            scale.celsius_difference(t - on_raw) as f32
         });
         out.drift_dps[axis] = grid.averages(&records[3 + axis], move |rate| (rate - bias) as f32);
     }

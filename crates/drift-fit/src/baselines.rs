@@ -467,6 +467,7 @@ mod tests {
                         initial_bias_dps: [0.01 * (on - 30.0) + jitter; 3],
                         drift_dps: [drift.clone(), drift.clone(), drift],
                         rise_celsius: [rise.clone(), rise.clone(), rise],
+                        temperature_scale: Default::default(),
                     });
                 }
             }

@@ -16,6 +16,7 @@ use crate::history_order::{crossings, Crossing};
 use crate::knots::{choose, k_window, mean_window};
 use crate::parallel::per_axis;
 use crate::settings::FitSettings;
+use drift_recording::{SCALE_KEY, ZERO_KEY};
 
 /// Capacities of the host table type (`ModifiedTables`'s defaults).
 const MAX_REFERENCES: usize = 16;
@@ -63,8 +64,11 @@ fn check(settings: &FitSettings) -> Result<(), FitError> {
             problem: problem.into(),
         })
     };
-    if settings.lowpass_window_samples == 0 {
-        return bad("lowpass_window_samples", "must be at least 1");
+    if !(settings.lowpass_window_s.is_finite() && settings.lowpass_window_s > 0.0) {
+        return bad(
+            "lowpass_window_s",
+            "must be a positive number of seconds (1 in the paper)",
+        );
     }
     if settings.grid_ms == 0 {
         return bad("grid_ms", "must be at least 1");
@@ -384,6 +388,20 @@ pub fn fit_unit_at(
             other.labels.unit_id
         )));
     }
+    let scale = activations
+        .first()
+        .map(|a| a.temperature_scale)
+        .unwrap_or_default();
+    if let Some(other) = activations.iter().find(|a| a.temperature_scale != scale) {
+        return Err(insufficient(format!(
+            "its recordings give two temperature scales ({} and {} raw/°C, {} and {} raw at \
+             0 °C; {SCALE_KEY} and {ZERO_KEY} in the recording metadata): one sensor has one",
+            scale.raw_per_celsius,
+            other.temperature_scale.raw_per_celsius,
+            scale.raw_at_zero_celsius,
+            other.temperature_scale.raw_at_zero_celsius,
+        )));
+    }
     let mut set_points = group(activations, settings);
     let mut notes = Vec::new();
     if set_points.is_empty() {
@@ -467,7 +485,12 @@ pub fn fit_unit_at(
                 .collect()
         })
         .collect();
-    let core_settings = Settings::default();
+    // The tables convert raw readings as the calibration recordings did.
+    let core_settings = Settings {
+        raw_per_celsius: scale.raw_per_celsius as f32,
+        raw_at_zero_celsius: scale.raw_at_zero_celsius as f32,
+        ..Settings::default()
+    };
     // The axes' tables and the baselines are independent: all on rayon's threads at once.
     let (tables, ((standard, third_order), (relative, relative_orders))) = rayon::join(
         || {

@@ -7,9 +7,10 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FitSettings {
-    /// Low-pass: centred moving average of this many samples ("a window at the operating
-    /// frequency (1000)": 1 s at 1000 Hz).
-    pub lowpass_window_samples: usize,
+    /// Low-pass: centred moving average over this many seconds ("a window at the operating
+    /// frequency (1000)": 1000 samples at the paper's 1000 Hz), converted with each recording's
+    /// own sample rate ([`Self::lowpass_window`]).
+    pub lowpass_window_s: f64,
     /// Analysis grid: the low-passed curves are kept every this many milliseconds.
     pub grid_ms: u32,
     /// The initial (switch-on) bias is the intercept of the rate against the temperature rise
@@ -34,7 +35,7 @@ pub struct FitSettings {
 impl Default for FitSettings {
     fn default() -> Self {
         Self {
-            lowpass_window_samples: 1000,
+            lowpass_window_s: 1.0,
             grid_ms: 10,
             initial_bias_window_s: 4.0,
             switch_on_window_ms: 20,
@@ -44,5 +45,33 @@ impl Default for FitSettings {
             independent_after_min: 15.0,
             polynomial_degree: 3,
         }
+    }
+}
+
+impl FitSettings {
+    /// The low-pass window in samples at `sample_rate_hz`: [`Self::lowpass_window_s`] of the
+    /// recording's own samples, at least one. Every metric and fit reads the window through this,
+    /// so one campaign gives the same figures at any rate.
+    pub fn lowpass_window(&self, sample_rate_hz: u32) -> usize {
+        let samples = (self.lowpass_window_s * f64::from(sample_rate_hz)).round();
+        if samples.is_finite() && samples >= 1.0 {
+            samples as usize
+        } else {
+            1
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_window_is_a_duration_at_every_rate() {
+        let settings = FitSettings::default();
+        assert_eq!(settings.lowpass_window(1000), 1000);
+        assert_eq!(settings.lowpass_window(200), 200);
+        assert_eq!(settings.lowpass_window(100), 100);
+        assert_eq!(settings.lowpass_window(0), 1);
     }
 }

@@ -367,7 +367,7 @@ class PeerCorrector:
 class FitSettings:
     """drift_fit::FitSettings with its defaults (the fields of `gyrodrift.FitSettings`)."""
 
-    lowpass_window_samples: int = 1000
+    lowpass_window_s: float = 1.0
     grid_ms: int = 10
     initial_bias_window_s: float = 4.0
     switch_on_window_ms: int = 20
@@ -455,7 +455,7 @@ def analyse(activation: Activation, settings: FitSettings) -> Analysed:
     step = max(_round(settings.grid_ms * per_ms), 1)
     grid = np.arange(0, n, step)
     head = np.arange(initial)
-    window = settings.lowpass_window_samples
+    window = max(_round(settings.lowpass_window_s * rate_hz), 1)
     zero = np.zeros((1, 3))
     # Running sums of every channel at once (in order, f64, as the Rust running sum).
     temperature_sum = np.concatenate((zero, np.cumsum(activation.temperature_raw, axis=0, dtype=np.float64)))

@@ -35,7 +35,7 @@ impl PyFitSettings {
     #[new]
     #[pyo3(signature = (
         *,
-        lowpass_window_samples = None,
+        lowpass_window_s = None,
         grid_ms = None,
         initial_bias_window_s = None,
         switch_on_window_ms = None,
@@ -47,7 +47,7 @@ impl PyFitSettings {
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        lowpass_window_samples: Option<&Bound<'_, PyAny>>,
+        lowpass_window_s: Option<&Bound<'_, PyAny>>,
         grid_ms: Option<&Bound<'_, PyAny>>,
         initial_bias_window_s: Option<&Bound<'_, PyAny>>,
         switch_on_window_ms: Option<&Bound<'_, PyAny>>,
@@ -58,12 +58,10 @@ impl PyFitSettings {
         polynomial_degree: Option<&Bound<'_, PyAny>>,
     ) -> Result<Self, Error> {
         let mut settings = FitSettings::default();
-        if let Some(v) = args::optional::<usize>(
-            "lowpass_window_samples",
-            "an integer ≥ 1",
-            lowpass_window_samples,
-        )? {
-            settings.lowpass_window_samples = v;
+        if let Some(v) =
+            args::optional::<f64>("lowpass_window_s", "a float > 0 (s)", lowpass_window_s)?
+        {
+            settings.lowpass_window_s = v;
         }
         if let Some(v) = args::optional::<u32>("grid_ms", "an integer ≥ 1 (ms)", grid_ms)? {
             settings.grid_ms = v;
@@ -129,10 +127,11 @@ impl PyFitSettings {
             .map_err(|e| Error::Input(format!("internal: fit settings JSON: {e}")))
     }
 
-    /// Low-pass window: centred moving average of this many samples (default 1000: 1 s at 1 kHz).
+    /// Low-pass window: centred moving average over this many seconds of each recording's own
+    /// samples (default 1.0).
     #[getter]
-    fn lowpass_window_samples(&self) -> usize {
-        self.0.lowpass_window_samples
+    fn lowpass_window_s(&self) -> f64 {
+        self.0.lowpass_window_s
     }
 
     /// Analysis grid: curves kept every this many ms (default 10).
@@ -185,6 +184,6 @@ impl PyFitSettings {
 
     fn __repr__(&self) -> String {
         let s = &self.0;
-        format!("FitSettings(lowpass_window_samples={:?}, grid_ms={:?}, initial_bias_window_s={:?}, switch_on_window_ms={:?}, first_reference_s={:?}, reference_count={:?}, reference_window_points={:?}, independent_after_min={:?}, polynomial_degree={:?})", s.lowpass_window_samples, s.grid_ms, s.initial_bias_window_s, s.switch_on_window_ms, s.first_reference_s, s.reference_count, s.reference_window_points, s.independent_after_min, s.polynomial_degree)
+        format!("FitSettings(lowpass_window_s={:?}, grid_ms={:?}, initial_bias_window_s={:?}, switch_on_window_ms={:?}, first_reference_s={:?}, reference_count={:?}, reference_window_points={:?}, independent_after_min={:?}, polynomial_degree={:?})", s.lowpass_window_s, s.grid_ms, s.initial_bias_window_s, s.switch_on_window_ms, s.first_reference_s, s.reference_count, s.reference_window_points, s.independent_after_min, s.polynomial_degree)
     }
 }

@@ -197,9 +197,12 @@ fn aux_channels(
 #[pymethods]
 impl PySegment {
     /// One activation built from arrays: `rate_dps` float32/float64 (n, 3) in °/s and
-    /// `temperature_raw` int16 (n, 3), consecutive samples from switch-on at `sample_rate_hz`.
+    /// `temperature_raw` int16 (n, 3), consecutive samples from switch-on at `sample_rate_hz`,
+    /// at `temperature_raw_per_celsius` (default 200) with `temperature_raw_at_zero_celsius`
+    /// (default 0) read at 0 °C.
     #[new]
-    #[pyo3(signature = (labels, rate_dps, temperature_raw, *, sample_rate_hz = None, power_on_ns = None, aux = None))]
+    #[pyo3(signature = (labels, rate_dps, temperature_raw, *, sample_rate_hz = None, power_on_ns = None, aux = None, temperature_raw_per_celsius = None, temperature_raw_at_zero_celsius = None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         labels: &Bound<'_, PyAny>,
@@ -208,7 +211,36 @@ impl PySegment {
         sample_rate_hz: Option<&Bound<'_, PyAny>>,
         power_on_ns: Option<&Bound<'_, PyAny>>,
         aux: Option<&Bound<'_, PyAny>>,
+        temperature_raw_per_celsius: Option<&Bound<'_, PyAny>>,
+        temperature_raw_at_zero_celsius: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let mut temperature_scale = drift_recording::TemperatureScale::default();
+        if let Some(v) = args::optional::<f64>(
+            "temperature_raw_per_celsius",
+            "a float > 0 (raw units per °C)",
+            temperature_raw_per_celsius,
+        )? {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Input(format!(
+                    "`temperature_raw_per_celsius` must be a finite number > 0 (raw units per °C), got {v}"
+                ))
+                .into());
+            }
+            temperature_scale.raw_per_celsius = v;
+        }
+        if let Some(v) = args::optional::<f64>(
+            "temperature_raw_at_zero_celsius",
+            "a float (raw units)",
+            temperature_raw_at_zero_celsius,
+        )? {
+            if !v.is_finite() {
+                return Err(Error::Input(format!(
+                    "`temperature_raw_at_zero_celsius` must be a finite number (raw units), got {v}"
+                ))
+                .into());
+            }
+            temperature_scale.raw_at_zero_celsius = v;
+        }
         let labels = labels.cast::<PyLabels>().map_err(|_| {
             Error::Input(format!(
                 "`labels` must be a gyrodrift.Labels, got {}",
@@ -252,9 +284,22 @@ impl PySegment {
             since_power_on: (0..n_u32).collect(),
             rate_dps: [0, 1, 2].map(|axis| rates.column(axis)),
             temperature_raw: [0, 1, 2].map(|axis| raw.column(axis).to_vec()),
+            temperature_scale,
             aux: aux_channels(py, aux)?,
         };
         Ok(Self::wrap(segment))
+    }
+
+    /// Raw temperature units per °C of `temperature_raw` (the recording's sensor scale).
+    #[getter]
+    fn temperature_raw_per_celsius(&self) -> f64 {
+        self.segment.temperature_scale.raw_per_celsius
+    }
+
+    /// The raw temperature reading at 0 °C.
+    #[getter]
+    fn temperature_raw_at_zero_celsius(&self) -> f64 {
+        self.segment.temperature_scale.raw_at_zero_celsius
     }
 
     /// The activation's labels.

@@ -38,7 +38,7 @@ def test_settings_are_the_command_lines(campaign_dir: Path) -> None:
     defaults = gyrodrift.FitSettings()
     assert defaults == gyrodrift.FitSettings.from_json("{}")
     assert json.loads(defaults.to_json()) == {
-        "lowpass_window_samples": 1000,
+        "lowpass_window_s": 1.0,
         "grid_ms": 10,
         "initial_bias_window_s": 4.0,
         "switch_on_window_ms": 20,

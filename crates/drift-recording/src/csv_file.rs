@@ -913,6 +913,7 @@ fn to_segment(
         since_power_on: (0..n as u32).collect(),
         rate_dps: rate,
         temperature_raw: raw,
+        temperature_scale: crate::TemperatureScale::default(),
         aux: Default::default(),
     })
 }

@@ -45,8 +45,8 @@ pub use read::{
     OpenRecording, Recording, REQUIRED_TOPICS,
 };
 pub use segment::{
-    temperature_reading, AuxChannel, Segment, SegmentLabels, SeriesKind, RAW_PER_CELSIUS,
-    TEMPERATURE_MISSING_RAW,
+    temperature_reading, AuxChannel, Segment, SegmentLabels, SeriesKind, TemperatureScale,
+    RAW_PER_CELSIUS, SCALE_KEY, TEMPERATURE_MISSING_RAW, ZERO_KEY,
 };
 pub use sheet::{
     read_sheet, read_sheet_campaign, read_sheet_campaign_with, recording_stem, LogReader,

@@ -17,7 +17,7 @@ use crate::error::ReadError;
 use crate::layout::{aux_samples_covered, AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use crate::messages::ChannelInfo;
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
-use crate::segment::{AuxChannel, Segment, SegmentLabels, SeriesKind};
+use crate::segment::{AuxChannel, Segment, SegmentLabels, SeriesKind, TemperatureScale};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
@@ -114,6 +114,8 @@ struct Opened {
     sample_rate_hz: u32,
     /// The metadata's `set_point_celsius`, when it has one.
     session_set_point_celsius: Option<f64>,
+    /// The metadata's temperature scale.
+    temperature_scale: TemperatureScale,
 }
 
 fn open(path: &Path) -> Result<Opened, ReadError> {
@@ -246,12 +248,14 @@ fn open_bytes(path: &Path, buf: Vec<u8>) -> Result<Opened, ReadError> {
             ))),
         })
         .transpose()?;
+    let temperature_scale = TemperatureScale::from_metadata(&metadata).map_err(meta_err)?;
     Ok(Opened {
         buf,
         metadata,
         unit_id,
         sample_rate_hz,
         session_set_point_celsius,
+        temperature_scale,
     })
 }
 
@@ -361,6 +365,7 @@ fn decode(
         unit_id,
         sample_rate_hz,
         session_set_point_celsius,
+        temperature_scale,
         ..
     } = opened;
     let mcap_err = |e| ReadError::Mcap {
@@ -372,6 +377,7 @@ fn decode(
         unit_id: &unit_id,
         rate_hz: sample_rate_hz,
         session_set_point_celsius,
+        temperature_scale,
         open: None,
         each,
         stopped: false,
@@ -413,6 +419,8 @@ struct Reader<'p> {
     rate_hz: u32,
     /// The recording's nominal set point, copied into every activation's labels.
     session_set_point_celsius: Option<f64>,
+    /// The recording's temperature scale, carried by every activation.
+    temperature_scale: TemperatureScale,
     open: Option<Open>,
     /// Takes each finished activation; `false`: no more wanted.
     each: &'p mut dyn FnMut(Segment) -> bool,
@@ -600,6 +608,7 @@ impl Reader<'_> {
             since_power_on: (0..n as u32).collect(),
             rate_dps: open.rate,
             temperature_raw: open.raw,
+            temperature_scale: self.temperature_scale,
             aux,
         };
         self.stopped = !(self.each)(segment);

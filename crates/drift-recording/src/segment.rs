@@ -4,8 +4,86 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-/// Temperature-sensor scale: raw units per °C (the paper's sensor: 1 °C = 200 units).
+/// The scale every writer of this crate (and the simulator) stores raw temperatures at: raw units
+/// per °C (the paper's sensor: 1 °C = 200 units). Readers do not assume it: a recording says its
+/// own scale ([`TemperatureScale`]), which travels with each [`Segment`].
 pub const RAW_PER_CELSIUS: f64 = 200.0;
+
+/// The recording metadata key of the temperature scale (raw units per °C).
+pub const SCALE_KEY: &str = "temperature_raw_per_celsius";
+
+/// The recording metadata key of the raw reading at 0 °C (optional: 0 when absent).
+pub const ZERO_KEY: &str = "temperature_raw_at_zero_celsius";
+
+/// How a sensor's raw temperature reading maps to °C: `°C = (raw − raw_at_zero_celsius) /
+/// raw_per_celsius`. Read from the recording (`temperature_raw_per_celsius`,
+/// `temperature_raw_at_zero_celsius`), carried by each activation, stamped into fitted tables.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TemperatureScale {
+    /// Raw units per °C (positive, finite).
+    pub raw_per_celsius: f64,
+    /// Raw reading at 0 °C (finite).
+    pub raw_at_zero_celsius: f64,
+}
+
+impl Default for TemperatureScale {
+    fn default() -> Self {
+        Self {
+            raw_per_celsius: RAW_PER_CELSIUS,
+            raw_at_zero_celsius: 0.0,
+        }
+    }
+}
+
+impl TemperatureScale {
+    /// A raw reading in °C.
+    pub fn celsius(&self, raw: f64) -> f64 {
+        (raw - self.raw_at_zero_celsius) / self.raw_per_celsius
+    }
+
+    /// A temperature difference of `raw` units in °C (the offset cancels).
+    pub fn celsius_difference(&self, raw: f64) -> f64 {
+        raw / self.raw_per_celsius
+    }
+
+    /// °C as a raw reading (not rounded).
+    pub fn raw(&self, celsius: f64) -> f64 {
+        celsius * self.raw_per_celsius + self.raw_at_zero_celsius
+    }
+
+    /// The scale a recording's metadata gives: [`SCALE_KEY`] (the default scale when absent, as
+    /// in recordings written before the key existed) and [`ZERO_KEY`] (0 when absent). A value
+    /// that is there must be a finite number (a positive one for the scale): the message names
+    /// the key and the value.
+    pub fn from_metadata(metadata: &BTreeMap<String, String>) -> Result<Self, String> {
+        let number = |key: &str, default: f64| match metadata.get(key) {
+            None => Ok(default),
+            Some(text) => match text.trim().parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(format!("{key} must be a finite number, got `{text}`")),
+            },
+        };
+        let scale = Self {
+            raw_per_celsius: number(SCALE_KEY, RAW_PER_CELSIUS)?,
+            raw_at_zero_celsius: number(ZERO_KEY, 0.0)?,
+        };
+        if scale.raw_per_celsius <= 0.0 {
+            return Err(format!(
+                "{SCALE_KEY} must be greater than zero (raw units per °C), got {}",
+                scale.raw_per_celsius
+            ));
+        }
+        Ok(scale)
+    }
+
+    /// The metadata entries that give this scale back through [`Self::from_metadata`].
+    pub fn metadata(&self) -> [(&'static str, String); 2] {
+        [
+            (SCALE_KEY, format!("{}", self.raw_per_celsius)),
+            (ZERO_KEY, format!("{}", self.raw_at_zero_celsius)),
+        ]
+    }
+}
 
 /// The raw temperature value that marks a missing reading (a temperature-sensor dropout) in
 /// `/gyro/temperature_raw` and in [`Segment::temperature_raw`]. A raw temperature is an `int16`,
@@ -116,8 +194,10 @@ pub struct Segment {
     pub since_power_on: Vec<u32>,
     /// Per sample: angular rate X, Y, Z (°/s).
     pub rate_dps: [Vec<f32>; 3],
-    /// Per sample: raw temperature X, Y, Z (200 raw units per °C).
+    /// Per sample: raw temperature X, Y, Z, at [`Self::temperature_scale`].
     pub temperature_raw: [Vec<i16>; 3],
+    /// How `temperature_raw` maps to °C (the recording's own sensor scale).
+    pub temperature_scale: TemperatureScale,
     /// Auxiliary channels by name: the format's own `accel_x`, `accel_y`, `accel_z` (g),
     /// `supply_voltage` (V), `chamber_set_point` (°C), and any named ones (`/aux/<name>` in a
     /// recording; [`crate::check_named_aux_channel`]).
@@ -145,7 +225,10 @@ impl Segment {
     /// reading, [`TEMPERATURE_MISSING_RAW`]).
     pub fn temperature_celsius(&self, axis: usize, i: usize) -> Option<f64> {
         let raw = *self.temperature_raw.get(axis)?.get(i)?;
-        Some(f64::from(temperature_reading(raw)) / RAW_PER_CELSIUS)
+        Some(
+            self.temperature_scale
+                .celsius(f64::from(temperature_reading(raw))),
+        )
     }
 
     /// The first missing temperature reading ([`TEMPERATURE_MISSING_RAW`]) as `(axis, sample)`.

@@ -24,6 +24,15 @@ pub(crate) fn check_writable(recording: &Recording) -> Result<Vec<NamedTopic>, S
     let mut named: BTreeMap<&str, (&str, usize)> = BTreeMap::new();
     for (k, segment) in recording.segments.iter().enumerate() {
         let at = || where_in(k, segment);
+        let scale = recording.segments[0].temperature_scale;
+        if segment.temperature_scale != scale {
+            return Err(format!(
+                "{}: temperature scale {:?}, but segment 0 has {scale:?} (a recording has one \
+                 temperature sensor scale)",
+                at(),
+                segment.temperature_scale
+            ));
+        }
         for (name, channel) in &segment.aux {
             match fixed_aux_unit(name) {
                 Some(unit) if channel.unit != unit => {

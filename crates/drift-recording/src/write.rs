@@ -5,7 +5,7 @@ use crate::error::WriteError;
 use crate::layout::{aux_every, AUX_RATE_HZ};
 use crate::read::Recording;
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
-use crate::segment::Segment;
+use crate::segment::{Segment, TemperatureScale};
 use crate::writable::check_writable;
 use crate::writer::McapFile;
 use std::collections::BTreeMap;
@@ -19,6 +19,12 @@ pub fn create_recording(
     path: &Path,
     metadata: BTreeMap<String, String>,
 ) -> Result<McapFile, WriteError> {
+    let scale =
+        TemperatureScale::from_metadata(&metadata).map_err(|reason| WriteError::Invalid {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+    let raw_per_celsius = format!("{}", scale.raw_per_celsius);
     let mut f = McapFile::create(path, schema::PROFILE_RECORDING, mcap::Compression::Zstd)?;
     f.add_topic(
         schema::TOPIC_RATE,
@@ -28,7 +34,10 @@ pub fn create_recording(
     f.add_topic(
         schema::TOPIC_TEMPERATURE_RAW,
         schema::SCHEMA_RAW_TEMPERATURE,
-        &[("unit", "raw"), ("raw_per_celsius", "200")],
+        &[
+            ("unit", "raw"),
+            ("raw_per_celsius", raw_per_celsius.as_str()),
+        ],
     )?;
     f.add_topic(
         schema::TOPIC_ACCEL,
@@ -84,7 +93,16 @@ pub fn write_recording(recording: &Recording, path: &Path) -> Result<u64, WriteE
         path: path.to_path_buf(),
         reason,
     })?;
-    let mut f = create_recording(path, recording.metadata.clone())?;
+    // The activations' own scale is what their raw temperatures are at: the file says it.
+    let mut metadata = recording.metadata.clone();
+    if let Some(first) = recording.segments.first() {
+        if TemperatureScale::from_metadata(&metadata) != Ok(first.temperature_scale) {
+            for (key, value) in first.temperature_scale.metadata() {
+                metadata.insert(key.to_owned(), value);
+            }
+        }
+    }
+    let mut f = create_recording(path, metadata)?;
     for channel in &named {
         f.add_topic(
             &channel.topic,

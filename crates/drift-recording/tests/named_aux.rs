@@ -64,6 +64,7 @@ fn segment(
         temperature_raw: std::array::from_fn(|a| {
             (0..n).map(|i| 6000 + (i / 7 + a) as i16).collect()
         }),
+        temperature_scale: drift_recording::TemperatureScale::default(),
         aux,
     }
 }

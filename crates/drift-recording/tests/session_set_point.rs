@@ -30,6 +30,7 @@ fn activation(activation: u32, at_switch_on: f64) -> Segment {
         since_power_on: (0..n as u32).collect(),
         rate_dps: std::array::from_fn(|a| vec![1e-3 * a as f32; n]),
         temperature_raw: std::array::from_fn(|_| vec![7000; n]),
+        temperature_scale: drift_recording::TemperatureScale::default(),
         aux: BTreeMap::new(),
     }
 }

@@ -239,6 +239,23 @@ impl Campaign {
                 ));
             }
         }
+        // Files are named by the set point to 0.1 °C: two that round alike would write one file.
+        for (j, b) in self.set_points_celsius.iter().enumerate() {
+            let name = format!("{b:+.1}");
+            if let Some(i) = self.set_points_celsius[..j]
+                .iter()
+                .position(|a| format!("{a:+.1}") == name)
+            {
+                return Err(bad(
+                    &format!("set_points_celsius[{j}]"),
+                    &format!(
+                        "{b} °C names the same recording files ({name} °C) as set_points_celsius[{i}] \
+                         = {} °C; give each set point once (--set-points), at least 0.1 °C apart",
+                        self.set_points_celsius[i]
+                    ),
+                ));
+            }
+        }
         if !(self.noise_scale.is_finite() && self.noise_scale >= 0.0) {
             return Err(bad(
                 "noise_scale",

@@ -651,13 +651,24 @@ class Segment:
         sample_rate_hz: int | None = None,
         power_on_ns: int | None = None,
         aux: Mapping[str, AuxChannel | tuple[_Floats, str, int]] | None = None,
+        temperature_raw_per_celsius: float | None = None,
+        temperature_raw_at_zero_celsius: float | None = None,
     ) -> Segment:
         """An activation from arrays: `rate_dps` float32/float64 (n, 3) in °/s (finite; float64 is
         rounded to f32), `temperature_raw` int16 (n, 3), consecutive samples from switch-on at
         `sample_rate_hz` (default 1000; a multiple of 100 dividing 10**9); `power_on_ns` the
         switch-on time on the recording clock (default 0); `aux` auxiliary channels by name, any
-        names (`Recording.save` says which a recording stores). Raises `InputError` for a wrong
-        dtype or shape, an empty or non-finite array, or lengths that differ."""
+        names (`Recording.save` says which a recording stores); `temperature_raw` is at
+        `temperature_raw_per_celsius` raw units per °C (default 200) with
+        `temperature_raw_at_zero_celsius` (default 0) read at 0 °C. Raises `InputError` for a wrong
+        dtype or shape, an empty or non-finite array, lengths that differ, or a scale that is not
+        a finite number (> 0)."""
+    @property
+    def temperature_raw_per_celsius(self) -> float:
+        """Raw temperature units per °C of `temperature_raw` (the recording's sensor scale)."""
+    @property
+    def temperature_raw_at_zero_celsius(self) -> float:
+        """The raw temperature reading at 0 °C."""
     @property
     def labels(self) -> Labels:
         """The activation's labels."""
@@ -796,7 +807,7 @@ class FitSettings:
     def __new__(
         cls,
         *,
-        lowpass_window_samples: int | None = None,
+        lowpass_window_s: float | None = None,
         grid_ms: int | None = None,
         initial_bias_window_s: float | None = None,
         switch_on_window_ms: int | None = None,
@@ -812,8 +823,9 @@ class FitSettings:
     def to_json(self) -> str:
         """The JSON form."""
     @property
-    def lowpass_window_samples(self) -> int:
-        """Low-pass: centred moving average of this many samples (default 1000: 1 s at 1 kHz)."""
+    def lowpass_window_s(self) -> float:
+        """Low-pass: centred moving average over this many seconds of each recording's own samples
+        (default 1.0)."""
     @property
     def grid_ms(self) -> int:
         """Analysis grid: curves kept every this many ms (default 10)."""

@@ -10,7 +10,7 @@ use super::definitions::{
 };
 use super::labels::{labels_entries, LABELS_RECORD};
 use crate::error::WriteError;
-use crate::segment::{temperature_reading, Segment, RAW_PER_CELSIUS};
+use crate::segment::{temperature_reading, Segment};
 use crate::writer::McapFile;
 
 /// Topics of an exported bag.
@@ -142,8 +142,11 @@ pub fn write_ros2_bag(
             }
             f.write_encoded(&topics.imu, t)?;
             for (axis, topic) in temperature_topics.iter().enumerate() {
-                let celsius = f64::from(temperature_reading(segment.temperature_raw[axis][i]))
-                    / RAW_PER_CELSIUS;
+                let celsius = segment
+                    .temperature_scale
+                    .celsius(f64::from(temperature_reading(
+                        segment.temperature_raw[axis][i],
+                    )));
                 f.enc
                     .begin()
                     .i32(sec)

@@ -1,0 +1,131 @@
+//! The drift metric and the fit measure durations, not sample counts: one simulated campaign,
+//! block-averaged from 1000 Hz to 200 and 100 Hz, reports every model's drift within 10 % at every
+//! rate (the 1-s low-pass stays 1 s, the fit's windows and reference times stay where they were).
+
+use std::path::Path;
+
+use drift_evaluate::evaluate::ModelKind;
+use drift_evaluate::pipeline::{self, Options};
+use drift_evaluate::summary::summarise;
+use drift_fit::FitSettings;
+use drift_recording::{
+    read_campaign_dir, write_recording, Recording, Segment, RECORDINGS_DIR, TEMPERATURE_MISSING_RAW,
+};
+use drift_sim::{simulate_campaign, Campaign, Protocol};
+
+fn campaign() -> Campaign {
+    Campaign {
+        name: "rates".into(),
+        seed: 21,
+        units: 1,
+        noise_scale: 1.0,
+        protocol: Some(Protocol {
+            intervals_min: vec![1.0, 5.0, 30.0],
+            repeats: 2,
+            activations: 3,
+            activation_s: 60.0,
+            ..Protocol::default()
+        }),
+        ..Campaign::default()
+    }
+}
+
+/// `segment` with every `factor` samples averaged into one (rates as means, raw temperatures as
+/// rounded means): what a sensor's output filter at the lower rate delivers.
+fn block_averaged(segment: &Segment, factor: usize) -> Segment {
+    let blocks = segment.len() / factor;
+    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / v.len() as f64;
+    let rate_dps = segment.rate_dps.clone().map(|axis| {
+        axis.chunks_exact(factor)
+            .map(|block| mean(block) as f32)
+            .collect()
+    });
+    let temperature_raw = segment.temperature_raw.clone().map(|axis| {
+        axis.chunks_exact(factor)
+            .map(|block| {
+                assert!(block.iter().all(|&r| r != TEMPERATURE_MISSING_RAW));
+                let sum: f64 = block.iter().map(|&r| f64::from(r)).sum();
+                (sum / factor as f64).round() as i16
+            })
+            .collect()
+    });
+    Segment {
+        sample_rate_hz: segment.sample_rate_hz / factor as u32,
+        since_power_on: (0..blocks)
+            .map(|k| segment.since_power_on[k * factor] / factor as u32)
+            .collect(),
+        rate_dps,
+        temperature_raw,
+        ..segment.clone()
+    }
+}
+
+/// Writes `recordings` block-averaged by `factor` as a campaign folder under `dir`.
+fn write_at(recordings: &[Recording], factor: usize, dir: &Path) {
+    let folder = dir.join(RECORDINGS_DIR);
+    std::fs::create_dir_all(&folder).unwrap();
+    for recording in recordings {
+        let rate = recording.sample_rate_hz / factor as u32;
+        let mut metadata = recording.metadata.clone();
+        metadata.insert("sample_rate_hz".into(), rate.to_string());
+        let lower = Recording {
+            metadata,
+            sample_rate_hz: rate,
+            segments: recording
+                .segments
+                .iter()
+                .map(|s| block_averaged(s, factor))
+                .collect(),
+            ..recording.clone()
+        };
+        let name = recording.path.file_name().unwrap();
+        write_recording(&lower, &folder.join(name)).unwrap();
+    }
+}
+
+/// Mean drift of every model over every record (set point, split, axis) of the campaign in `dir`.
+fn drifts(dir: &Path) -> Vec<(ModelKind, f64)> {
+    let files = pipeline::recording_files(dir).unwrap();
+    let options = Options {
+        calibration_set_points: vec![30.0, 40.0],
+        validation_set_points: vec![33.0],
+        fit: FitSettings::default(),
+        held_out_repeats: true,
+        evaluate: true,
+    };
+    let outcome = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap();
+    let records = summarise(&outcome.results);
+    ModelKind::ALL
+        .iter()
+        .map(|&model| {
+            let values: Vec<f64> = records
+                .iter()
+                .filter(|r| r.model == model.name())
+                .map(|r| r.drift_dps)
+                .collect();
+            assert!(!values.is_empty(), "{model:?}");
+            (model, values.iter().sum::<f64>() / values.len() as f64)
+        })
+        .collect()
+}
+
+#[test]
+fn every_models_drift_is_the_same_at_1000_200_and_100_hz() {
+    let full = tempfile::tempdir().unwrap();
+    simulate_campaign(&campaign(), full.path(), |_| {}).unwrap();
+    let recordings = read_campaign_dir(full.path()).unwrap();
+    assert!(recordings.iter().all(|r| r.sample_rate_hz == 1000));
+    let at_1000 = drifts(full.path());
+    for factor in [5, 10] {
+        let lower = tempfile::tempdir().unwrap();
+        write_at(&recordings, factor, lower.path());
+        let at_lower = drifts(lower.path());
+        for ((model, fast), (_, slow)) in at_1000.iter().zip(&at_lower) {
+            let rate = 1000 / factor;
+            assert!(
+                (slow - fast).abs() <= 0.1 * fast,
+                "{model:?}: {fast:.5} °/s at 1000 Hz, {slow:.5} °/s at {rate} Hz"
+            );
+        }
+    }
+}
