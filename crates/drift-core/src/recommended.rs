@@ -61,7 +61,11 @@ impl TurnOn {
     /// Checks the polynomial and the slope; `at` names the axis.
     pub fn validate(&self, at: Location) -> Result<(), Error> {
         self.polynomial.validate(at)?;
-        check_finite("dps_per_residual_celsius", at, [self.dps_per_residual_celsius])
+        check_finite(
+            "dps_per_residual_celsius",
+            at,
+            [self.dps_per_residual_celsius],
+        )
     }
 }
 
@@ -294,7 +298,9 @@ mod tests {
         assert!((bias - (0.01 + 0.02 - 0.008)).abs() < 1e-7, "{bias}");
         assert!(!flags.contains(Flags::HISTORY_UNKNOWN), "{flags:?}");
         let mut paper_state = ModifiedAxisState::default();
-        let _ = axis.table.power_on_after(&settings, &warm, &mut paper_state);
+        let _ = axis
+            .table
+            .power_on_after(&settings, &warm, &mut paper_state);
         for (ms, rise) in [(500, 0.4_f32), (1000, 1.5), (4000, 2.5)] {
             let got = axis.drift(&settings, &mut state, ms, 40.0 + rise, rise);
             let want = axis
