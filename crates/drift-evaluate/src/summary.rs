@@ -278,8 +278,14 @@ pub fn absolute_error(
             let modified = rms_of(&members, ModelKind::Modified, axis);
             let by_history = rms_of(&members, ModelKind::ByHistory, axis);
             let recommended = rms_of(&members, ModelKind::Recommended, axis);
+            // Only the baselines evaluated: an absent one is not a zero error.
             let baselines: Vec<BiasRms> = ModelKind::BASELINES
                 .iter()
+                .filter(|&&b| {
+                    members
+                        .iter()
+                        .any(|r| r.models.iter().any(|m| m.model == b))
+                })
                 .map(|&b| rms_of(&members, b, axis))
                 .collect();
             let best = baselines
