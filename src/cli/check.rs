@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use drift_core::blob::Image;
-use drift_core::{Model, ModifiedTables, PolynomialTables, RelativePolynomialTables};
+use drift_core::{
+    Model, ModifiedTables, PolynomialTables, RecommendedTables, RelativePolynomialTables,
+};
 use drift_evaluate::check::{AxisVerdict, CheckedActivation, Limits, UnitCheck};
 use drift_evaluate::pipeline;
 use drift_evaluate::tables_folder::{self, StoredModel, TablesError};
@@ -23,6 +25,10 @@ use drift_report::write_atomic;
 /// Which of a unit's stored models to check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Stored {
+    /// The recommended model (`recommended.bin`): the paper's drift correction with the turn-on
+    /// bias fitted on every calibration activation; each unit's activations run in recording order,
+    /// each starting from what its firmware kept of the one before.
+    Recommended,
     /// The paper's tables (`modified.bin`).
     Modified,
     /// The paper's curves with stage 3 keyed by heating history (`by_history.bin`); each unit's
@@ -45,6 +51,7 @@ impl Stored {
             Self::Standard => StoredModel::Standard,
             Self::ThirdOrder => StoredModel::ThirdOrder,
             Self::Relative => StoredModel::Relative,
+            Self::Recommended => StoredModel::Recommended,
         }
     }
 }
@@ -225,6 +232,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         Stored::Relative => {
             check_all::<RelativePolynomialTables>(args, &files, &settings, &limits, &steps)?
+        }
+        Stored::Recommended => {
+            check_all::<RecommendedTables>(args, &files, &settings, &limits, &steps)?
         }
     };
     steps.finish();

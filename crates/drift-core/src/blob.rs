@@ -23,6 +23,7 @@ use serde::{de::DeserializeOwned, Serialize};
 use crate::error::Error;
 use crate::model::Model;
 use crate::polynomial::{PolynomialTables, RelativePolynomialTables};
+use crate::recommended::RecommendedTables;
 use crate::table::ModifiedTables;
 
 mod in_place;
@@ -49,6 +50,9 @@ pub enum Kind {
     Polynomial = 2,
     /// [`RelativePolynomialTables`]: the polynomial baseline relative to the switch-on.
     RelativePolynomial = 3,
+    /// [`RecommendedTables`]: the paper's drift correction with the turn-on bias fitted across
+    /// every calibration activation.
+    Recommended = 4,
 }
 
 /// A model that can be stored as a firmware image.
@@ -77,6 +81,24 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
             .and_then(|()| place.validate().map_err(BlobError::Invalid));
         if decoded.is_err() {
             in_place::empty(place);
+        }
+        decoded
+    }
+}
+
+impl<const R: usize, const A: usize, const C: usize> Image for RecommendedTables<R, A, C> {
+    const KIND: Kind = Kind::Recommended;
+
+    /// In place, as the paper's tables it holds (the same stack bound). On error `place` is
+    /// emptied (validation rejects it).
+    fn payload_into(payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
+        let decoded = in_place::fill_exact(place, payload)
+            .map_err(BlobError::Malformed)
+            .and_then(|()| place.validate().map_err(BlobError::Invalid));
+        if decoded.is_err() {
+            for axis in &mut place.axes {
+                in_place::empty_axis(&mut axis.table);
+            }
         }
         decoded
     }

@@ -28,6 +28,7 @@ mod interp;
 mod model;
 mod modified;
 mod polynomial;
+mod recommended;
 mod settings;
 mod stage;
 mod stillness;
@@ -50,6 +51,7 @@ pub use polynomial::{
     PolynomialAxis, PolynomialAxisState, PolynomialTables, RelativePolynomialAxis,
     RelativePolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
 };
+pub use recommended::{RecommendedAxis, RecommendedTables, TurnOn};
 pub use settings::Settings;
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};

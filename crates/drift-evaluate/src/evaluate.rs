@@ -25,27 +25,40 @@ pub enum ModelKind {
     /// The least-squares polynomial relative to the switch-on: the turn-on bias registered from
     /// the calibration, the drift after it `p(T) − p(T_on)`.
     Relative,
+    /// The same form with `p` and `q` cubic, no order chosen (PX4's and ArduPilot's order,
+    /// relative to the switch-on).
+    RelativeCubic,
     /// The paper's modified method.
     Modified,
     /// The paper's tables with stage 3 keyed by heating history, fed what firmware would have
     /// kept of the unit's previous activation ([`kept_before`]).
     ByHistory,
+    /// The recommended model: the paper's drift after switch-on with the turn-on bias fitted on
+    /// every calibration activation, fed what firmware would have kept of the previous activation.
+    Recommended,
 }
 
 impl ModelKind {
     /// Every model, in report order.
-    pub const ALL: [ModelKind; 6] = [
+    pub const ALL: [ModelKind; 8] = [
         Self::Uncorrected,
         Self::Standard,
         Self::ThirdOrder,
         Self::Relative,
+        Self::RelativeCubic,
         Self::Modified,
         Self::ByHistory,
+        Self::Recommended,
     ];
 
     /// The standard baselines the paper's model is compared against: the best of them on
     /// held-out data is the headline's reference.
-    pub const BASELINES: [ModelKind; 3] = [Self::Standard, Self::ThirdOrder, Self::Relative];
+    pub const BASELINES: [ModelKind; 4] = [
+        Self::Standard,
+        Self::ThirdOrder,
+        Self::Relative,
+        Self::RelativeCubic,
+    ];
 
     /// Name used in reports.
     pub fn name(self) -> &'static str {
@@ -54,8 +67,10 @@ impl ModelKind {
             Self::Standard => "standard",
             Self::ThirdOrder => "3rd-order",
             Self::Relative => "relative",
+            Self::RelativeCubic => "relative-cubic",
             Self::Modified => "modified",
             Self::ByHistory => "by-history",
+            Self::Recommended => "recommended",
         }
     }
 }
@@ -384,9 +399,15 @@ pub fn evaluate_after(
                 ModelKind::Standard => correct_segment(&fitted.standard, segment, switch_on),
                 ModelKind::ThirdOrder => correct_segment(&fitted.third_order, segment, switch_on),
                 ModelKind::Relative => correct_segment(&fitted.relative, segment, switch_on),
+                ModelKind::RelativeCubic => {
+                    correct_segment(&fitted.relative_cubic, segment, switch_on)
+                }
                 ModelKind::Modified => correct_segment(&fitted.modified, segment, switch_on),
                 ModelKind::ByHistory => {
                     correct_segment_after(&fitted.by_history, segment, switch_on, Some(previous))
+                }
+                ModelKind::Recommended => {
+                    correct_segment_after(&fitted.recommended, segment, switch_on, Some(previous))
                 }
             };
             let (drift_dps, residual_rms_dps) = metric(&rates, window);

@@ -171,6 +171,10 @@ pub struct AbsoluteCell {
     pub modified: BiasRms,
     /// The paper's curves keyed by history, started from what firmware kept (`by-history`).
     pub by_history: BiasRms,
+    /// The recommended model, started from what firmware kept (`recommended`).
+    pub recommended: BiasRms,
+    /// The recommended model's mean over the best baseline's (the floor it is held to: ≤ 1).
+    pub recommended_ratio: f64,
     /// Every standard baseline, in report order.
     pub baselines: Vec<BiasRms>,
     /// The baseline with the smallest mean.
@@ -273,8 +277,15 @@ pub fn absolute_error(
         .map(|((unit, set_point, class, axis), members)| {
             let modified = rms_of(&members, ModelKind::Modified, axis);
             let by_history = rms_of(&members, ModelKind::ByHistory, axis);
+            let recommended = rms_of(&members, ModelKind::Recommended, axis);
+            // Only the baselines evaluated: an absent one is not a zero error.
             let baselines: Vec<BiasRms> = ModelKind::BASELINES
                 .iter()
+                .filter(|&&b| {
+                    members
+                        .iter()
+                        .any(|r| r.models.iter().any(|m| m.model == b))
+                })
                 .map(|&b| rms_of(&members, b, axis))
                 .collect();
             let best = baselines
@@ -282,6 +293,7 @@ pub fn absolute_error(
                 .min_by(|a, b| a.mean_dps.total_cmp(&b.mean_dps))
                 .map_or(("–", f64::NAN), |b| (b.model, b.mean_dps));
             let ratio = modified.mean_dps / best.1;
+            let recommended_ratio = recommended.mean_dps / best.1;
             AbsoluteCell {
                 unit,
                 axis: ["X", "Y", "Z"][axis],
@@ -290,6 +302,8 @@ pub fn absolute_error(
                 activations: members.len(),
                 modified,
                 by_history,
+                recommended,
+                recommended_ratio,
                 baselines,
                 best_baseline: best.0,
                 ratio,

@@ -66,11 +66,15 @@ pub enum StoredModel {
     ThirdOrder,
     /// The least-squares polynomial relative to the switch-on.
     Relative,
+    /// The recommended model: the paper's drift correction with the turn-on bias fitted on every
+    /// calibration activation (firmware that keeps what it knew of the previous activation).
+    Recommended,
 }
 
 impl StoredModel {
     /// Every stored model, in the order files are written.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 6] = [
+        Self::Recommended,
         Self::Modified,
         Self::ByHistory,
         Self::Standard,
@@ -78,7 +82,8 @@ impl StoredModel {
         Self::Relative,
     ];
 
-    /// The files' stem: `modified`, `by_history`, `standard`, `third_order`, `relative`.
+    /// The files' stem: `recommended`, `modified`, `by_history`, `standard`, `third_order`,
+    /// `relative`.
     pub fn stem(self) -> &'static str {
         match self {
             Self::Modified => "modified",
@@ -86,6 +91,7 @@ impl StoredModel {
             Self::Standard => "standard",
             Self::ThirdOrder => "third_order",
             Self::Relative => "relative",
+            Self::Recommended => "recommended",
         }
     }
 
@@ -144,6 +150,7 @@ pub fn unit_files(
             StoredModel::Standard => model_files(&dir, stem, &unit.standard)?,
             StoredModel::ThirdOrder => model_files(&dir, stem, &unit.third_order)?,
             StoredModel::Relative => model_files(&dir, stem, &unit.relative)?,
+            StoredModel::Recommended => model_files(&dir, stem, &unit.recommended)?,
         };
         files.extend(pair);
     }
@@ -151,7 +158,7 @@ pub fn unit_files(
 }
 
 /// Writes each unit's models as
-/// `<folder>/<unit>/{modified,by_history,standard,third_order,relative}.{json,bin}`.
+/// `<folder>/<unit>/{recommended,modified,by_history,standard,third_order,relative}.{json,bin}`.
 ///
 /// Every file is encoded in memory first, so an encoding error leaves the folder untouched; each
 /// file is then replaced atomically, so none is ever half-written.

@@ -1,8 +1,8 @@
 //! The baselines, fitted on the same calibration activations as the paper's tables: bias as a
 //! polynomial of the sensor temperature, no heating dynamics. Absolute (`bias = p(T)`: the paper's
 //! standard calibration, the PX4/ArduPilot least-squares polynomial) and relative to the switch-on
-//! (`bias = q(T_on) + p(T) − p(T_on)`, orders chosen by cross-validation over the calibration's
-//! series).
+//! (`bias = q(T_on) + p(T) − p(T_on)`, orders up to the cubic chosen by cross-validation over
+//! held-out temperature bands, or cubic as PX4 and ArduPilot fit theirs).
 
 use std::collections::BTreeMap;
 
@@ -17,13 +17,13 @@ use crate::parallel::per_axis;
 
 /// The normalised variable `x = (T − mid) / half_span` over a temperature range.
 #[derive(Debug, Clone, Copy)]
-struct Normalise {
+pub(crate) struct Normalise {
     mid: f64,
     half: f64,
 }
 
 impl Normalise {
-    fn over(range: [f64; 2]) -> Self {
+    pub(crate) fn over(range: [f64; 2]) -> Self {
         let half = 0.5 * (range[1] - range[0]);
         Self {
             mid: range[0] + half,
@@ -32,7 +32,7 @@ impl Normalise {
     }
 
     #[inline]
-    fn apply(self, t: f64) -> f64 {
+    pub(crate) fn apply(self, t: f64) -> f64 {
         (t - self.mid) / self.half
     }
 }
@@ -42,7 +42,7 @@ impl Normalise {
 /// From each activation's smallest and largest rise: adding the switch-on temperature rounds
 /// monotonically, so the extremes of `switch-on + rise` are those of the rise, and a min/max over
 /// the f32 rises runs at memory speed.
-fn range_of(activations: &[&Analysed], axis: usize) -> [f64; 2] {
+pub(crate) fn range_of(activations: &[&Analysed], axis: usize) -> [f64; 2] {
     let (lo, hi) = activations
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
@@ -64,7 +64,7 @@ fn range_of(activations: &[&Analysed], axis: usize) -> [f64; 2] {
     }
 }
 
-fn axis_polynomial(range: [f64; 2], coefficients: &[f64]) -> PolynomialAxis {
+pub(crate) fn axis_polynomial(range: [f64; 2], coefficients: &[f64]) -> PolynomialAxis {
     let mut axis = PolynomialAxis {
         range_celsius: [range[0] as f32, range[1] as f32],
         ..PolynomialAxis::default()
@@ -215,16 +215,22 @@ pub fn least_squares_polynomial(
     PolynomialTables { settings, axes }
 }
 
-/// Highest order the relative baseline's cross-validation tries for the drift polynomial `p`.
-pub const MAX_RELATIVE_DRIFT_DEGREE: usize = 5;
+/// Highest order the relative baseline tries for the drift polynomial `p`: the cubic PX4 and
+/// ArduPilot use. Higher orders follow the calibrated ambients' bands and swing between them, where
+/// a unit is used and no calibration point pins them.
+pub const MAX_RELATIVE_DRIFT_DEGREE: usize = 3;
 /// Highest order it tries for the turn-on polynomial `q`.
 pub const MAX_TURN_ON_DEGREE: usize = 3;
+/// Width of the temperature bands the relative baseline's cross-validation leaves out in turn, °C:
+/// an order is judged on temperatures it was not fitted at, as a unit between its calibration set
+/// points is.
+pub const HELD_OUT_BAND_CELSIUS: f64 = 2.5;
 
 /// Sums of a least-squares problem `y ≈ Σ_j c_j φ_j` over a group of points: `Σ φφᵀ`, `Σ φ y` and
 /// `Σ y²`, enough for the fit on any union of groups and the squared error on any group, for
 /// every leading subset of the basis (every lower order).
 #[derive(Clone, Copy)]
-struct Gram {
+pub(crate) struct Gram {
     phi_phi: [[f64; MAX_POLYNOMIAL_COEFFICIENTS]; MAX_POLYNOMIAL_COEFFICIENTS],
     phi_y: [f64; MAX_POLYNOMIAL_COEFFICIENTS],
     y_y: f64,
@@ -241,7 +247,7 @@ impl Default for Gram {
 }
 
 impl Gram {
-    fn add(&mut self, phi: &[f64], y: f64) {
+    pub(crate) fn add(&mut self, phi: &[f64], y: f64) {
         for (r, &a) in phi.iter().enumerate() {
             for (c, &b) in phi.iter().enumerate().skip(r) {
                 self.phi_phi[r][c] += a * b;
@@ -288,7 +294,7 @@ impl Gram {
 /// The order (number of leading basis functions, from `min_columns` to `max_columns`) whose fit
 /// on all groups but one predicts the left-out one best, summed over every group left out in
 /// turn; and its coefficients fitted on every group. One group only: the lowest order.
-fn cross_validated(
+pub(crate) fn cross_validated(
     groups: &[Gram],
     min_columns: usize,
     max_columns: usize,
@@ -318,41 +324,65 @@ fn cross_validated(
     total.solve(columns).map(|c| (columns, c))
 }
 
-/// The calibration series an activation belongs to: the group cross-validation leaves out whole,
-/// so an order is judged on series it did not see (activations within a series share their
-/// heating history and are not independent).
-fn series_key(a: &Analysed) -> (i64, u32, u32) {
-    (
-        (a.labels.set_point_celsius * 1000.0).round() as i64,
-        a.labels.series,
-        a.labels.repeat,
-    )
+/// The temperature band (°C, [`HELD_OUT_BAND_CELSIUS`] wide) the cross-validation leaves out
+/// whole: a fit without it has no point there and must interpolate (or extrapolate, for the end
+/// bands) across it, as it must between calibration set points in use.
+pub(crate) fn band_key(celsius: f64) -> i64 {
+    (celsius / HELD_OUT_BAND_CELSIUS).floor() as i64
 }
 
 /// The orders the relative baseline chose, per axis: `p`'s and `q`'s degree.
 pub type RelativeOrders = [(usize, usize); 3];
 
+/// How the relative baseline's orders are found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Orders {
+    /// Cross-validated over held-out temperature bands, up to the caps.
+    HeldOutBands,
+    /// Cubic `p` and `q`, as PX4 and ArduPilot fit theirs.
+    Cubic,
+}
+
 /// The baseline relative to the switch-on: per axis, `p` by least squares on every calibration
 /// grid point's drift since switch-on (`g = p(T) − p(T_on)`, the basis `x^k − x_on^k`, k ≥ 1),
 /// and `q` by least squares on each activation's initial bias against its switch-on temperature;
-/// each order chosen by leave-one-series-out cross-validation on the calibration activations
-/// (`p` up to [`MAX_RELATIVE_DRIFT_DEGREE`], `q` up to [`MAX_TURN_ON_DEGREE`]).
+/// each order chosen by cross-validation that leaves out one temperature band at a time
+/// ([`HELD_OUT_BAND_CELSIUS`]; `p` by the grid point's temperature, `q` by the switch-on
+/// temperature), up to the cubic ([`MAX_RELATIVE_DRIFT_DEGREE`], [`MAX_TURN_ON_DEGREE`]).
+///
+/// Why bands, not series: a series covers the temperatures every other series of its set point
+/// covers, so leaving one out never asks an order to predict a temperature it was not fitted at;
+/// a band does, which is what a unit used between its calibration set points asks.
 pub fn relative_polynomial(
     activations: &[&Analysed],
     settings: Settings,
 ) -> (RelativePolynomialTables, RelativeOrders) {
+    relative_with(activations, settings, Orders::HeldOutBands)
+}
+
+/// The cubic relative to the switch-on: [`relative_polynomial`]'s form with `p` and `q` cubic, no
+/// order chosen (the cubic PX4 and ArduPilot fit, taken relative to the switch-on).
+pub fn relative_cubic(activations: &[&Analysed], settings: Settings) -> RelativePolynomialTables {
+    relative_with(activations, settings, Orders::Cubic).0
+}
+
+fn relative_with(
+    activations: &[&Analysed],
+    settings: Settings,
+    orders: Orders,
+) -> (RelativePolynomialTables, RelativeOrders) {
     let fitted = per_axis(|axis| {
         let range = range_of(activations, axis);
         let normalise = Normalise::over(range);
-        let mut drift_groups: BTreeMap<(i64, u32, u32), Gram> = BTreeMap::new();
-        let mut turn_on_groups: BTreeMap<(i64, u32, u32), Gram> = BTreeMap::new();
+        let mut drift_groups: BTreeMap<i64, Gram> = BTreeMap::new();
+        let mut turn_on_groups: BTreeMap<i64, Gram> = BTreeMap::new();
         let mut phi = [0.0; MAX_RELATIVE_DRIFT_DEGREE + 1];
         for a in activations {
             let on = a.switch_on_celsius[axis];
             let x_on = normalise.apply(on);
-            let drift = drift_groups.entry(series_key(a)).or_default();
             for (&rise, &g) in a.rise_celsius[axis].iter().zip(&a.drift_dps[axis]) {
-                let (x, g) = (normalise.apply(on + f64::from(rise)), f64::from(g));
+                let celsius = on + f64::from(rise);
+                let (x, g) = (normalise.apply(celsius), f64::from(g));
                 if !(x.is_finite() && g.is_finite()) {
                     continue;
                 }
@@ -362,7 +392,10 @@ pub fn relative_polynomial(
                     power_on *= x_on;
                     *value = power - power_on;
                 }
-                drift.add(&phi[..MAX_RELATIVE_DRIFT_DEGREE], g);
+                drift_groups
+                    .entry(band_key(celsius))
+                    .or_default()
+                    .add(&phi[..MAX_RELATIVE_DRIFT_DEGREE], g);
             }
             let bias = a.initial_bias_dps[axis];
             if x_on.is_finite() && bias.is_finite() {
@@ -372,17 +405,23 @@ pub fn relative_polynomial(
                     power *= x_on;
                 }
                 turn_on_groups
-                    .entry(series_key(a))
+                    .entry(band_key(on))
                     .or_default()
                     .add(&phi[..=MAX_TURN_ON_DEGREE], bias);
             }
         }
         let drift_groups: Vec<Gram> = drift_groups.into_values().collect();
         let turn_on_groups: Vec<Gram> = turn_on_groups.into_values().collect();
+        let (drift_min, turn_on_min) = match orders {
+            Orders::HeldOutBands => (1, 1),
+            Orders::Cubic => (MAX_RELATIVE_DRIFT_DEGREE, MAX_TURN_ON_DEGREE + 1),
+        };
         let (drift_columns, drift) =
-            cross_validated(&drift_groups, 1, MAX_RELATIVE_DRIFT_DEGREE).unwrap_or((1, vec![0.0]));
+            cross_validated(&drift_groups, drift_min, MAX_RELATIVE_DRIFT_DEGREE)
+                .unwrap_or((1, vec![0.0]));
         let (turn_on_columns, turn_on) =
-            cross_validated(&turn_on_groups, 1, MAX_TURN_ON_DEGREE + 1).unwrap_or((1, vec![0.0]));
+            cross_validated(&turn_on_groups, turn_on_min, MAX_TURN_ON_DEGREE + 1)
+                .unwrap_or((1, vec![0.0]));
         // p's constant term cancels in p(T) − p(T_on): stored as 0.
         let mut p = vec![0.0];
         p.extend(drift);

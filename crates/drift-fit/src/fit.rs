@@ -4,12 +4,12 @@ use std::collections::BTreeSet;
 
 use drift_core::{
     AmbientCurves, AxisTable, Curve, CurvePoint, Model, ModifiedTables, PolynomialTables,
-    RelativePolynomialTables, Settings, WarmStart,
+    RecommendedTables, RelativePolynomialTables, Settings, WarmStart,
 };
 use nalgebra::{Matrix2, Vector2};
 
 use crate::analyse::Analysed;
-use crate::baselines;
+use crate::baselines::{self, HELD_OUT_BAND_CELSIUS};
 use crate::curves::{group, AveragedCurve, CurveKey, SetPointCurves};
 use crate::error::FitError;
 use crate::history_order::{crossings, Crossing};
@@ -38,13 +38,20 @@ pub struct FittedUnit {
     /// (`drift_core::AmbientCurves::warm_starts`): for firmware that keeps what it knew of the
     /// previous activation across power-off (`drift_core::CorrectorState::power_on_after`).
     pub by_history: ModifiedTables,
+    /// The recommended model: the paper's curves (as `modified`) with the turn-on bias fitted on
+    /// every calibration activation ([`crate::turn_on`]).
+    pub recommended: RecommendedTables,
     /// The paper's standard calibration (Lagrange through the set points).
     pub standard: PolynomialTables,
     /// The least-squares polynomial baseline (3rd order by default).
     pub third_order: PolynomialTables,
     /// The least-squares polynomial baseline relative to the switch-on (turn-on bias `q(T_on)`,
-    /// drift `p(T) − p(T_on)`), orders chosen by cross-validation over the calibration's series.
+    /// drift `p(T) − p(T_on)`), orders up to the cubic chosen by cross-validation over held-out
+    /// temperature bands.
     pub relative: RelativePolynomialTables,
+    /// The same form with `p` and `q` cubic (PX4's and ArduPilot's order, relative to the
+    /// switch-on).
+    pub relative_cubic: RelativePolynomialTables,
     /// The averaged curves the tables were built from (for plots and diagnosis).
     pub set_points: Vec<SetPointCurves>,
     /// The curve keys kept, in table order before the per-reference-time sort.
@@ -492,35 +499,41 @@ pub fn fit_unit_at(
         ..Settings::default()
     };
     // The axes' tables and the baselines are independent: all on rayon's threads at once.
-    let (tables, ((standard, third_order), (relative, relative_orders))) = rayon::join(
-        || {
-            per_axis(|axis| {
-                let given = references.map(|r| r[axis].as_slice());
-                let by_rise =
-                    axis_table(&set_points, axis, first, settings, Stage3::ByRise, given)?;
-                let by_history =
-                    axis_table(&set_points, axis, first, settings, Stage3::ByHistory, given)?;
-                Ok::<_, String>((by_rise, by_history))
-            })
-        },
-        || {
-            rayon::join(
-                || {
-                    rayon::join(
-                        || baselines::standard(&by_set_point, core_settings),
-                        || {
-                            baselines::least_squares_polynomial(
-                                &protocol,
-                                settings.polynomial_degree,
-                                core_settings,
-                            )
-                        },
-                    )
-                },
-                || baselines::relative_polynomial(&protocol, core_settings),
-            )
-        },
-    );
+    let (tables, ((standard, third_order), ((relative, relative_orders), relative_cubic))) =
+        rayon::join(
+            || {
+                per_axis(|axis| {
+                    let given = references.map(|r| r[axis].as_slice());
+                    let by_rise =
+                        axis_table(&set_points, axis, first, settings, Stage3::ByRise, given)?;
+                    let by_history =
+                        axis_table(&set_points, axis, first, settings, Stage3::ByHistory, given)?;
+                    Ok::<_, String>((by_rise, by_history))
+                })
+            },
+            || {
+                rayon::join(
+                    || {
+                        rayon::join(
+                            || baselines::standard(&by_set_point, core_settings),
+                            || {
+                                baselines::least_squares_polynomial(
+                                    &protocol,
+                                    settings.polynomial_degree,
+                                    core_settings,
+                                )
+                            },
+                        )
+                    },
+                    || {
+                        rayon::join(
+                            || baselines::relative_polynomial(&protocol, core_settings),
+                            || baselines::relative_cubic(&protocol, core_settings),
+                        )
+                    },
+                )
+            },
+        );
     let mut axes: [Table; 3] = Default::default();
     let mut history_axes: [Table; 3] = Default::default();
     for ((table, history_table), fitted) in axes.iter_mut().zip(&mut history_axes).zip(tables) {
@@ -548,6 +561,12 @@ pub fn fit_unit_at(
         })?;
     }
 
+    let recommended = RecommendedTables::try_new(&modified, crate::turn_on::turn_on(&protocol))
+        .map_err(|source| FitError::Table {
+            unit: unit_id.clone(),
+            model: "recommended",
+            source,
+        })?;
     for (model, tables) in [("standard", &standard), ("third_order", &third_order)] {
         tables.validate().map_err(|source| FitError::Table {
             unit: unit_id.clone(),
@@ -555,13 +574,15 @@ pub fn fit_unit_at(
             source,
         })?;
     }
-    relative.validate().map_err(|source| FitError::Table {
-        unit: unit_id.clone(),
-        model: "relative",
-        source,
-    })?;
+    for (model, tables) in [("relative", &relative), ("relative_cubic", &relative_cubic)] {
+        tables.validate().map_err(|source| FitError::Table {
+            unit: unit_id.clone(),
+            model,
+            source,
+        })?;
+    }
     notes.push(format!(
-        "relative baseline: orders by leave-one-series-out cross-validation on the calibration, drift p(T) of degree {} and turn-on bias q(T_on) of degree {} (X, Y, Z)",
+        "relative baseline: orders by cross-validation over held-out {HELD_OUT_BAND_CELSIUS} °C temperature bands of the calibration, up to the cubic: drift p(T) of degree {} and turn-on bias q(T_on) of degree {} (X, Y, Z)",
         relative_orders
             .iter()
             .map(|o| o.0.to_string())
@@ -577,9 +598,11 @@ pub fn fit_unit_at(
         unit_id,
         modified,
         by_history,
+        recommended,
         standard,
         third_order,
         relative,
+        relative_cubic,
         curve_keys: common.into_iter().collect(),
         set_points,
         notes,

@@ -5,6 +5,7 @@
 //! - [`fit`] groups activations into the paper's curves ([`curves`]), picks reference times
 //!   ([`knots`]) and builds the paper's tables ([`drift_core::ModifiedTables`]), the same curves
 //!   keyed by heating history ([`history_order`]) and the two polynomial baselines;
+//! - [`turn_on`] fits the recommended model's turn-on bias ([`drift_core::RecommendedTables`]);
 //! - [`regression`] is the one least-squares solver the fitting and the closed loop share.
 //!
 //! Evaluation lives in `drift-evaluate`, the closed loop in `drift-diagnose`; both build on this
@@ -21,6 +22,7 @@ pub mod lowpass;
 mod parallel;
 pub mod regression;
 pub mod settings;
+pub mod turn_on;
 mod windows;
 
 pub use error::FitError;

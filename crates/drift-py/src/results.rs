@@ -84,7 +84,8 @@ impl PyActivationResult {
         PyLabels(self.result.labels.clone())
     }
 
-    /// Per model ("uncorrected", "standard", "3rd-order", "relative", "modified", "by-history"):
+    /// Per model ("uncorrected", "standard", "3rd-order", "relative", "relative-cubic", "modified",
+    /// "by-history", "recommended"):
     /// drift per axis, °/s (max − min of the 1-s low-frequency rate over the activation).
     #[getter]
     fn drift_dps(&self) -> PerModel<f64> {

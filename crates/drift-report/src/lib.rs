@@ -127,6 +127,7 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
     ));
     let cells = absolute_error(input.results, input.independent_after_min);
     md.push_str(&tables::absolute_error_flags(&cells));
+    md.push_str(&tables::absolute_error_by_class(&cells));
     md.push_str(&tables::paper_table(&records, input.fitted));
     md.push_str(&tables::field_table(&records, input.fitted));
     md.push_str(&tables::noise_floor(&records, input.noise_floor_units));

@@ -8,12 +8,14 @@ use drift_evaluate::summary::{AbsoluteCell, Record, Split, WORSE_THAN_BASELINE};
 use drift_fit::FittedUnit;
 
 const AXES: [&str; 3] = ["X", "Y", "Z"];
-const MODELS: [&str; 6] = [
+const MODELS: [&str; 8] = [
     "standard",
     "modified",
     "by-history",
     "3rd-order",
     "relative",
+    "relative-cubic",
+    "recommended",
     "uncorrected",
 ];
 
@@ -104,7 +106,7 @@ pub fn headline(records: &[Record], fitted: &[FittedUnit], noise_units: &[String
         "{} × 3 axes, on activations the fit did not see:\n",
         count(units.len(), "unit", "units")
     );
-    md.push_str("| set point | data | uncorrected | standard | 3rd-order | relative | modified | best baseline / modified | modified, keyed by history | noise floor |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    md.push_str("| set point | data | uncorrected | standard | 3rd-order | relative | relative cubic | modified | best baseline / modified | modified, keyed by history | recommended | noise floor |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (set_point, split) in rows(records) {
         let m = |model| mean_drift(records, &units, set_point, split, model);
         let noise: Vec<f64> = noise_units
@@ -124,18 +126,20 @@ pub fn headline(records: &[Record], fitted: &[FittedUnit], noise_units: &[String
         };
         let _ = writeln!(
             md,
-            "| {set_point:+} °C | {} | {} | {} | {} | {} | {} | {ratio} | {} | {} |",
+            "| {set_point:+} °C | {} | {} | {} | {} | {} | {} | {} | {ratio} | {} | {} | {} |",
             split.name(),
             fmt(m("uncorrected")),
             fmt(m("standard")),
             fmt(m("3rd-order")),
             fmt(m("relative")),
+            fmt(m("relative-cubic")),
             fmt(m("modified")),
             fmt(m("by-history")),
+            fmt(m("recommended")),
             fmt(noise)
         );
     }
-    md.push_str("\nAll drifts in °/s. The standard baselines: *standard*, the paper's (Lagrange through the calibration set points, bias = p(T)); *3rd-order*, the PX4/ArduPilot practice (least squares, bias = p(T)); *relative*, least squares relative to the switch-on (bias = q(T_on) + p(T) − p(T_on): the turn-on bias registered at switch-on from the calibration, as the paper's model takes its initial bias, and the drift after it; orders chosen by leave-one-series-out cross-validation on the calibration). *Best baseline / modified*: against the baseline with the smallest drift on the row's own held-out data, named. *Noise floor*: the same metric on a unit with zero systematic drift (uncorrected): no correction can go below it. *Keyed by history*: the paper's curves with stage 3 looked up by the residual heat at switch-on instead of by the rise, each activation started from what firmware kept of the one before in its recording (`by_history.bin`; docs/closed-loop.md).\n\n");
+    md.push_str("\nAll drifts in °/s. The standard baselines: *standard*, the paper's (Lagrange through the calibration set points, bias = p(T)); *3rd-order*, the PX4/ArduPilot practice (least squares, bias = p(T)); *relative*, least squares relative to the switch-on (bias = q(T_on) + p(T) − p(T_on): the turn-on bias registered at switch-on from the calibration, as the paper's model takes its initial bias, and the drift after it; orders up to the cubic chosen by cross-validation that leaves out one 2.5 °C temperature band of the calibration at a time, so that an order is judged on temperatures it was not fitted at, as between set points); *relative cubic*, the same form with both polynomials cubic, the order PX4 and ArduPilot use. *Best baseline / modified*: against the strongest of the four, the baseline with the smallest drift on the row's own held-out data, named. *Noise floor*: the same metric on a unit with zero systematic drift (uncorrected): no correction can go below it. *Keyed by history*: the paper's curves with stage 3 looked up by the residual heat at switch-on instead of by the rise, each activation started from what firmware kept of the one before in its recording (`by_history.bin`; docs/closed-loop.md). *Recommended*: the paper's drift correction with the turn-on bias fitted on every calibration activation, q(T_on) + h · residual heat, started from what firmware kept (`recommended.bin`; docs/method.md).\n\n");
     md
 }
 
@@ -301,7 +305,14 @@ pub fn residual_rms(records: &[Record], fitted: &[FittedUnit]) -> String {
     md.push_str(&"---:|".repeat(units.len()));
     md.push('\n');
     for (set_point, split) in rows(records) {
-        for model in ["standard", "3rd-order", "relative", "modified"] {
+        for model in [
+            "standard",
+            "3rd-order",
+            "relative",
+            "relative-cubic",
+            "modified",
+            "recommended",
+        ] {
             let _ = write!(md, "| {set_point:+} °C | {} | {model} |", split.name());
             for u in &units {
                 let values: Vec<f64> = AXES
@@ -379,13 +390,61 @@ pub fn absolute_error_flags(cells: &[AbsoluteCell]) -> String {
     md
 }
 
+/// The residual bias RMS per activation class, means over its unit × axis × set point cells: the
+/// paper's model, its history-keyed form, the recommended model and the best baseline, with the
+/// cells where each is worse than the best baseline.
+pub fn absolute_error_by_class(cells: &[AbsoluteCell]) -> String {
+    if cells.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from("## Absolute error by activation class\n\nResidual bias RMS, means over the class's unit × axis × set point cells, °/s (each cell a mean over its activations; the cells: *Absolute error*, below). *Recommended ≤ best*: the cells where the recommended model leaves no more than the best baseline of that cell.\n\n| class | cells | modified | keyed by history | recommended | best baseline | noise floor | modified > 1.25× best | recommended ≤ best |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    let mut classes: Vec<_> = cells.iter().map(|c| c.class).collect();
+    classes.sort();
+    classes.dedup();
+    for class in classes {
+        let members: Vec<&AbsoluteCell> = cells.iter().filter(|c| c.class == class).collect();
+        let n = members.len() as f64;
+        let mean = |f: &dyn Fn(&AbsoluteCell) -> f64| members.iter().map(|c| f(c)).sum::<f64>() / n;
+        let best = |c: &AbsoluteCell| {
+            c.baselines
+                .iter()
+                .map(|b| b.mean_dps)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let floor = mean(&|c| c.noise_floor_dps);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} | {} | {} of {} |",
+            class.name(),
+            members.len(),
+            mean(&|c| c.modified.mean_dps),
+            mean(&|c| c.by_history.mean_dps),
+            mean(&|c| c.recommended.mean_dps),
+            mean(&best),
+            if floor.is_finite() {
+                format!("{floor:.4}")
+            } else {
+                "–".to_owned()
+            },
+            members.iter().filter(|c| c.worse).count(),
+            members
+                .iter()
+                .filter(|c| c.recommended_ratio <= 1.0)
+                .count(),
+            members.len(),
+        );
+    }
+    md.push('\n');
+    md
+}
+
 /// Residual bias RMS per unit × axis × set point × activation class, with its worst activation
 /// and the noise floor.
 pub fn absolute_error(cells: &[AbsoluteCell]) -> String {
     if cells.is_empty() {
         return String::new();
     }
-    let mut md = String::from("## Absolute error\n\nResidual bias RMS (RMS of the corrected 1-s low-frequency rate; the unit is static, so the true rate is zero) per unit × axis × set point × activation class, on held-out activations, °/s: mean over the class's activations, and its worst activation. Unlike the drift it includes the error of the offset at switch-on. *Cold start*: off at least the calibration's cool-down before it (or first in its series); *warm restart*: off less (residual heat at switch-on); *field*: field-like sessions. *By-history*: the paper's curves keyed by history, started from what firmware kept of the previous activation (mean). *Noise floor*: what the paper's model leaves on the zero-drift unit's activations of the class (turn-on repeatability and noise). Flagged (**bold ratio**) where the paper's model leaves more than 1.25× the best baseline; `outside` counts activations switched on outside the model's calibrated envelope (clamped). The same as data: `absolute_error.json`.\n\n| unit | axis | set point | activations | n | modified (worst, where) | outside | by-history | standard | 3rd-order | relative | best | modified / best | noise floor |\n|---|---|---|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|\n");
+    let mut md = String::from("## Absolute error\n\nResidual bias RMS (RMS of the corrected 1-s low-frequency rate; the unit is static, so the true rate is zero) per unit × axis × set point × activation class, on held-out activations, °/s: mean over the class's activations, and its worst activation. Unlike the drift it includes the error of the offset at switch-on. *Cold start*: off at least the calibration's cool-down before it (or first in its series); *warm restart*: off less (residual heat at switch-on); *field*: field-like sessions. *By-history*: the paper's curves keyed by history, started from what firmware kept of the previous activation (mean). *Noise floor*: what the paper's model leaves on the zero-drift unit's activations of the class (turn-on repeatability and noise). Flagged (**bold ratio**) where the paper's model leaves more than 1.25× the best baseline; `outside` counts activations switched on outside the model's calibrated envelope (clamped). The same as data: `absolute_error.json`.\n\n| unit | axis | set point | activations | n | modified (worst, where) | outside | by-history | recommended | standard | 3rd-order | relative | relative cubic | best | modified / best | recommended / best | noise floor |\n|---|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n");
     for c in cells {
         let baseline = |name: &str| {
             c.baselines
@@ -405,7 +464,7 @@ pub fn absolute_error(cells: &[AbsoluteCell]) -> String {
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {:+} °C | {} | {} | {:.4} ({:.4}, {}) | {} | {:.4} | {} | {} | {} | {} | {ratio} | {floor} |",
+            "| {} | {} | {:+} °C | {} | {} | {:.4} ({:.4}, {}) | {} | {:.4} | {:.4} | {} | {} | {} | {} | {} | {ratio} | {:.2}× | {floor} |",
             c.unit,
             c.axis,
             c.set_point_celsius,
@@ -416,10 +475,13 @@ pub fn absolute_error(cells: &[AbsoluteCell]) -> String {
             c.modified.worst_activation,
             c.modified.outside_envelope,
             c.by_history.mean_dps,
+            c.recommended.mean_dps,
             baseline("standard"),
             baseline("3rd-order"),
             baseline("relative"),
+            baseline("relative-cubic"),
             c.best_baseline,
+            c.recommended_ratio,
         );
     }
     md.push('\n');

@@ -11,6 +11,7 @@ use heapless::Vec;
 use serde::de::{self, DeserializeSeed, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 
+use crate::recommended::{RecommendedAxis, RecommendedTables};
 use crate::table::{AmbientCurves, AxisTable, ModifiedTables};
 use crate::AXES;
 
@@ -48,6 +49,7 @@ by_value!(
     crate::settings::Settings,
     crate::extension::Extension,
     crate::warm_start::WarmStart,
+    crate::recommended::TurnOn,
 );
 
 impl<const R: usize> Fill for crate::table::Curve<R> {
@@ -124,8 +126,21 @@ fill_struct!(
     ]
 );
 
+fill_struct!(
+    RecommendedTables<R, A, C>,
+    "RecommendedTables",
+    "struct RecommendedTables",
+    [settings, axes]
+);
+fill_struct!(
+    RecommendedAxis<R, A, C>,
+    "RecommendedAxis",
+    "struct RecommendedAxis",
+    [table, turn_on]
+);
+
 /// The axes, a fixed-size array: a tuple of `AXES` elements, as serde encodes arrays.
-impl<const R: usize, const A: usize, const C: usize> Fill for [AxisTable<R, A, C>; AXES] {
+impl<T: Fill> Fill for [T; AXES] {
     fn fill<'de, D: Deserializer<'de>>(&mut self, deserializer: D) -> Result<(), D::Error> {
         struct Elements<'a, T>(&'a mut [T; AXES]);
         impl<'de, T: Fill> Visitor<'de> for Elements<'_, T> {
@@ -187,6 +202,13 @@ pub(super) fn fill_modified<const R: usize, const A: usize, const C: usize>(
     place: &mut ModifiedTables<R, A, C>,
     payload: &[u8],
 ) -> Result<(), postcard::Error> {
+    fill_exact(place, payload)
+}
+
+/// Fills `place` from `payload`, which must hold exactly one value of its type. On error `place`
+/// is partly written; the caller empties it.
+#[allow(private_bounds)]
+pub(super) fn fill_exact<T: Fill>(place: &mut T, payload: &[u8]) -> Result<(), postcard::Error> {
     let mut deserializer = postcard::Deserializer::from_bytes(payload);
     place.fill(&mut deserializer)?;
     if deserializer.finalize()?.is_empty() {
@@ -201,7 +223,14 @@ pub(super) fn empty<const R: usize, const A: usize, const C: usize>(
     place: &mut ModifiedTables<R, A, C>,
 ) {
     for axis in &mut place.axes {
-        axis.reference_ms.clear();
-        axis.ambients.clear();
+        empty_axis(axis);
     }
+}
+
+/// Empties one axis's table in place (no reference time: validation rejects it).
+pub(super) fn empty_axis<const R: usize, const A: usize, const C: usize>(
+    axis: &mut AxisTable<R, A, C>,
+) {
+    axis.reference_ms.clear();
+    axis.ambients.clear();
 }
