@@ -620,6 +620,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let mut json = Vec::new();
     for (unit, closed, fitted) in &units {
+        // Files are named by unit and half, without the heading's spaces and commas.
+        let stem = match closed.half {
+            Some(half) => format!("{}-half{}", fitted.unit_id, half + 1),
+            None => fitted.unit_id.clone(),
+        };
         let (activations, axes, roles) = (&closed.series, &closed.axes, &closed.roles);
         let _ = writeln!(md, "# Unit {unit}\n");
         {
@@ -688,7 +693,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         md.push_str(&markdown(axes, args.top));
         // The plots show the ranking just above them (behind the loop's model), so they follow
         // it rather than the paper's ranking.
-        md.push_str(&residual_plots(unit, activations, axes, &args.out)?);
+        md.push_str(&residual_plots(&stem, activations, axes, &args.out)?);
         if closed.keying.any() {
             md.push_str(&paper_markdown(&closed.paper_axes, args.top));
         }
@@ -774,13 +779,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         }
         if args.extend {
-            println!("  extended model: {}", super::extend::verdict(unit, closed));
+            println!(
+                "  extended model: {}",
+                super::extend::verdict(&stem, closed)
+            );
         }
         let profiles = closed.profiles(fitted, &options.fit);
         md.push_str(&profile_markdown(&profiles));
         if args.extend {
             md.push_str(&super::extend::run(
-                unit,
+                &stem,
                 closed,
                 fitted,
                 &before_after,
