@@ -8,6 +8,7 @@ mod engine;
 pub mod error;
 pub mod faults;
 pub mod hidden;
+pub mod output_folder;
 pub mod overrides;
 mod rng;
 pub mod schedule;
