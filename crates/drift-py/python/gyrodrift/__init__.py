@@ -57,6 +57,7 @@ from ._gyrodrift import (
     simulate,
     summarise,
 )
+from .frames import correct_frame, results_frame
 from .tables import paper_table
 
 __all__ = [
@@ -90,6 +91,7 @@ __all__ = [
     "TableError",
     "__version__",
     "analyse",
+    "correct_frame",
     "evaluate",
     "excess_cut",
     "fit",
@@ -97,6 +99,7 @@ __all__ = [
     "paper_table",
     "report",
     "resolve_campaign",
+    "results_frame",
     "simulate",
     "summarise",
 ]
