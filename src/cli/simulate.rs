@@ -4,7 +4,7 @@ use anyhow::{bail, Context};
 use drift_sim::campaign::TruthBias;
 use drift_sim::overrides::{parse_set_points, Overrides};
 use drift_sim::Campaign;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A size in GB or TB, three significant digits.
 pub(crate) fn gigabytes(gb: f64) -> String {
