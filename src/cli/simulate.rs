@@ -1,11 +1,10 @@
 //! `gyrodrift simulate`: record a simulated calibration campaign as a folder of MCAP files.
 
 use anyhow::{bail, Context};
-use drift_recording::{COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR};
 use drift_sim::campaign::TruthBias;
 use drift_sim::overrides::{parse_set_points, Overrides};
 use drift_sim::Campaign;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A size in GB or TB, three significant digits.
 pub(crate) fn gigabytes(gb: f64) -> String {
@@ -78,9 +77,6 @@ pub struct Args {
     pub quiet: bool,
 }
 
-/// What `simulate` writes into its output folder, and so what `--force` replaces.
-const WRITTEN: [&str; 3] = [RECORDINGS_DIR, TRUTH_DIR, COMPLETION_MARKER];
-
 /// Bytes a campaign writes, estimated from its gyro samples: measured 11.5 B per sample of
 /// recording, 17.0 B of truth sidecar at every sample and 6.1 B at the auxiliary rate
 /// (`gyrodrift simulate --units 1 --set-points 30 --repeats 1 --seed 1`, with and without
@@ -91,58 +87,6 @@ pub(crate) fn estimate_bytes(campaign: &Campaign, samples: u64) -> f64 {
         TruthBias::AuxRate => 6.5,
     };
     samples as f64 * (12.0 + truth)
-}
-
-/// Refuses an output folder holding anything, unless `force`: then removes what an earlier
-/// simulation wrote there, and refuses anything else it holds (it is not ours to delete).
-fn prepare(out: &Path, force: bool) -> anyhow::Result<()> {
-    let entries: Vec<String> = match std::fs::read_dir(out) {
-        Ok(entries) => entries
-            .filter_map(Result::ok)
-            .map(|e| e.file_name().to_string_lossy().into_owned())
-            .collect(),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", out.display())),
-    };
-    if entries.is_empty() {
-        return Ok(());
-    }
-    let mut listed = entries.clone();
-    listed.sort();
-    if !force {
-        bail!(
-            "{} is not empty ({}): simulating into it would mix two campaigns; pass --force to replace the campaign there, or choose a new folder",
-            out.display(),
-            listed.join(", ")
-        );
-    }
-    let foreign: Vec<&String> = listed
-        .iter()
-        .filter(|name| !WRITTEN.contains(&name.as_str()))
-        .collect();
-    if !foreign.is_empty() {
-        let names: Vec<&str> = foreign.iter().map(|s| s.as_str()).collect();
-        bail!(
-            "{} holds files `simulate` does not write ({}): --force replaces only a campaign; choose a new folder",
-            out.display(),
-            names.join(", ")
-        );
-    }
-    for name in WRITTEN {
-        let path = out.join(name);
-        let removed = if path.is_dir() {
-            std::fs::remove_dir_all(&path)
-        } else {
-            std::fs::remove_file(&path)
-        };
-        match removed {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(e).with_context(|| format!("removing {}", path.display()))
-            }
-            _ => {}
-        }
-    }
-    Ok(())
 }
 
 /// The campaign these flags describe: the file's (or the built-in paper campaign) with the flags
@@ -193,7 +137,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             args.max_gb
         );
     }
-    prepare(&args.out, args.force)?;
+    drift_sim::output_folder::prepare(&args.out, args.force, "--force")?;
     if !args.quiet {
         eprintln!(
             "simulating `{}`: {} samples, about {} → {}",

@@ -37,6 +37,7 @@ pub struct Output {
 
 /// Run-time state of one axis. Plain data: copy it to persist, restore it to resume.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct AxisState<S> {
     switch_on_raw: f32,
     initial_bias_dps: f32,
@@ -86,6 +87,7 @@ impl<S> AxisState<S> {
 /// Per-unit run-time state, separate from the immutable tables: the same tables can serve several
 /// units, and swapping tables never corrupts a state.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CorrectorState<S> {
     axes: [AxisState<S>; AXES],
     extension: ExtensionState,

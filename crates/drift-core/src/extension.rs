@@ -258,6 +258,7 @@ impl Extension {
 /// filters and the time of the last sample. Reset at every switch-on. Plain data (32 bytes): copy
 /// it to persist, restore it to resume.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ExtensionState {
     /// Per axis, the rise since switch-on through the rate filter's first-order low-pass, °C (for
     /// [`Term::TemperatureRate`]); at switch-on `−rate · τ` for the [`SwitchOnRate`] it starts

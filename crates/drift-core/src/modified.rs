@@ -24,6 +24,7 @@ use crate::AXES;
 /// Kept field by field rather than as an [`AmbientPosition`] and a [`Segment`], so that the
 /// one-byte indices share one word: a unit's state stays within 256 bytes (docs/embedded.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ModifiedAxisState {
     ambient_weight: f32,
     ambient_lo: u8,

@@ -118,6 +118,7 @@ impl Span {
 
 /// Per-axis run-time state of a polynomial baseline: its value at switch-on.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PolynomialAxisState {
     at_switch_on_dps: f32,
 }

@@ -16,7 +16,7 @@ use crate::segment::PySegment;
 /// One analysed activation: per axis, every `grid_ms` from switch-on.
 #[pyclass(module = "gyrodrift", name = "AnalysedActivation", frozen)]
 pub struct PyAnalysed {
-    analysed: Analysed,
+    pub(crate) analysed: Analysed,
     time_s: PyOnceLock<Py<PyArray1<f64>>>,
     drift_dps: PyOnceLock<Py<PyArray2<f32>>>,
     rise_celsius: PyOnceLock<Py<PyArray2<f32>>>,
@@ -107,6 +107,10 @@ impl PyAnalysed {
     #[getter]
     fn initial_bias_dps(&self) -> (f64, f64, f64) {
         triple(self.analysed.initial_bias_dps)
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
     }
 
     fn __repr__(&self) -> String {

@@ -48,6 +48,43 @@ fn not_empty(name: &str, value: &Bound<'_, PyAny>, rows: usize) -> Result<(), Er
     Ok(())
 }
 
+/// The kind of a numpy array's dtype (`'f'`, `'m'` for timedelta64, ...), if `value` is one.
+fn dtype_kind(value: &Bound<'_, PyAny>) -> Option<char> {
+    let array = value.cast::<PyUntypedArray>().ok()?;
+    let kind = array
+        .dtype()
+        .getattr("kind")
+        .ok()?
+        .extract::<String>()
+        .ok()?;
+    kind.chars().next()
+}
+
+/// Whether `value` is a pandas object (a Series or a DataFrame), which is not an ndarray.
+fn is_pandas(value: &Bound<'_, PyAny>) -> bool {
+    value
+        .get_type()
+        .module()
+        .is_ok_and(|m| m.to_string().starts_with("pandas"))
+}
+
+/// How to convert `value` into what `expected` needs, for the error message.
+fn hint(value: &Bound<'_, PyAny>, milliseconds: bool) -> &'static str {
+    if is_pandas(value) {
+        return "a pandas object: pass .to_numpy() of the column(s), then convert as needed";
+    }
+    match (dtype_kind(value), milliseconds) {
+        (Some('m'), true) => {
+            "timedelta64: convert with (t // np.timedelta64(1, 'ms')).astype(np.uint32); .astype(np.uint32) would count its native unit"
+        }
+        (Some('f'), false) => {
+            "temperatures in °C? convert with np.round(settings.raw(celsius)).astype(np.int16); .astype(np.int16) would truncate °C to whole degrees"
+        }
+        (_, true) => "convert with .astype(np.uint32)",
+        (_, false) => "convert with .astype(np.int16)",
+    }
+}
+
 /// A borrowed `(n,)` uint32 array (times since switch-on, ms).
 pub fn times<'py>(
     name: &str,
@@ -55,8 +92,9 @@ pub fn times<'py>(
 ) -> Result<PyReadonlyArray1<'py, u32>, Error> {
     let array = value.cast::<PyArray1<u32>>().map_err(|_| {
         Error::Input(format!(
-            "`{name}` must be a uint32 array of shape (n,), got {} (convert with .astype(np.uint32))",
-            describe(value)
+            "`{name}` must be a uint32 array of shape (n,), got {} ({})",
+            describe(value),
+            hint(value, true)
         ))
     })?;
     not_empty(name, value, array.len())?;
@@ -378,8 +416,9 @@ pub fn raw_rows<'py>(
 ) -> Result<PyReadonlyArray2<'py, i16>, Error> {
     let wrong = || {
         Error::Input(format!(
-            "`{name}` must be an int16 array of shape (n, 3), got {} (convert with .astype(np.int16))",
-            describe(value)
+            "`{name}` must be an int16 array of shape (n, 3), got {} ({})",
+            describe(value),
+            hint(value, false)
         ))
     };
     let array = value.cast::<PyArray2<i16>>().map_err(|_| wrong())?;

@@ -18,6 +18,7 @@ use crate::arrays::{
     copy_times, describe, rows_per_axis, times, BatchArrays, OutArrays, Rows, RowsView,
 };
 use crate::errors::Error;
+use crate::model_io;
 use crate::tables::{PyModifiedTables, PyPolynomialTables, PyRelativePolynomialTables};
 
 /// Samples staged at a time between the caller's arrays and the corrector (on the stack).
@@ -27,7 +28,7 @@ const BLOCK: usize = 512;
 const BLOCK_VALUES: usize = BLOCK * 3;
 
 /// A model and its state; the model kind decides the state type.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 enum Engine {
     Modified(
         Arc<ModifiedTables>,
@@ -180,6 +181,14 @@ impl Engine {
         }
     }
 
+    fn settings(&self) -> &drift_core::Settings {
+        match self {
+            Self::Modified(model, _) => model.settings(),
+            Self::Polynomial(model, _) => model.settings(),
+            Self::Relative(model, _) => model.settings(),
+        }
+    }
+
     fn power_off(&mut self) {
         match self {
             Self::Modified(_, state) => state.power_off(),
@@ -234,23 +243,51 @@ impl Engine {
 pub struct PyOutput {
     /// Rate with the estimated drift removed, °/s.
     #[pyo3(get)]
-    corrected_dps: (f32, f32, f32),
+    pub(crate) corrected_dps: (f32, f32, f32),
     /// Estimated bias that was removed (initial bias + drift since switch-on), °/s.
     #[pyo3(get)]
-    bias_dps: (f32, f32, f32),
+    pub(crate) bias_dps: (f32, f32, f32),
     /// Status flags (see `gyrodrift.Flags`).
     #[pyo3(get)]
-    flags: (u16, u16, u16),
+    pub(crate) flags: (u16, u16, u16),
 }
 
 #[pymethods]
 impl PyOutput {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Output(corrected_dps={:?}, bias_dps={:?}, flags={:?})",
             self.corrected_dps, self.bias_dps, self.flags
         )
     }
+}
+
+/// Raw readings this close to 0 that read as outside the calibrated range are taken for °C.
+const CELSIUS_LIKE_RAW: f32 = 150.0;
+
+/// Refuses a switch-on whose raw readings look like °C: every axis within ±150 of zero (a °C
+/// value, not a count at 200 raw/°C) and outside the model's calibrated temperatures. Checked on
+/// a trial start, so a refusal leaves the state unchanged.
+fn refuse_celsius(
+    raw: [f32; 3],
+    flags: [Flags; 3],
+    settings: &drift_core::Settings,
+) -> Result<(), Error> {
+    let outside = |f: &Flags| {
+        f.contains(Flags::AMBIENT_OUT_OF_RANGE) || f.contains(Flags::TEMPERATURE_OUT_OF_RANGE)
+    };
+    if raw.iter().all(|r| r.abs() <= CELSIUS_LIKE_RAW) && flags.iter().all(outside) {
+        let celsius = raw.map(|r| settings.celsius(r));
+        return Err(Error::Input(format!(
+            "`switch_on_raw` {raw:?} reads as {celsius:?} °C, outside the model's calibrated temperatures: these look like °C, not raw sensor counts ({} raw/°C); convert with model.settings.raw(celsius); the state is unchanged",
+            settings.raw_per_celsius
+        )));
+    }
+    Ok(())
 }
 
 fn triple<T: Copy>(values: [T; 3]) -> (T, T, T) {
@@ -373,11 +410,14 @@ impl PyCorrector {
     /// flags that hold for the whole activation, per axis.
     fn power_on(&mut self, switch_on_raw: &Bound<'_, PyAny>) -> Result<(u16, u16, u16), Error> {
         let raw = args::per_axis("switch_on_raw", switch_on_raw)?;
-        let flags = self.engine.power_on(raw).map_err(|error| {
+        let mut trial = self.engine.clone();
+        let flags = trial.power_on(raw).map_err(|error| {
             Error::Input(format!(
                 "`switch_on_raw` must be finite on every axis, got {raw:?} ({error}); the state is unchanged"
             ))
         })?;
+        refuse_celsius(raw, flags, trial.settings())?;
+        self.engine = trial;
         Ok(triple(flags.map(|f| f.0)))
     }
 
@@ -394,11 +434,14 @@ impl PyCorrector {
     ) -> Result<Started<'py>, Error> {
         let raw = args::per_axis("switch_on_raw", switch_on_raw)?;
         let mut kept = previous_arg("previous", previous)?;
-        let flags = self.engine.power_on_after(raw, &mut kept).map_err(|error| {
+        let mut trial = self.engine.clone();
+        let flags = trial.power_on_after(raw, &mut kept).map_err(|error| {
             Error::Input(format!(
                 "`switch_on_raw` must be finite on every axis, got {raw:?} ({error}); the state is unchanged"
             ))
         })?;
+        refuse_celsius(raw, flags, trial.settings())?;
+        self.engine = trial;
         Ok((triple(flags.map(|f| f.0)), previous_array(py, &kept)?))
     }
 
@@ -524,6 +567,10 @@ impl PyCorrector {
         ))
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         let model = match &self.engine {
             Engine::Modified(..) => "ModifiedTables",
@@ -536,5 +583,45 @@ impl PyCorrector {
             "not powered on"
         };
         format!("<Corrector {model}, {state}>")
+    }
+}
+
+/// A corrector's pickled form: the model as its firmware image and the run-time state, so that an
+/// activation continues where it was (a worker process, a checkpoint).
+#[derive(serde::Serialize, serde::Deserialize)]
+enum EngineState {
+    Modified(Vec<u8>, CorrectorState<<ModifiedAxis as AxisModel>::State>),
+    Polynomial(
+        Vec<u8>,
+        CorrectorState<<PolynomialAxis as AxisModel>::State>,
+    ),
+    Relative(Vec<u8>, CorrectorState<<RelativeAxis as AxisModel>::State>),
+}
+
+impl crate::pickle_state::Pickled for PyCorrector {
+    const KIND: &'static str = "Corrector";
+
+    fn state(&self, _py: Python<'_>) -> PyResult<Vec<u8>> {
+        let state = match &self.engine {
+            Engine::Modified(m, s) => EngineState::Modified(model_io::to_image(&**m)?, *s),
+            Engine::Polynomial(m, s) => EngineState::Polynomial(model_io::to_image(&**m)?, *s),
+            Engine::Relative(m, s) => EngineState::Relative(model_io::to_image(&**m)?, *s),
+        };
+        crate::pickle_state::encode(Self::KIND, &state)
+    }
+
+    fn restore(_py: Python<'_>, state: &[u8]) -> PyResult<Self> {
+        let engine = match crate::pickle_state::decode(Self::KIND, state)? {
+            EngineState::Modified(image, s) => {
+                Engine::Modified(Arc::new(model_io::from_image(&image)?), s)
+            }
+            EngineState::Polynomial(image, s) => {
+                Engine::Polynomial(Arc::new(model_io::from_image(&image)?), s)
+            }
+            EngineState::Relative(image, s) => {
+                Engine::Relative(Arc::new(model_io::from_image(&image)?), s)
+            }
+        };
+        Ok(Self { engine })
     }
 }

@@ -4,46 +4,65 @@
 
 use std::sync::Arc;
 
+use drift_core::ModifiedTables;
+use drift_diagnose::closing::PROFILE_EDGES_S;
 use drift_diagnose::closing::{close, LoopOptions};
-use drift_diagnose::closing::{BeforeAfter, Profile, Stage3Choice, PROFILE_EDGES_S};
 use drift_diagnose::diagnose::AxisDiagnosis;
 use drift_diagnose::extend::Admission;
-use drift_diagnose::warm_start::WarmStartChoice;
 use drift_fit::{FitSettings, FittedUnit};
 use drift_recording::{read_recording, Segment};
 use numpy::ndarray::Array3;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use serde::Serialize;
+use pyo3::types::{PyDict, PyTuple};
+use serde::{Deserialize, Serialize};
 
 use crate::errors::Error;
 use crate::outputs::vector;
+use crate::pickle_state::{self, Pickled};
 use crate::sources::{self, Source};
 use crate::tables::PyModifiedTables;
 
 /// What the diagnosis found for one unit, and the extended model when one was asked for.
+///
+/// Held as owned data (records as JSON text, the model as tables) so that it pickles.
 #[pyclass(module = "gyrodrift", name = "Diagnosis", frozen)]
-#[derive(Debug)]
+#[derive(Debug, Serialize, Deserialize)]
 pub struct PyDiagnosis {
     unit_id: String,
-    axes: [AxisDiagnosis; 3],
-    paper_axes: [AxisDiagnosis; 3],
+    /// JSON records of `ranking` and `paper_ranking`.
+    ranking: String,
+    paper_ranking: String,
+    /// Per axis, the significant winner.
+    chosen: Vec<(String, Option<String>)>,
     proposed: Vec<String>,
-    admissions: Vec<Admission>,
-    stage3: [Stage3Choice; 3],
-    warm_start: [WarmStartChoice; 3],
-    extended: Option<PyModifiedTables>,
+    /// JSON records of `admissions`, `stage3`, `warm_start`, `before_after`.
+    admissions: String,
+    stage3: String,
+    warm_start: String,
+    before_after: String,
+    extended: Option<Box<ModifiedTables>>,
     aux_inputs: Vec<String>,
-    before_after: Vec<BeforeAfter>,
-    profiles: Vec<Profile>,
-    counts: [(&'static str, usize); 5],
+    profiles: Vec<ProfileRow>,
+    counts: Vec<(String, usize)>,
 }
 
-/// Serialisable values as Python objects (lists and dicts), through JSON like `report.json`.
-fn to_python<'py>(py: Python<'py>, value: &impl Serialize) -> PyResult<Bound<'py, PyAny>> {
-    let text = serde_json::to_string(value)
-        .map_err(|e| Error::Input(format!("internal: records JSON: {e}")))?;
+/// One held-out activation's residual profile ([`Profile`], owned).
+#[derive(Debug, Serialize, Deserialize)]
+struct ProfileRow {
+    set_point_celsius: f64,
+    series_kind: String,
+    off_before_s: Option<f64>,
+    after_dps: [Vec<f64>; 3],
+}
+
+/// JSON text of serialisable records (NaN becomes null, as in `report.json`).
+fn json(value: &impl Serialize) -> Result<String, Error> {
+    serde_json::to_string(value).map_err(|e| Error::Input(format!("internal: records JSON: {e}")))
+}
+
+/// JSON records as Python objects (lists and dicts).
+fn to_python<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (text,))
 }
 
@@ -150,36 +169,55 @@ pub fn diagnose_unit(
         } else {
             Vec::new()
         };
+        let chosen = closed
+            .axes
+            .iter()
+            .map(|a| (a.axis.to_owned(), a.chosen().map(|c| c.name.clone())))
+            .collect();
+        let profiles = closed
+            .profiles(unit, settings)
+            .into_iter()
+            .map(|p| ProfileRow {
+                set_point_celsius: p.set_point_celsius,
+                series_kind: p.series_kind.to_owned(),
+                off_before_s: p.off_before_s,
+                after_dps: p.after_dps,
+            })
+            .collect();
+        let admissions: Vec<Admission> = closed
+            .extended
+            .as_ref()
+            .map(|e| e.admissions.clone())
+            .unwrap_or_default();
         Ok(PyDiagnosis {
             unit_id: unit.unit_id.clone(),
+            ranking: json(&records(&closed.axes))?,
+            paper_ranking: json(&records(&closed.paper_axes))?,
+            chosen,
             proposed: closed
                 .proposed
                 .terms
                 .iter()
                 .map(|t| t.candidate.clone())
                 .collect(),
-            admissions: closed
-                .extended
-                .as_ref()
-                .map(|e| e.admissions.clone())
-                .unwrap_or_default(),
-            extended: changed.then(|| PyModifiedTables(Arc::from(closed.model(unit)))),
-            stage3: closed.stage3.clone(),
-            warm_start: closed.warm_start.clone(),
+            admissions: json(&admissions)?,
+            extended: changed.then(|| closed.model(unit)),
+            stage3: json(&closed.stage3)?,
+            warm_start: json(&closed.warm_start)?,
             aux_inputs: admitted
                 .map(|e| e.plan.aux_inputs.clone())
                 .unwrap_or_default(),
-            before_after,
-            profiles: closed.profiles(unit, settings),
+            before_after: json(&before_after)?,
+            profiles,
             counts: [
                 ("calibration", closed.roles.calibration.len()),
                 ("training", closed.roles.training.len()),
                 ("held_out", closed.roles.held_out.len()),
                 ("outside_range", closed.roles.outside_range),
                 ("diagnosed", closed.series.len()),
-            ],
-            axes: closed.axes,
-            paper_axes: closed.paper_axes,
+            ]
+            .map(|(name, n)| (name.to_owned(), n))
+            .to_vec(),
         })
     })?;
     Ok(diagnosis)
@@ -201,7 +239,7 @@ impl PyDiagnosis {
     /// significant with these activations. The t-tests' p-values are reported, not gated on.
     #[getter]
     fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &records(&self.axes))
+        to_python(py, &self.ranking)
     }
 
     /// The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's
@@ -210,7 +248,7 @@ impl PyDiagnosis {
     /// the paper's model.
     #[getter]
     fn paper_ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &records(&self.paper_axes))
+        to_python(py, &self.paper_ranking)
     }
 
     /// The ranking as a pandas DataFrame (needs pandas; raises ImportError without it).
@@ -220,17 +258,14 @@ impl PyDiagnosis {
                 "Diagnosis.to_dataframe needs pandas (pip install pandas): {error}"
             ))
         })?;
-        pandas.call_method1("DataFrame", (to_python(py, &records(&self.axes))?,))
+        pandas.call_method1("DataFrame", (to_python(py, &self.ranking)?,))
     }
 
     /// Per axis ("X", "Y", "Z"), the significant winner's name, or None when no significant
     /// systematic effect is left.
     #[getter]
-    fn chosen(&self) -> Vec<(&'static str, Option<String>)> {
-        self.axes
-            .iter()
-            .map(|a| (a.axis, a.chosen().map(|c| c.name.clone())))
-            .collect()
+    fn chosen(&self) -> Vec<(String, Option<String>)> {
+        self.chosen.clone()
     }
 
     /// The terms proposed for the extended model: the diagnosis's significant candidates that
@@ -270,7 +305,9 @@ impl PyDiagnosis {
     /// heating history need `power_on_after`.
     #[getter]
     fn extended(&self) -> Option<PyModifiedTables> {
-        self.extended.clone()
+        self.extended
+            .clone()
+            .map(|m| PyModifiedTables(Arc::from(m)))
     }
 
     /// The recorded channels the firmware passes as the extended model's auxiliary inputs 0..,
@@ -310,13 +347,17 @@ impl PyDiagnosis {
         let dict = PyDict::new(py);
         dict.set_item("edges_s", vector(py, PROFILE_EDGES_S.to_vec()))?;
         dict.set_item("after_dps", after.into_pyarray(py))?;
-        let of = |f: fn(&Profile) -> f64| self.profiles.iter().map(f).collect::<Vec<f64>>();
+        let of = |f: fn(&ProfileRow) -> f64| self.profiles.iter().map(f).collect::<Vec<f64>>();
         dict.set_item(
             "off_before_s",
             vector(py, of(|p| p.off_before_s.unwrap_or(f64::NAN))),
         )?;
         dict.set_item("set_point_celsius", vector(py, of(|p| p.set_point_celsius)))?;
-        let kinds: Vec<&str> = self.profiles.iter().map(|p| p.series_kind).collect();
+        let kinds: Vec<&str> = self
+            .profiles
+            .iter()
+            .map(|p| p.series_kind.as_str())
+            .collect();
         dict.set_item("series_kind", kinds)?;
         Ok(dict)
     }
@@ -324,24 +365,36 @@ impl PyDiagnosis {
     /// How many activations played each part: calibration, training, held_out, outside_range,
     /// diagnosed.
     #[getter]
-    fn activations(&self) -> Vec<(&'static str, usize)> {
-        self.counts.to_vec()
+    fn activations(&self) -> Vec<(String, usize)> {
+        self.counts.clone()
     }
 
     fn __repr__(&self) -> String {
         let chosen: Vec<String> = self
-            .axes
+            .chosen
             .iter()
-            .map(|a| {
+            .map(|(axis, name)| {
                 format!(
-                    "{}: {}",
-                    a.axis,
-                    a.chosen()
-                        .map_or("nothing significant", |c| c.name.as_str())
+                    "{axis}: {}",
+                    name.as_deref().unwrap_or("nothing significant")
                 )
             })
             .collect();
         format!("<Diagnosis {}: {}>", self.unit_id, chosen.join("; "))
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        pickle_state::reduce(slf)
+    }
+}
+
+impl Pickled for PyDiagnosis {
+    const KIND: &'static str = "Diagnosis";
+    fn state(&self, _py: Python<'_>) -> PyResult<Vec<u8>> {
+        pickle_state::encode(Self::KIND, self)
+    }
+    fn restore(_py: Python<'_>, state: &[u8]) -> PyResult<Self> {
+        pickle_state::decode(Self::KIND, state)
     }
 }
 

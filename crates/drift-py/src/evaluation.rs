@@ -59,11 +59,11 @@ pub fn summarise<'py>(py: Python<'py>, results: &Bound<'py, PyAny>) -> PyResult<
 /// evaluated activation, with the report's table as records.
 #[pyclass(module = "gyrodrift", name = "Evaluation", frozen)]
 pub struct PyEvaluation {
-    fitted: Vec<Py<PyFittedUnit>>,
-    calibration: Vec<Py<PyAnalysed>>,
-    results: Vec<(Split, ActivationResult)>,
-    noise_floor_units: Vec<String>,
-    timings: Vec<(String, f64)>,
+    pub(crate) fitted: Vec<Py<PyFittedUnit>>,
+    pub(crate) calibration: Vec<Py<PyAnalysed>>,
+    pub(crate) results: Vec<(Split, ActivationResult)>,
+    pub(crate) noise_floor_units: Vec<String>,
+    pub(crate) timings: Vec<(String, f64)>,
 }
 
 #[pymethods]
@@ -118,6 +118,10 @@ impl PyEvaluation {
     #[getter]
     fn timings(&self) -> Vec<(String, f64)> {
         self.timings.clone()
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
     }
 
     fn __repr__(&self) -> String {

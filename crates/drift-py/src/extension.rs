@@ -207,6 +207,10 @@ impl PyExtraTerm {
         triple(self.0.coefficient)
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         let parameter = parameter(self.0.term).map_or_else(String::new, |p| format!(", {p}"));
         let filter = match self.0.term {

@@ -318,6 +318,10 @@ impl PyFittedUnit {
         Ok(folder.join(&self.unit.unit_id))
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<FittedUnit {}: {} curves × {} ambients>",

@@ -182,6 +182,10 @@ impl PyFitSettings {
         self.0.polynomial_degree
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         let s = &self.0;
         format!("FitSettings(lowpass_window_s={:?}, grid_ms={:?}, initial_bias_window_s={:?}, switch_on_window_ms={:?}, first_reference_s={:?}, reference_count={:?}, reference_window_points={:?}, independent_after_min={:?}, polynomial_degree={:?})", s.lowpass_window_s, s.grid_ms, s.initial_bias_window_s, s.switch_on_window_ms, s.first_reference_s, s.reference_count, s.reference_window_points, s.independent_after_min, s.polynomial_degree)

@@ -157,6 +157,10 @@ impl PyLabels {
         self.0.off_before_s
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         let l = &self.0;
         format!(

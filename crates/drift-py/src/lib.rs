@@ -10,6 +10,7 @@ mod args;
 mod arrays;
 mod check;
 mod corrector;
+mod csv_input;
 mod diagnosis;
 mod errors;
 mod evaluation;
@@ -21,6 +22,8 @@ mod flags;
 mod labels;
 mod model_io;
 mod outputs;
+mod pickle_state;
+mod pickling;
 mod recording;
 mod results;
 mod segment;
@@ -65,5 +68,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(evaluation::summarise, module)?)?;
     module.add_function(wrap_pyfunction!(evaluation::report, module)?)?;
     module.add_function(wrap_pyfunction!(excess::excess_cut, module)?)?;
+    module.add_function(wrap_pyfunction!(pickling::restore, module)?)?;
+    module.add_function(wrap_pyfunction!(csv_input::read_csv_text, module)?)?;
     Ok(())
 }

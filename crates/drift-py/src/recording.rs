@@ -11,7 +11,7 @@ use drift_recording::{
     Recording, AUX_RATE_HZ,
 };
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyDict, PyList};
 
 use crate::args;
 use crate::errors::Error;
@@ -30,11 +30,11 @@ pub const FORMAT_CHANNELS: [&str; 5] = [
 /// One unit's recording: metadata and its activations in order.
 #[pyclass(module = "gyrodrift", name = "Recording", frozen)]
 pub struct PyRecording {
-    path: Option<PathBuf>,
-    metadata: BTreeMap<String, String>,
-    unit_id: String,
-    sample_rate_hz: u32,
-    segments: Vec<Py<PySegment>>,
+    pub(crate) path: Option<PathBuf>,
+    pub(crate) metadata: BTreeMap<String, String>,
+    pub(crate) unit_id: String,
+    pub(crate) sample_rate_hz: u32,
+    pub(crate) segments: Vec<Py<PySegment>>,
 }
 
 impl PyRecording {
@@ -238,6 +238,33 @@ impl PyRecording {
         })
     }
 
+    /// A recording from a pandas DataFrame of a continuous log (one or several power-ons):
+    /// `gyrodrift.frames.from_dataframe`, documented in the stub and the README.
+    #[staticmethod]
+    #[pyo3(signature = (frame, **options))]
+    fn from_dataframe<'py>(
+        py: Python<'py>,
+        frame: &Bound<'py, PyAny>,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        py.import("gyrodrift.frames")?
+            .getattr("from_dataframe")?
+            .call((frame,), options)
+    }
+
+    /// A recording from a CSV file (through pandas): `gyrodrift.frames.read_csv`.
+    #[staticmethod]
+    #[pyo3(signature = (path, **options))]
+    fn read_csv<'py>(
+        py: Python<'py>,
+        path: &Bound<'py, PyAny>,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        py.import("gyrodrift.frames")?
+            .getattr("read_csv")?
+            .call((path,), options)
+    }
+
     /// Reads and validates an MCAP recording. Raises `FileError` (missing or unreadable) or
     /// `RecordingError` (naming file, topic and message index).
     #[staticmethod]
@@ -309,6 +336,10 @@ impl PyRecording {
 
     fn __len__(&self) -> usize {
         self.segments.len()
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {

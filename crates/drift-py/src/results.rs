@@ -104,6 +104,10 @@ impl PyActivationResult {
         self.per_model(|m| m.flags)
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         let l = &self.result.labels;
         format!(

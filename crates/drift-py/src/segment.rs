@@ -99,6 +99,10 @@ impl PyAuxChannel {
         self.channel.values.len()
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<AuxChannel {} values, {} Hz, {:?}>",
@@ -402,6 +406,10 @@ impl PySegment {
             .into());
         };
         PyAuxChannel::wrap(py, channel.clone())
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
     }
 
     fn __repr__(&self) -> String {

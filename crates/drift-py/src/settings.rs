@@ -1,7 +1,9 @@
 //! `gyrodrift.Settings`: sensor conversion and envelope settings stored with every model.
 
 use drift_core::Settings;
+use numpy::{IntoPyArray, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
+use pyo3::types::{PyFloat, PyInt};
 
 use crate::args;
 use crate::errors::Error;
@@ -96,6 +98,40 @@ impl PySettings {
     /// A raw temperature reading in °C (f32 arithmetic, as the corrector does it).
     fn celsius(&self, raw: &Bound<'_, PyAny>) -> Result<f32, Error> {
         Ok(self.0.celsius(args::float("raw", raw)?))
+    }
+
+    /// Raw temperature readings from °C, in f32 as the corrector converts them back: a float for
+    /// a float, a float32 array for any array-like (a list, a numpy array, a pandas Series), so
+    /// that `correct_batch` can be fed a log in °C.
+    fn raw<'py>(
+        &self,
+        py: Python<'py>,
+        celsius: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let s = self.0;
+        let convert = move |c: f32| c * s.raw_per_celsius + s.raw_at_zero_celsius;
+        if let Ok(value) = celsius.cast::<PyFloat>() {
+            return Ok(PyFloat::new(py, f64::from(convert(value.value() as f32))).into_any());
+        }
+        if let Ok(value) = celsius.cast::<PyInt>() {
+            let value: f64 = value.extract()?;
+            return Ok(PyFloat::new(py, f64::from(convert(value as f32))).into_any());
+        }
+        let array = py
+            .import("numpy")?
+            .call_method1("asarray", (celsius, "float32"))
+            .map_err(|_| {
+                Error::Input(format!(
+                    "`celsius` must be a float or an array of floats (°C), got {}",
+                    crate::arrays::describe(celsius)
+                ))
+            })?;
+        let array: PyReadonlyArrayDyn<'py, f32> = array.extract()?;
+        Ok(array.as_array().mapv(convert).into_pyarray(py).into_any())
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
     }
 
     fn __repr__(&self) -> String {

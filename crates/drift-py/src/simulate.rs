@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use drift_sim::output_folder::{prepare, FolderError};
 use drift_sim::overrides::{parse_set_points, OverrideError, Overrides, SetPointsError};
 use drift_sim::{Campaign, Protocol};
 use pyo3::prelude::*;
@@ -189,13 +190,14 @@ pub fn resolve_campaign<'py>(
 }
 
 /// Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
-/// does; returns the summary (files, samples, bytes, wall time) as a dict. The GIL is released.
+/// does: a folder that is not empty is refused unless `force` (then an earlier campaign there is
+/// replaced, and anything else refused); returns the summary (files, samples, bytes, wall time) as a dict. The GIL is released.
 #[pyfunction]
 #[pyo3(signature = (
     out, campaign = None, *, seed = None, units = None, set_points = None, intervals = None,
     repeats = None, field = false, field_only = false, zero_drift = false, paper_exact = false,
     effects = None,
-    noise_scale = None, truth_at_aux_rate = false,
+    noise_scale = None, truth_at_aux_rate = false, force = false,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -214,6 +216,7 @@ pub fn simulate<'py>(
     effects: Option<&Bound<'py, PyAny>>,
     noise_scale: Option<&Bound<'py, PyAny>>,
     truth_at_aux_rate: bool,
+    force: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let out = args::path("out", out)?;
     let c = resolve(
@@ -232,9 +235,25 @@ pub fn simulate<'py>(
         noise_scale,
         truth_at_aux_rate,
     )?;
-    let summary = py
-        .detach(|| drift_sim::simulate_campaign(&c, &out, |_| {}))
-        .map_err(Error::from)?;
+    let summary = py.detach(|| -> Result<_, Error> {
+        prepare(&out, force, "force=True").map_err(|e| match e {
+            FolderError::Io {
+                action,
+                path,
+                source,
+            } => Error::File {
+                action: if action == "reading" {
+                    "read"
+                } else {
+                    "remove"
+                },
+                path,
+                source,
+            },
+            other => Error::Input(other.to_string()),
+        })?;
+        Ok(drift_sim::simulate_campaign(&c, &out, |_| {})?)
+    })?;
     let text = serde_json::to_string(&summary)
         .map_err(|e| Error::Campaign(format!("internal: summary JSON: {e}")))?;
     py.import("json")?.call_method1("loads", (text,))

@@ -181,6 +181,10 @@ macro_rules! model_class {
                 Self::checked(tables)
             }
 
+            fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+                crate::pickle_state::reduce(slf)
+            }
+
             fn __repr__(&self) -> String {
                 format!("<{} {}>", $name, self.0.summary())
             }

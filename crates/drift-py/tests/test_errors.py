@@ -110,6 +110,11 @@ def test_hierarchy() -> None:
         ),
         (
             "since_power_on_ms",
+            np.arange(N, dtype="timedelta64[ns]"),
+            "`since_power_on_ms` must be a uint32 array of shape (n,), got timedelta64[ns] array of shape (5,) (timedelta64: convert with (t // np.timedelta64(1, 'ms')).astype(np.uint32); .astype(np.uint32) would count its native unit)",
+        ),
+        (
+            "since_power_on_ms",
             np.arange(N, dtype=np.float64),
             "`since_power_on_ms` must be a uint32 array of shape (n,), got float64 array of shape (5,)",
         ),

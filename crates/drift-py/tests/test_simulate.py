@@ -81,3 +81,25 @@ def test_same_bytes_as_the_command_line(tmp_path: Path) -> None:
     from_python = simulate_tiny(tmp_path / "py", 5)
     from_cli = tmp_path / "cli" / "recordings" / from_python.name
     assert from_cli.read_bytes() == from_python.read_bytes()
+
+
+def test_a_campaign_already_there_is_refused_unless_force(tmp_path: Path) -> None:
+    """One rule with the command line: a folder that is not empty is refused; `force=True`
+    replaces a campaign there, never anything else."""
+    first = simulate_tiny(tmp_path, 11).read_bytes()
+    with pytest.raises(
+        gyrodrift.InputError,
+        match=r"is not empty \(recordings, summary.json, truth\): simulating into it would mix two "
+        "campaigns; pass force=True to replace",
+    ):
+        gyrodrift.simulate(tmp_path, TINY_PROTOCOL, seed=12, **TINY)  # type: ignore[arg-type]
+    assert (tmp_path / "recordings" / "GIU-01_sp+30.0C_protocol.mcap").read_bytes() == first
+    gyrodrift.simulate(tmp_path, TINY_PROTOCOL, seed=12, force=True, **TINY)  # type: ignore[arg-type]
+    assert (tmp_path / "recordings" / "GIU-01_sp+30.0C_protocol.mcap").read_bytes() != first
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(
+        gyrodrift.InputError,
+        match=r"holds files `simulate` does not write \(notes.txt\): force=True replaces only a campaign",
+    ):
+        gyrodrift.simulate(tmp_path, TINY_PROTOCOL, seed=13, force=True, **TINY)  # type: ignore[arg-type]
+    assert (tmp_path / "notes.txt").read_text() == "mine"

@@ -51,7 +51,7 @@ def test_hierarchy() -> None:
         ),
         (
             {"temperature_raw": np.zeros((N, 3), dtype=np.float32)},
-            "`temperature_raw` must be an int16 array of shape (n, 3), got float32 array of shape (1000, 3) (convert with .astype(np.int16))",
+            "`temperature_raw` must be an int16 array of shape (n, 3), got float32 array of shape (1000, 3) (temperatures in °C? convert with np.round(settings.raw(celsius)).astype(np.int16); .astype(np.int16) would truncate °C to whole degrees)",
         ),
         (
             {"temperature_raw": np.zeros((N - 1, 3), dtype=np.int16)},

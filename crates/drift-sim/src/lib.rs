@@ -9,6 +9,7 @@ pub mod error;
 pub mod faults;
 pub mod hidden;
 pub mod motion;
+pub mod output_folder;
 pub mod overrides;
 mod rng;
 pub mod schedule;

@@ -44,6 +44,7 @@ pub struct Segment {
 /// it: every sample reads its flag as one mask, not a comparison and a select (3 instructions per
 /// axis on the Cortex-M4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[repr(u8)]
 pub enum SegmentKind {
     /// Before the first reference time: rises scaled, `k` held.

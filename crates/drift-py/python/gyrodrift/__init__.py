@@ -58,6 +58,7 @@ from ._gyrodrift import (
     simulate,
     summarise,
 )
+from .frames import correct_frame, results_frame
 from .tables import paper_table
 
 __all__ = [
@@ -92,6 +93,7 @@ __all__ = [
     "TableError",
     "__version__",
     "analyse",
+    "correct_frame",
     "evaluate",
     "excess_cut",
     "fit",
@@ -99,6 +101,7 @@ __all__ = [
     "paper_table",
     "report",
     "resolve_campaign",
+    "results_frame",
     "simulate",
     "summarise",
 ]

@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Final, Literal, final
+from typing import Any, Final, Literal, final, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -60,6 +60,8 @@ __all__ = [
     "StillnessLearner",
     "TableError",
     "__version__",
+    "_read_csv_text",
+    "_restore",
     "analyse",
     "evaluate",
     "excess_cut",
@@ -178,6 +180,13 @@ class Settings:
         """Identical raw readings in a row that mean a stuck sensor; 0 disables (default 2000)."""
     def celsius(self, raw: float) -> float:
         """A raw temperature reading in °C, computed in f32 as the corrector does."""
+    @overload
+    def raw(self, celsius: float) -> float: ...
+    @overload
+    def raw(self, celsius: Any) -> NDArray[np.float32]:
+        """Raw temperature readings from °C (f32): a float for a float, a float32 array for an
+        array-like (list, numpy array, pandas Series), to feed `power_on`/`correct_batch` a log in
+        °C."""
 
 @final
 class ModifiedTables:
@@ -716,6 +725,43 @@ class Recording:
         segments'; `metadata` adds to (and overrides) the default metadata record, except
         `unit_id` and `sample_rate_hz`. Raises `InputError`."""
     @staticmethod
+    def from_dataframe(
+        frame: Any,
+        *,
+        rate_unit: Literal["deg/s", "rad/s"],
+        time: str = "time",
+        time_unit: Literal["s", "ms"] | None = None,
+        rate: Sequence[str] = ("rate_x", "rate_y", "rate_z"),
+        temperature: str | Sequence[str] = "temperature",
+        activation: str | None = None,
+        gap_s: float | None = None,
+        sample_rate_hz: int | None = None,
+        max_gap_s: float | None = None,
+        unit_id: str = "dataframe",
+        set_point_celsius: float | None = None,
+        series_kind: Literal["protocol", "field"] = "protocol",
+        interval_min: float | None = None,
+        temperature_dropouts: bool = False,
+        name: str = "DataFrame",
+    ) -> Recording:
+        """A recording from a pandas DataFrame of a continuous log with one or several power-ons.
+
+        `time`: float s or ms (`time_unit` required), timedelta64 or datetime64; `rate`: three
+        columns in `rate_unit` (required: no default, so rad/s is never read as °/s);
+        `temperature`: one °C column (a single die sensor) or three. Activations: consecutive rows
+        with the same `activation` value, or split where the time steps by more than `gap_s`, or
+        the whole frame. `sample_rate_hz`: inferred from the median step when None; every row is
+        then one sample on the grid (`max_gap_s` None) or rows are interpolated onto it with steps
+        up to `max_gap_s`. Checked by `gyrodrift import`'s CSV reader: times that go back or
+        repeat, gaps, rates beyond 10,000 °/s and temperatures beyond ±163.8 °C (raw counts given
+        as °C) are refused with an `InputError` naming the row (the frame's n-th, from 1) and the
+        column. Split on `gap_s`, the activations are numbered 1, 2, … with the off-time before
+        each (`off_before_s`) measured from the log; `interval_min` labels them as a protocol
+        series at that off-time, which the fit needs to key its curves. Needs pandas."""
+    @staticmethod
+    def read_csv(path: _Path, *, rate_unit: Literal["deg/s", "rad/s"], **options: Any) -> Recording:
+        """`from_dataframe(pandas.read_csv(path), ...)`: the same options; errors name the file."""
+    @staticmethod
     def load(path: _Path) -> Recording:
         """Reads and validates an MCAP recording (the GIL is released). Raises `FileError`
         (missing or unreadable file) or `RecordingError` (naming file, topic and message index)."""
@@ -770,9 +816,12 @@ def simulate(
     effects: Sequence[str] | None = None,
     noise_scale: float | None = None,
     truth_at_aux_rate: bool = False,
+    force: bool = False,
 ) -> dict[str, Any]:
     """Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
-    does: the same campaign and seed give the same bytes. `campaign` is None (the paper's), a dict
+    does: the same campaign and seed give the same bytes. A folder that is not empty is refused
+    (`InputError`), as the command line refuses it; `force=True` replaces a campaign there (and
+    still refuses a folder holding other files). `campaign` is None (the paper's), a dict
     or TOML/JSON text (drift_sim::Campaign's fields), or a file path (os.PathLike; JSON if it ends in
     .json, else TOML). The keywords are the command line's flags (`set_points` also takes its text,
     "30,40,33" or "-40:60:10"). Returns the run's summary. The GIL is released while simulating.
@@ -1149,3 +1198,24 @@ def excess_cut(before: _Floats, after: _Floats, floor: _Floats) -> tuple[float, 
     seeded bootstrap of 2000 draws, so the same data give the same interval). Raises `InputError`
     for an array that is empty, not finite (naming the index), or `after` not as long as
     `before`."""
+
+def _restore(kind: str, version: str, state: bytes) -> Any:
+    """Rebuilds a pickled object (what `__reduce__` names)."""
+
+def _read_csv_text(
+    data: bytes,
+    name: str,
+    *,
+    time: str,
+    rate: Sequence[str],
+    temperature: Sequence[str],
+    activation: str | None,
+    rate_unit: str,
+    unit_id: str,
+    sample_rate_hz: int,
+    max_gap_s: float | None,
+    set_point_celsius: float | None,
+    series_kind: str,
+    temperature_dropouts: bool,
+) -> Recording:
+    """CSV text through the command line's validating reader (`Recording.from_dataframe`)."""
