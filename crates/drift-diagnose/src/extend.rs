@@ -856,19 +856,27 @@ pub fn extend(
             let level = ADMIT_ALPHA / (3 * plan.terms.len()).max(1) as f64;
             let drift_before =
                 gains.iter().map(|g| g.drift_before).sum::<f64>() / gains.len().max(1) as f64;
-            // Where the diagnosis found the term significant, the burden is on refusing it: it
-            // is admitted unless the held-out folds say it makes things worse, on the metric it
-            // is for or on the other one (one-sided, 5 %). A right, significant candidate that
-            // waited for a Bonferroni-level gain of its own on a few dozen activations went
-            // unadmitted on every axis it was found on.
+            // Where the diagnosis found the term significant, it needs no significance of its
+            // own on the held-out folds: it is admitted unless they say it makes things worse —
+            // a mean loss on the metric it is for, or a significant one (one-sided, 5 %) on the
+            // other. A right, significant candidate that waited for a Bonferroni-level gain of its
+            // own on a few dozen activations went unadmitted on every axis it was found on; one
+            // admitted on "not significantly worse" alone let a neighbour's rise and rise² in
+            // where the element's lag was the effect (their held-out drift went up, by little).
             let squared_worse = improvement < 0.0 && 1.0 - p_value < ADMIT_ALPHA;
             let drift_worse =
                 drift_gain < -0.01 * drift_before && 1.0 - drift_p_value < ADMIT_ALPHA;
             if chosen.found_on[axis] {
-                let admit = !squared_worse && !drift_worse;
+                let (own_gain, own_metric) = if changes_shape(chosen.term) {
+                    (drift_gain, "drift")
+                } else {
+                    (improvement, "squared residual")
+                };
+                let admit = own_gain > 0.0 && !squared_worse && !drift_worse;
                 let reason = if admit {
-                    "significant in the diagnosis on this axis, and no worse on the held-out folds"
-                        .to_owned()
+                    format!("significant in the diagnosis on this axis, and lowers the held-out {own_metric}")
+                } else if own_gain <= 0.0 {
+                    format!("significant in the diagnosis, but the held-out {own_metric} does not fall with it")
                 } else if drift_worse {
                     format!(
                         "significant in the diagnosis, but raises the held-out drift by {:.2e} °/s (p {:.3})",
