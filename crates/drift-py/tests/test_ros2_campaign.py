@@ -42,11 +42,6 @@ def known_slope() -> float:
     return float(module.SLOPE_DPS_PER_C)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the analysis windows are sample counts sized for 1 kHz (a 10-s low-pass at 100 Hz); "
-    "passes once they are durations in seconds",
-)
 def test_bags_written_by_rosbags_import_fit_and_report_with_the_known_slope(tmp_path: Path) -> None:
     gyrodrift = binary()
     bags, check = tmp_path / "bags", tmp_path / "check-bags"
