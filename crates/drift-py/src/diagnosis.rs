@@ -120,7 +120,6 @@ pub fn diagnose_unit(
     calibration: Option<&Bound<'_, PyAny>>,
     asked: Asked,
 ) -> PyResult<PyDiagnosis> {
-    let extend = asked.extend;
     let source = sources::source(py, "segments", segments)?;
     let set_points = match calibration {
         Some(v) if !v.is_none() => sources::set_points("calibration", v, false)?,
@@ -130,7 +129,38 @@ pub fn diagnose_unit(
             .map(|s| s.set_point_celsius)
             .collect(),
     };
-    let diagnosis = py.detach(|| -> Result<PyDiagnosis, Error> {
+    // The loop runs on a thread of its own with a stack sized for it: its host types (tables of
+    // every model, refitted per candidate and fold) are values of hundreds of KB, and on the
+    // interpreter's main thread, whose stack Python's own frames share, they overflowed it.
+    let diagnosis = py.detach(|| {
+        std::thread::scope(|scope| {
+            std::thread::Builder::new()
+                .name("gyrodrift-diagnose".into())
+                .stack_size(LOOP_STACK_BYTES)
+                .spawn_scoped(scope, || {
+                    run_loop(unit, settings, source, &set_points, &asked)
+                })
+                .map_err(|e| Error::Input(format!("internal: starting the loop's thread: {e}")))?
+                .join()
+                .map_err(|_| Error::Input("internal: the closed loop's thread panicked".into()))?
+        })
+    })?;
+    Ok(diagnosis)
+}
+
+/// Stack of the closed loop's thread, bytes (reserved address space, not memory in use).
+const LOOP_STACK_BYTES: usize = 256 << 20;
+
+/// The loop itself, off the interpreter's thread.
+fn run_loop(
+    unit: &FittedUnit,
+    settings: &FitSettings,
+    source: Source,
+    set_points: &[f64],
+    asked: &Asked,
+) -> Result<PyDiagnosis, Error> {
+    let extend = asked.extend;
+    {
         let all = activations(source)?;
         let own: Vec<&Segment> = all
             .iter()
@@ -148,7 +178,7 @@ pub fn diagnose_unit(
             extend,
             diagnose_on: asked.diagnose_on.clone(),
             half: asked.half,
-            ..LoopOptions::new(&set_points)
+            ..LoopOptions::new(set_points)
         };
         options
             .bench_channels
@@ -160,7 +190,10 @@ pub fn diagnose_unit(
                 unit.unit_id
             )));
         }
-        let admitted = closed.extended.as_ref().filter(|e| !e.plan.terms.is_empty());
+        let admitted = closed
+            .extended
+            .as_ref()
+            .filter(|e| !e.plan.terms.is_empty());
         // The loop's model differs from the paper's when a term was admitted, or stage 3 or the
         // initial bias reads the heating history on an axis.
         let changed = admitted.is_some() || closed.keying.any();
@@ -219,8 +252,7 @@ pub fn diagnose_unit(
             .map(|(name, n)| (name.to_owned(), n))
             .to_vec(),
         })
-    })?;
-    Ok(diagnosis)
+    }
 }
 
 #[pymethods]
