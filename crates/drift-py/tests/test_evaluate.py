@@ -27,8 +27,10 @@ def test_records_cover_every_split_model_and_axis(evaluation: gyrodrift.Evaluati
         "standard",
         "3rd-order",
         "relative",
+        "relative-cubic",
         "modified",
         "by-history",
+        "recommended",
     }
     assert {r["axis"] for r in records} == {"X", "Y", "Z"}
     assert len(evaluation.fitted) == 1 and len(evaluation.calibration) == 24
@@ -57,8 +59,10 @@ def test_per_activation_evaluation_and_summarise_agree(
         "standard",
         "3rd-order",
         "relative",
+        "relative-cubic",
         "modified",
         "by-history",
+        "recommended",
     }
     expected = [r for r in evaluation.records if r["split"] == "validation"]
     assert gyrodrift.summarise(results) == expected

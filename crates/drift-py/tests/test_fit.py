@@ -62,7 +62,7 @@ def test_fitted_models_save_like_the_command_line(campaign_dir: Path, tmp_path: 
     assert folder == tmp_path / "GIU-01"
     names = sorted(
         f"{model}.{kind}"
-        for model in ("modified", "by_history", "standard", "third_order", "relative")
+        for model in ("recommended", "modified", "by_history", "standard", "third_order", "relative")
         for kind in ("bin", "json")
     )
     assert sorted(p.name for p in folder.iterdir()) == names

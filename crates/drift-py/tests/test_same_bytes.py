@@ -32,7 +32,7 @@ def test_fit_and_save_write_the_same_tables_folder(campaign_dir: Path, tmp_path:
     written = files(tmp_path / "cli")
     assert set(written) == {
         f"GIU-01/{model}.{ext}"
-        for model in ("modified", "by_history", "standard", "third_order", "relative")
+        for model in ("recommended", "modified", "by_history", "standard", "third_order", "relative")
         for ext in ("json", "bin")
     }
     assert written == files(tmp_path / "py")
