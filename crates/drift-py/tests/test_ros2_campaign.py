@@ -3,7 +3,8 @@
 (20 s each here; the full-size 2-min campaign is measured in docs/measured.md), labelled by an
 activation sheet, go `import campaign` → `fit` → `report`, and the fitted drift has the slope the
 bags were written with. What `export ros2` writes opens in `rosbags`' AnyReader, and a bag whose
-messages rosbag2 compressed is refused with the word "compressed". Needs the CLI binary: GYRODRIFT_BIN (scripts/check-python.sh sets it).
+messages rosbag2 compressed is refused with the word "compressed". Needs the CLI binary:
+GYRODRIFT_BIN (scripts/check-python.sh sets it).
 """
 
 from __future__ import annotations
