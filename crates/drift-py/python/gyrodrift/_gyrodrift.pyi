@@ -472,9 +472,7 @@ class StillnessLearner:
         """Clears the still detector and keeps the offset (call it at switch-on)."""
     def accelerometer(self, accel_g: _Floats3) -> None:
         """One accelerometer reading, g, at `accel_rate_hz`; a non-finite reading is skipped."""
-    def update(
-        self, rate_dps: _Floats3
-    ) -> tuple[tuple[float, float, float], bool, bool]:
+    def update(self, rate_dps: _Floats3) -> tuple[tuple[float, float, float], bool, bool]:
         """One rate sample, °/s: `(rate less the offset learned before it, still, learning)`."""
     def update_batch(
         self,
@@ -1095,9 +1093,9 @@ class FittedUnit:
         *,
         calibration: Sequence[float] | str | None = None,
         extend: bool = False,
-        diagnose_on: Sequence[float] = (),
+        diagnose_on: Sequence[float] = ...,
         half: int = 0,
-        bench_channels: Sequence[str] = (),
+        bench_channels: Sequence[str] = ...,
     ) -> Diagnosis:
         """Diagnoses what the paper's model leaves in the residual of this unit's activations among
         `segments` (recordings, segments or files; other units' activations are skipped), as

@@ -24,7 +24,7 @@ _RATE_UNITS = ("deg/s", "rad/s")
 
 def _pandas() -> Any:
     try:
-        import pandas
+        import pandas  # type: ignore[import-untyped]
     except ImportError as error:
         raise ImportError(
             f"gyrodrift's DataFrame functions need pandas (pip install pandas): {error}"
