@@ -298,14 +298,15 @@ impl LoopOptions {
 }
 
 /// The roles of one source: split, the training outside the ambient range held out, the
-/// selection and the diagnosis half moved in (`diagnosis_data`: activations of another source
-/// that are the analyst's diagnosis data whatever their set point).
+/// selection and the diagnosis series of `half` moved in (`diagnosis_data`: activations of
+/// another source that are the analyst's diagnosis data whatever their set point).
 fn roles_of<'a>(
     fitted: &FittedUnit,
     source: &[&'a Segment],
     diagnosis_data: &[&'a Segment],
     options: &LoopOptions,
     settings: &FitSettings,
+    half: usize,
 ) -> Roles<'a> {
     let mut roles = Roles::split(source.iter().copied(), &options.calibration_set_points);
     roles.hold_out_outside_range(fitted, settings);
@@ -319,7 +320,7 @@ fn roles_of<'a>(
                     &options.diagnose_on,
                 )
         };
-        roles.diagnose_on(named, options.half);
+        roles.diagnose_on(named, half);
     }
     roles
 }
@@ -403,13 +404,7 @@ fn close_each<'a>(
 ) -> Result<Vec<Closed<'a>>, FitError> {
     let roles = halves
         .iter()
-        .map(|&half| {
-            let options = LoopOptions {
-                half,
-                ..options.clone()
-            };
-            roles_of(fitted, source, diagnosis_data, &options, settings)
-        })
+        .map(|&half| roles_of(fitted, source, diagnosis_data, options, settings, half))
         .collect();
     // The unit's whole life in order, as its firmware would have lived it: every activation
     // passes what it kept on to the next.
@@ -499,11 +494,7 @@ fn close_separate_each<'a>(
     let roles: Vec<Roles> = halves
         .iter()
         .map(|&half| {
-            let options = LoopOptions {
-                half,
-                ..options.clone()
-            };
-            let mut roles = roles_of(fitted, &source, diagnosis_data, &options, settings);
+            let mut roles = roles_of(fitted, &source, diagnosis_data, options, settings, half);
             roles.not_judged = std::mem::replace(&mut roles.held_out, evaluation.clone());
             roles
         })

@@ -866,7 +866,7 @@ pub fn extend(
             let squared_worse = improvement < 0.0 && 1.0 - p_value < ADMIT_ALPHA;
             let drift_worse =
                 drift_gain < -0.01 * drift_before && 1.0 - drift_p_value < ADMIT_ALPHA;
-            if chosen.found_on[axis] {
+            let (admit, reason) = if chosen.found_on[axis] {
                 let (own_gain, own_metric) = if changes_shape(chosen.term) {
                     (drift_gain, "drift")
                 } else {
@@ -890,46 +890,14 @@ pub fn extend(
                         1.0 - p_value
                     )
                 };
-                if admit {
-                    admitted[axis].push(t);
-                }
-                admissions.push(Admission {
-                    candidate: chosen.candidate.clone(),
-                    axis: AXIS_NAMES[axis],
-                    improvement,
-                    p_value,
-                    drift_gain_dps: drift_gain,
-                    drift_p_value,
-                    admitted: admit,
-                    reason,
-                });
-                continue;
-            }
-            // Each kind is tested on the metric it is for, and refused when it costs the other
-            // one significantly (one-sided, 5 %).
-            let admit = if changes_shape(chosen.term) {
-                // A shape within activations (the element's heating rate, rise², another axis's
-                // rise) lowers the drift of every activation while its share of the squared
-                // residual, which the offsets between activations dominate, stays in the noise.
-                drift_p_value < level && drift_gain > 0.0 && !squared_worse
+                (admit, reason)
             } else {
-                // An auxiliary input moves offsets (supply, orientation), which the drift cannot
-                // see; it may add wiggles within activations: refused when the drift gets worse
-                // by more than 1 %. Not "no worse on average": an offset term leaves the metric
-                // alone up to noise, and a refit moves it consistently by ~1e-7 °/s.
-                p_value < level && improvement > 0.0 && !drift_worse
-            };
-            let (metric, p) = if changes_shape(chosen.term) {
-                ("drift", drift_p_value)
-            } else {
-                ("squared residual", p_value)
-            };
-            let reason = if admit {
-                format!("not found on this axis, but lowers the held-out {metric} (p {p:.1e} < {level:.1e})")
-            } else if squared_worse || drift_worse {
-                "not found on this axis, and makes the held-out data worse".to_owned()
-            } else {
-                format!("not found on this axis, and its held-out {metric} gain is not significant (p {p:.3}, needs < {level:.1e} over every term and axis)")
+                not_found_admission(
+                    changes_shape(chosen.term),
+                    (improvement, p_value, squared_worse),
+                    (drift_gain, drift_p_value, drift_worse),
+                    level,
+                )
             };
             if admit {
                 admitted[axis].push(t);
@@ -965,6 +933,47 @@ pub fn extend(
         admissions,
         refitted,
     })
+}
+
+/// The guard's decision, and why, for a term on an axis whose diagnosis did not find it: each kind
+/// is tested on the metric it is for, at `level`, and refused when it costs the other one
+/// significantly. `squared` and `drift`: each metric's held-out gain, its one-sided p-value and
+/// whether it got significantly worse.
+fn not_found_admission(
+    shape: bool,
+    squared: (f64, f64, bool),
+    drift: (f64, f64, bool),
+    level: f64,
+) -> (bool, String) {
+    let ((improvement, p_value, squared_worse), (drift_gain, drift_p_value, drift_worse)) =
+        (squared, drift);
+    let admit = if shape {
+        // A shape within activations (the element's heating rate, rise², another axis's rise)
+        // lowers the drift of every activation while its share of the squared residual, which
+        // the offsets between activations dominate, stays in the noise.
+        drift_p_value < level && drift_gain > 0.0 && !squared_worse
+    } else {
+        // An auxiliary input moves offsets (supply, orientation), which the drift cannot see; it
+        // may add wiggles within activations: refused when the drift gets worse by more than
+        // 1 %. Not "no worse on average": an offset term leaves the metric alone up to noise, and
+        // a refit moves it consistently by ~1e-7 °/s.
+        p_value < level && improvement > 0.0 && !drift_worse
+    };
+    let (metric, p) = if shape {
+        ("drift", drift_p_value)
+    } else {
+        ("squared residual", p_value)
+    };
+    let reason = if admit {
+        format!(
+            "not found on this axis, but lowers the held-out {metric} (p {p:.1e} < {level:.1e})"
+        )
+    } else if squared_worse || drift_worse {
+        "not found on this axis, and makes the held-out data worse".to_owned()
+    } else {
+        format!("not found on this axis, and its held-out {metric} gain is not significant (p {p:.3}, needs < {level:.1e} over every term and axis)")
+    };
+    (admit, reason)
 }
 
 /// `segment` with the extension's contribution taken out of its rates (what the tables should
