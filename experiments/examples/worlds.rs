@@ -5,8 +5,13 @@
 //! ```sh
 //! cargo run --release -p experiments --example worlds -- [--families all|humidity,…] \
 //!     [--worlds-per-family 20] [--null-worlds 30] [--first-seed 10000] [--jobs 1] \
-//!     [--out table.md] [--json scores.jsonl] [--small] [--select-on-validation]
+//!     [--out table.md] [--json scores.jsonl] [--small] [--select-on-validation] \
+//!     [--diagnosis-series 20]
 //! ```
+//!
+//! `--diagnosis-series N` records, per world, an analyst's diagnosis campaign beside the
+//! calibration one (N ramped field series of 5 at +33 °C) and diagnoses on it, cross-fitted by
+//! series.
 //!
 //! World k of every family (and null world k) is drawn from seed `first-seed + k`: the same unit
 //! and structure, different effects. Each world is recorded in a child process, its loop run in
@@ -26,7 +31,7 @@ use experiments::worlds::{
 
 const USAGE: &str = "worlds [--families all|accelerometer,humidity,…] [--worlds-per-family 20] \
 [--null-worlds 30] [--first-seed 10000] [--jobs 1] [--out table.md] [--json scores.jsonl] [--small] \
-[--select-on-validation]";
+[--select-on-validation] [--diagnosis-series 20]";
 
 /// The value after `flag`.
 fn value(args: &[String], flag: &str) -> Option<String> {
@@ -44,6 +49,9 @@ where
             .with_context(|| format!("{flag}: cannot read `{s}`"))
     })
 }
+
+/// Stack of a child's worker thread, bytes (reserved address space, not memory in use).
+const CHILD_STACK_BYTES: usize = 256 << 20;
 
 /// The last line of a child's standard output, as JSON.
 fn child<T: serde::de::DeserializeOwned>(args: &[&str]) -> anyhow::Result<T> {
@@ -68,19 +76,27 @@ fn one_world(
     work: &Path,
     small: bool,
     select: bool,
+    diagnosis_series: u32,
 ) -> anyhow::Result<WorldScore> {
     let paths = WorldPaths::new(work, kind, seed);
     let small_flag = if small { "yes" } else { "no" };
     let select_flag = if select { "yes" } else { "no" };
     let seed_text = seed.to_string();
     let work_text = work.display().to_string();
+    let series_text = diagnosis_series.to_string();
     let recorded: anyhow::Result<Recorded> = child(&[
         "--child-record",
         kind.name(),
         &seed_text,
         &work_text,
         small_flag,
+        &series_text,
     ]);
+    let diagnosis_text = if diagnosis_series > 0 {
+        paths.diagnosis_dir.display().to_string()
+    } else {
+        "-".to_owned()
+    };
     let outcome: anyhow::Result<Outcome> = match &recorded {
         Ok(_) => child(&[
             "--child-loop",
@@ -88,6 +104,7 @@ fn one_world(
             &paths.floor_dir.display().to_string(),
             small_flag,
             select_flag,
+            &diagnosis_text,
         ]),
         Err(_) => Err(anyhow::anyhow!("not recorded")),
     };
@@ -100,9 +117,9 @@ fn one_world(
     result
 }
 
-/// A child's part: `--child-record <kind> <seed> <work> <yes|no>` records one world;
-/// `--child-loop <world dir> <floor dir> <small: yes|no> <select on +33 °C: yes|no>` closes the
-/// loop on the two recordings folders.
+/// A child's part: `--child-record <kind> <seed> <work> <small: yes|no> <diagnosis series>`
+/// records one world; `--child-loop <world dir> <floor dir> <small: yes|no> <select on +33 °C:
+/// yes|no> <diagnosis dir or ->` closes the loop on the recordings folders.
 fn child_part(args: &[String]) -> anyhow::Result<()> {
     let small = |i: usize| args.get(i).is_some_and(|s| s == "yes");
     let arg = |i: usize| args.get(i).context("missing a child argument");
@@ -110,15 +127,18 @@ fn child_part(args: &[String]) -> anyhow::Result<()> {
         let kind = Kind::parse(arg(1)?)?;
         let seed: u64 = arg(2)?.parse()?;
         let paths = WorldPaths::new(Path::new(arg(3)?), kind, seed);
-        serde_json::to_string(&record(kind, seed, &paths, small(4))?)?
+        let series: u32 = arg(5)?.parse()?;
+        serde_json::to_string(&record(kind, seed, &paths, small(4), series)?)?
     } else {
         // Sees the two recordings folders and nothing else.
         let settings = fit_settings();
+        let diagnosis = arg(5)?;
         serde_json::to_string(&close_blind(
             Path::new(arg(1)?),
             Path::new(arg(2)?),
             &settings,
             small(4),
+            (diagnosis != "-").then(|| Path::new(diagnosis)),
         )?)?
     };
     println!("{line}");
@@ -131,7 +151,14 @@ fn main() -> anyhow::Result<()> {
         .first()
         .is_some_and(|a| a == "--child-record" || a == "--child-loop")
     {
-        return child_part(&args);
+        // The loop's tables live on the stack as in the command line's worker (src/main.rs):
+        // the main thread's 8 MiB overflowed on some worlds.
+        return std::thread::Builder::new()
+            .name("worlds-child".into())
+            .stack_size(CHILD_STACK_BYTES)
+            .spawn(move || child_part(&args))?
+            .join()
+            .unwrap_or_else(|_| Err(anyhow::anyhow!("the child's work panicked")));
     }
     if args.iter().any(|a| a == "--help" || a == "-h") {
         let names: Vec<&str> = EffectFamily::ALL.iter().map(|f| f.name()).collect();
@@ -145,7 +172,8 @@ fn main() -> anyhow::Result<()> {
         .iter()
         .filter(|a| *a != "--small" && *a != "--select-on-validation")
         .collect();
-    const FLAGS: [&str; 7] = [
+    const FLAGS: [&str; 8] = [
+        "--diagnosis-series",
         "--families",
         "--worlds-per-family",
         "--null-worlds",
@@ -175,10 +203,15 @@ fn main() -> anyhow::Result<()> {
     let nulls: u64 = number(&args, "--null-worlds", 30)?;
     let first: u64 = number(&args, "--first-seed", DEFAULT_FIRST_SEED)?;
     let jobs: usize = number(&args, "--jobs", 1usize)?.max(1);
+    let diagnosis_series: u32 = number(&args, "--diagnosis-series", 0)?;
     let out: Option<PathBuf> = value(&args, "--out").map(PathBuf::from);
     // Every world's score with its whole ranking, one JSON line each: what the significance
     // threshold is calibrated from (experiments/null_threshold.py).
     let json: Option<PathBuf> = value(&args, "--json").map(PathBuf::from);
+    if let Some(path) = &json {
+        // Lines are appended world by world (below): start the file empty.
+        std::fs::write(path, "").with_context(|| format!("writing {}", path.display()))?;
+    }
 
     let mut kinds: Vec<Kind> = families.iter().map(|&f| Kind::Effect(f)).collect();
     if nulls > 0 {
@@ -221,13 +254,28 @@ fn main() -> anyhow::Result<()> {
             s.spawn(|| loop {
                 let next = queue.lock().map(|mut q| q.next()).ok().flatten();
                 let Some((kind, seed)) = next else { break };
-                let result = one_world(kind, seed, work.path(), small, select);
+                let result = one_world(kind, seed, work.path(), small, select, diagnosis_series);
                 let mut guard = match results.lock() {
                     Ok(g) => g,
                     Err(p) => p.into_inner(),
                 };
                 match result {
                     Ok(score) => {
+                        // Each world's line as soon as it is scored: a long run stopped early
+                        // keeps what it measured.
+                        if let Some(path) = &json {
+                            let line = serde_json::to_string(&score).unwrap_or_default();
+                            let appended = std::fs::OpenOptions::new()
+                                .create(true)
+                                .append(true)
+                                .open(path)
+                                .and_then(|mut f| {
+                                    std::io::Write::write_all(&mut f, (line + "\n").as_bytes())
+                                });
+                            if let Err(e) = appended {
+                                eprintln!("writing {}: {e}", path.display());
+                            }
+                        }
                         for line in world_lines(&score) {
                             eprintln!("{line}");
                         }
@@ -267,14 +315,6 @@ fn main() -> anyhow::Result<()> {
     println!("{text}");
     for f in &failures {
         println!("- failed: {} seed {}: {}", f.kind, f.seed, f.error);
-    }
-    if let Some(path) = json {
-        let lines: Vec<String> = scores
-            .iter()
-            .map(serde_json::to_string)
-            .collect::<Result<_, _>>()?;
-        std::fs::write(&path, lines.join("\n") + "\n")
-            .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = out {
         let mut body = text;

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use drift_diagnose::closing::{close, LoopOptions};
+use drift_diagnose::closing::{close, close_both, LoopOptions};
 use drift_diagnose::roles::Roles;
 use drift_evaluate::evaluate;
 use drift_evaluate::excess::{excess_cut, ExcessCut};
@@ -132,6 +132,8 @@ pub struct WorldPaths {
     pub dir: PathBuf,
     /// The zero-drift twin's campaign.
     pub floor_dir: PathBuf,
+    /// The analyst's diagnosis campaign, when one is recorded.
+    pub diagnosis_dir: PathBuf,
     /// The truth file (outside both).
     pub truth: PathBuf,
 }
@@ -143,6 +145,7 @@ impl WorldPaths {
         Self {
             dir: work.join(&name).join("world"),
             floor_dir: work.join(&name).join("floor"),
+            diagnosis_dir: work.join(&name).join("diagnosis"),
             truth: work.join("truth").join(format!("{name}.json")),
         }
     }
@@ -175,7 +178,17 @@ pub struct Recorded {
 /// twin's (field sessions at +33 °C, behind a one-series protocol the campaign needs) into
 /// `paths.floor_dir`, and writes the truth to `paths.truth`. The simulator's truth sidecars are
 /// deleted: the recordings folders are all the loop can read.
-pub fn record(kind: Kind, seed: u64, paths: &WorldPaths, small: bool) -> anyhow::Result<Recorded> {
+///
+/// With `diagnosis_series` > 0 the unit also records an analyst's diagnosis campaign into
+/// `paths.diagnosis_dir`: that many ramped field series of 5 activations at the validation set
+/// point (no protocol), on a schedule of its own.
+pub fn record(
+    kind: Kind,
+    seed: u64,
+    paths: &WorldPaths,
+    small: bool,
+    diagnosis_series: u32,
+) -> anyhow::Result<Recorded> {
     let started = Instant::now();
     let plan = world_campaign(small);
     let world = World::draw(seed, &kind.spec());
@@ -191,7 +204,22 @@ pub fn record(kind: Kind, seed: u64, paths: &WorldPaths, small: bool) -> anyhow:
     }
     twin.simulate(&floor, &paths.floor_dir, |_| {})
         .context("simulating the zero-drift twin")?;
-    for dir in [&paths.dir, &paths.floor_dir] {
+    if diagnosis_series > 0 {
+        let mut diagnosis = world.campaign(&plan);
+        diagnosis.name = "diagnosis".into();
+        // Its own schedule and noise: the diagnosis campaign is another day on the bench.
+        diagnosis.seed ^= 0x00D1_A600;
+        diagnosis.set_points_celsius = vec![VALIDATION];
+        diagnosis.protocol = None;
+        if let Some(field) = &mut diagnosis.field {
+            field.sessions = diagnosis_series;
+            field.activations = 5;
+        }
+        world
+            .simulate(&diagnosis, &paths.diagnosis_dir, |_| {})
+            .context("simulating the diagnosis campaign")?;
+    }
+    for dir in [&paths.dir, &paths.floor_dir, &paths.diagnosis_dir] {
         let _ = std::fs::remove_dir_all(dir.join(TRUTH_DIR));
     }
     if let Some(parent) = paths.truth.parent() {
@@ -267,11 +295,16 @@ fn is(set_point: f64, value: f64) -> bool {
 /// (`floor_dir`) and nothing else.
 /// With `select_on_validation`, the +33 °C protocol activations join the diagnosis
 /// (`Roles::select`); the before/after is on the +33 °C field activations either way.
+///
+/// With `diagnosis_dir` (an analyst's diagnosis campaign) the loop diagnoses on it, cross-fitted
+/// by series (`closing::close_both`); the outcome is the first half's, judged on held-out series
+/// that include the other half.
 pub fn close_blind(
     dir: &Path,
     floor_dir: &Path,
     settings: &FitSettings,
     select_on_validation: bool,
+    diagnosis_dir: Option<&Path>,
 ) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let all = segments(&dir.join(RECORDINGS_DIR))?;
@@ -291,7 +324,19 @@ pub fn close_blind(
         select_on: selection.to_vec(),
         ..LoopOptions::new(&CALIBRATION)
     };
-    let closed = close(&base, &all, &[], &options, settings)?;
+    let diagnosis = match diagnosis_dir {
+        Some(d) => segments(&d.join(RECORDINGS_DIR))?,
+        None => Vec::new(),
+    };
+    let diagnosis: Vec<&Segment> = diagnosis.iter().collect();
+    let closed = if diagnosis.is_empty() {
+        close(&base, &all, &[], &options, settings)?
+    } else {
+        close_both(&base, &all, &diagnosis, &options, settings)?
+            .into_iter()
+            .next()
+            .context("the cross-fitted loop closed no half")?
+    };
     let measured: Vec<_> = closed
         .before_after(&base, settings)
         .into_iter()
@@ -556,11 +601,11 @@ pub fn score(
 /// the memory figures): record, close blind, score, then delete the world's files.
 pub fn run_world(kind: Kind, seed: u64, work: &Path, small: bool) -> anyhow::Result<WorldScore> {
     let paths = WorldPaths::new(work, kind, seed);
-    let recorded = record(kind, seed, &paths, small);
+    let recorded = record(kind, seed, &paths, small, 0);
     let outcome = recorded
         .as_ref()
         .ok()
-        .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(), false));
+        .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(), false, None));
     paths.remove_recordings();
     let result = match (recorded, outcome) {
         (Ok(r), Some(Ok(o))) => score(kind, seed, &paths.truth, &r, &o),

@@ -285,22 +285,38 @@ fn profile_markdown(profiles: &[Profile]) -> String {
 
 /// The ranking as Markdown.
 pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
-    let mut md = String::from("## Diagnosis of the residual after the loop's model (stage 3 and the initial bias as chosen above)\n\nCandidates ranked by out-of-sample explained share of the residual's variance (cross-validated with whole series held out together, at the better of two levels: shapes within activations, offsets between them; 0 when the folds' coefficients disagree in sign), each stripped first of what the paper's model already accounts for: the paper's tables are fitted to the candidate itself on the calibration activations, and what they predict of it is taken out (the column “absorbed by the model” is the share of the candidate's variance they predict). Significant: family-wise α = 0.05 by shuffling — the candidates are shuffled among activations of the same unit and set point 99 times, and a candidate is significant when the best of all candidates reached its share in at most 5 % of the shuffles (p family). *Detectable*: the share a candidate must exceed to be significant with these activations; a smaller effect cannot be told from chance here. The per-activation t-tests at the candidate's level (p) and on the whole residual (p whole: offsets and shape together, what a firmware term changes) are shown, not gated on.\n\n");
+    let mut md = String::from("## Diagnosis of the residual after the loop's model (stage 3 and the initial bias as chosen above)\n\nFirst the **baseline**, fitted before any candidate and never a discovery: the paper model's known ambient gap (the tables read at the chamber air logged at switch-on, less the paper's reading at the switch-on temperature) and the bench's context channels (the chamber air, alone and times the rise and the temperature). Then each candidate, stripped first of what the paper's model already accounts for (the paper's tables are fitted to the candidate itself on the calibration activations with the drift fit's reference times, and what they predict of it is taken out: “absorbed by the model”), is scored by its **gain**: the out-of-sample share of the residual's variance it explains beyond the baseline (cross-validated with whole series held out together, at the better of two levels: shapes within activations, offsets between them; 0 when the folds' coefficients disagree in sign). **Selection** is forward: the best candidate is selected when it is significant family-wise (α = 0.05: whole series' candidates are shuffled onto other series of the same unit and set point 99 times, and the best of all candidates reached its gain in at most 5 % of the shuffles: p family) **and** its gain reaches the size threshold τ (the 95th percentile of the top gain on null worlds for this many activations); it then joins the baseline and the rest are scored again, up to four. *Detectable*: the larger of chance's 5 % level and τ. The per-activation t-tests at the candidate's level (p) and on the whole residual (p whole), on what the baseline leaves, are shown, not gated on.\n\n");
     for axis in axes {
         let _ = writeln!(
             md,
-            "### Axis {} ({} activations, residual RMS {:.4} °/s, detectable share {:.3}): {}\n",
+            "### Axis {} ({} activations, residual RMS {:.4} °/s, detectable gain {:.3}, τ {:.3}): {}\n",
             axis.axis,
             axis.activations,
             axis.residual_rms_dps,
             axis.detectable_share,
-            axis.chosen()
-                .map_or("nothing beyond chance".to_owned(), |c| format!(
-                    "**{}**",
-                    c.name
-                ))
+            axis.size_threshold,
+            if axis.selected.is_empty() {
+                "nothing beyond the baseline and chance".to_owned()
+            } else {
+                axis.selected
+                    .iter()
+                    .map(|s| format!("**{}** (gain {:.3}, p family {:.2})", s.name, s.gain, s.family_p_value))
+                    .collect::<Vec<_>>()
+                    .join(", then ")
+            }
         );
-        md.push_str("| rank | candidate | level | explained | p family | p | p whole | significant | coefficient | absorbed by the model |\n|---:|---|---|---:|---:|---:|---:|:---:|---:|---:|\n");
+        let _ = writeln!(
+            md,
+            "Baseline: {} — explains {:.3} of the residual's variance within activations and {:.3} of the activations' means, out of sample.\n",
+            if axis.baseline.is_empty() {
+                "none (no chamber air logged)".to_owned()
+            } else {
+                axis.baseline.join("; ")
+            },
+            axis.baseline_explained_within,
+            axis.baseline_explained_between
+        );
+        md.push_str("| rank | candidate | level | gain | p family | p | p whole | selected | coefficient | absorbed by the model |\n|---:|---|---|---:|---:|---:|---:|:---:|---:|---:|\n");
         for (i, c) in axis.ranking.iter().take(top).enumerate() {
             let _ = writeln!(
                 md,
@@ -749,26 +765,31 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         }
         for axis in axes.iter() {
-            let chosen = axis.chosen().map_or_else(
-                || {
-                    format!(
-                        "nothing beyond chance (with these activations only an effect explaining more than {:.0} % of the residual would show)",
-                        100.0 * axis.detectable_share
-                    )
-                },
-                |c| {
-                    format!(
-                        "{} (explains {:.0} %; chance reaches {:.0} % in 5 % of shuffles)",
-                        c.name,
-                        100.0 * c.explained,
-                        100.0 * axis.detectable_share
-                    )
-                },
-            );
+            let chosen = if axis.selected.is_empty() {
+                format!(
+                    "nothing beyond the baseline (which explains {:.0} % within activations) and chance: with these activations only a gain above {:.0} % would show",
+                    100.0 * axis.baseline_explained_within,
+                    100.0 * axis.detectable_share
+                )
+            } else {
+                axis.selected
+                    .iter()
+                    .map(|c| {
+                        format!(
+                            "{} (gain {:.0} % over the baseline; τ {:.0} %, p family {:.2})",
+                            c.name,
+                            100.0 * c.gain,
+                            100.0 * axis.size_threshold,
+                            c.family_p_value
+                        )
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", then ")
+            };
             println!("  {}: {chosen}", axis.axis);
             for (i, c) in axis.ranking.iter().take(args.top).enumerate() {
                 println!(
-                    "     {}. {:<42} {:<20} explained {:>6.3}  p family {:.2}{}",
+                    "     {}. {:<42} {:<20} gain {:>6.3}  p family {:.2}{}",
                     i + 1,
                     c.name,
                     c.level,

@@ -39,13 +39,17 @@ pub const REFERENCE_CELSIUS: f64 = 25.0;
 /// The auxiliary channel holding the chamber's set point (the ambient the unit is kept at).
 pub const SET_POINT_CHANNEL: &str = "chamber_set_point";
 
+/// The auxiliary channel holding the chamber's air temperature: the ambient the bench logged, which
+/// the diagnosis's baseline reads the paper's tables at ([`crate::diagnose::AMBIENT_TERM`]).
+pub const AMBIENT_CHANNEL: &str = "chamber_air";
+
 /// Channels that describe the bench rather than the unit, by default: the chamber's set point and
 /// its air. Firmware in the field has neither, and the chamber air follows the ambient, which the
 /// paper's model reads from the switch-on temperature: where that reading is off (short off-times,
 /// ramps) any channel that follows the air explains the residual, in every world, null included.
 /// They are context — never ranked, never a term. The analyst adds others with
 /// `--bench-channel`.
-pub const DEFAULT_BENCH_CHANNELS: [&str; 2] = [SET_POINT_CHANNEL, "chamber_air"];
+pub const DEFAULT_BENCH_CHANNELS: [&str; 2] = [SET_POINT_CHANNEL, AMBIENT_CHANNEL];
 
 /// A recorded auxiliary channel less its mean over the calibration activations: what an
 /// interaction multiplies. Uncentred, a channel that hardly moves times the heating is the heating
@@ -176,6 +180,22 @@ impl Kind {
             kinds.push(Self::ResidualHeat);
         }
         kinds
+    }
+
+    /// The kinds of the bench's context channels (each with its calibration mean): the channel, and
+    /// the channel times the rise and times the temperature — what a bench ambient that ramps
+    /// does to a unit whose tables read the ambient once, at switch-on. The diagnosis's baseline.
+    pub fn context(channels: impl IntoIterator<Item = (String, f64)>) -> Vec<Self> {
+        channels
+            .into_iter()
+            .flat_map(|(channel, centre)| {
+                [
+                    Self::Aux(channel.clone()),
+                    Self::AuxTimesRise(Deviation::new(&channel, centre)),
+                    Self::AuxTimesTemperature(Deviation::new(&channel, centre)),
+                ]
+            })
+            .collect()
     }
 
     /// The candidate's name on `axis` (what reports and the term plan read).

@@ -34,19 +34,21 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::absorb::Absorber;
-use crate::candidates::{Kind, SET_POINT_CHANNEL};
+use crate::candidates::{Kind, AMBIENT_CHANNEL, SET_POINT_CHANNEL};
 use crate::keying::Keying;
 use crate::permutation::{Level, Null, Scored};
 use crate::statistics::one_sided_mean_test;
 use crate::switch_on_rate::start_rates;
-use drift_evaluate::evaluate::{spread, switch_on_raw};
+use drift_evaluate::evaluate::{correct_segment_after, spread, switch_on_raw};
 use drift_fit::error::FitError;
 use drift_fit::fit::{reference_indices, FittedUnit};
 use drift_fit::lowpass::centred_moving_average;
 use drift_fit::settings::FitSettings;
+use drift_recording::TEMPERATURE_MISSING_RAW;
 
-/// Spacing of the diagnosis grid, ms: the residual is low-passed at 1 s, so 10 Hz keeps it whole.
-pub const GRID_MS: u32 = 100;
+/// Spacing of the diagnosis grid, ms: the residual and the candidates are 1-s means, so two
+/// points per window keep what least squares on them needs, at a fifth of a 10-Hz grid's cost.
+pub const GRID_MS: u32 = 500;
 const AXES: [&str; 3] = ["X", "Y", "Z"];
 
 /// One activation on the diagnosis grid.
@@ -60,7 +62,17 @@ pub struct ActivationSeries {
     pub candidates: [BTreeMap<String, Vec<f64>>; 3],
     /// The same candidates less what the paper's tables predict of them: what is scored.
     pub left_over: [BTreeMap<String, Vec<f64>>; 3],
+    /// The baseline's columns per axis, by name: the paper model's known gap (the tables read at
+    /// the logged ambient, [`AMBIENT_TERM`]) and the bench's context channels, less what the
+    /// tables predict of them. Fitted before any candidate; never ranked, never a term.
+    pub baseline: [BTreeMap<String, Vec<f64>>; 3],
 }
+
+/// The baseline column of the paper model's ambient gap: what the tables predict with stage 2 read
+/// at the chamber air logged at switch-on, less what they predict read at the switch-on
+/// temperature (the paper's ambient, which after short off-times and under ramps is not the
+/// ambient).
+pub const AMBIENT_TERM: &str = "ambient term (tables at the logged air)";
 
 /// Low-pass at the fit's window and sample on the diagnosis grid.
 fn on_grid<T: Copy + Into<f64>>(values: &[T], window: usize, step: usize) -> Vec<f64> {
@@ -83,6 +95,10 @@ pub struct Diagnoser {
     /// Each candidate kind with the tables fitted to it; a kind the calibration activations cannot
     /// carry (an auxiliary channel they lack) is not offered.
     kinds: Vec<(Kind, Absorber)>,
+    /// The bench's context channels' kinds, with the tables fitted to each: the baseline's.
+    context: Vec<(Kind, Absorber)>,
+    /// The paper's tables (stage 3 by rise): what the ambient term reads at the logged air.
+    paper: Box<drift_core::ModifiedTables>,
     /// Each axis's rate at switch-on measured on the calibration, where a rate candidate's filter
     /// starts, as the firmware's term would.
     switch_on_rate: [SwitchOnRate; 3],
@@ -112,12 +128,20 @@ impl Diagnoser {
             .unwrap_or_default();
         channels.retain(|c| calibration.iter().all(|s| s.aux.contains_key(c)));
         // The residual heat reads the chamber set point (the bench's reference for the ambient);
-        // the set point itself, like every bench channel, is never a candidate.
+        // the set point itself, like every bench channel, is never a candidate. The other bench
+        // channels (the chamber air) are the baseline's context: what follows them is taken out
+        // before any candidate is scored.
         let has_set_point = channels.iter().any(|c| c == SET_POINT_CHANNEL);
-        channels.retain(|c| !bench_channels.contains(c));
+        // The set point among them: in a field recording it logs the ambient the bench went
+        // through, ramps included.
+        let context_channels: Vec<String> = channels
+            .iter()
+            .filter(|c| bench_channels.contains(c))
+            .cloned()
+            .collect();
         let core = fitted.modified.settings;
         // Each channel's mean over every calibration sample: where its interactions are centred.
-        let centred = channels.into_iter().map(|c| {
+        let centred = |c: String| {
             let (sum, n) = calibration
                 .iter()
                 .filter_map(|s| s.aux.get(&c))
@@ -126,33 +150,43 @@ impl Diagnoser {
                 .fold((0.0, 0usize), |(sum, n), &v| (sum + f64::from(v), n + 1));
             let centre = sum / n.max(1) as f64;
             (c, centre)
-        });
+        };
         // The drift fit's reference times: each candidate is taken out by the paper's own
         // operator (`Absorber::fit`).
         let references = reference_indices(&fitted.modified, settings);
         // A kind no calibration activation carries (an empty channel) is not offered.
-        let kinds = Kind::all(centred, has_set_point)
+        let absorb = |kinds: Vec<Kind>| {
+            kinds
+                .into_iter()
+                .filter_map(|kind| {
+                    let absorber = Absorber::fit(
+                        calibration,
+                        |s| {
+                            let on = switch_on_raw(s, settings);
+                            let start = start_rates(&switch_on_rate, &core, on, keying.previous(s));
+                            kind.values(s, on, &start)
+                        },
+                        settings,
+                        &keying,
+                        &references,
+                    );
+                    absorber.transpose().map(|a| a.map(|a| (kind, a)))
+                })
+                .collect::<Result<Vec<_>, FitError>>()
+        };
+        let candidates = channels
             .into_iter()
-            .filter_map(|kind| {
-                let absorber = Absorber::fit(
-                    calibration,
-                    |s| {
-                        let on = switch_on_raw(s, settings);
-                        let start = start_rates(&switch_on_rate, &core, on, keying.previous(s));
-                        kind.values(s, on, &start)
-                    },
-                    settings,
-                    &keying,
-                    &references,
-                );
-                absorber.transpose().map(|a| a.map(|a| (kind, a)))
-            })
-            .collect::<Result<Vec<_>, FitError>>()?;
+            .filter(|c| !bench_channels.contains(c))
+            .map(centred);
+        let kinds = absorb(Kind::all(candidates, has_set_point))?;
+        let context = absorb(Kind::context(context_channels.into_iter().map(centred)))?;
         Ok(Self {
             settings: settings.clone(),
             tables: keying.tables(&fitted.modified, &fitted.by_history),
             keying,
             kinds,
+            context,
+            paper: Box::new(fitted.modified.clone()),
             switch_on_rate,
         })
     }
@@ -172,20 +206,35 @@ impl Diagnoser {
         let residual: [Vec<f64>; 3] = [0, 1, 2].map(|a| on_grid(&corrected[a], window, step));
         let mut candidates: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
         let mut left_over: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
-        let computed: Vec<_> = self
-            .kinds
-            .par_iter()
-            .filter_map(|(kind, absorber)| {
-                let values = kind.values(segment, switch_on, &start)?;
-                let left = absorber.left_over(segment, values.clone(), switch_on, &self.keying);
-                Some((kind, values, left))
-            })
-            .collect();
-        for (kind, values, left) in computed {
+        let mut baseline: [BTreeMap<String, Vec<f64>>; 3] = Default::default();
+        let left = |kinds: &[(Kind, Absorber)]| -> Vec<(usize, Axes, Axes)> {
+            kinds
+                .par_iter()
+                .enumerate()
+                .filter_map(|(k, (kind, absorber))| {
+                    let values = kind.values(segment, switch_on, &start)?;
+                    let left = absorber.left_over(segment, values.clone(), switch_on, &self.keying);
+                    Some((k, values, left))
+                })
+                .collect()
+        };
+        for (k, values, left) in left(&self.kinds) {
+            let kind = &self.kinds[k].0;
             for axis in 0..3 {
                 let name = kind.name(axis);
                 candidates[axis].insert(name.clone(), on_grid(&values[axis], window, step));
                 left_over[axis].insert(name, on_grid(&left[axis], window, step));
+            }
+        }
+        for (k, _, left) in left(&self.context) {
+            let kind = &self.context[k].0;
+            for (axis, column) in baseline.iter_mut().enumerate() {
+                column.insert(kind.name(axis), on_grid(&left[axis], window, step));
+            }
+        }
+        if let Some(term) = ambient_term(&self.paper, segment, switch_on) {
+            for (axis, column) in baseline.iter_mut().enumerate() {
+                column.insert(AMBIENT_TERM.to_owned(), on_grid(&term[axis], window, step));
             }
         }
         ActivationSeries {
@@ -193,17 +242,70 @@ impl Diagnoser {
             residual_dps: residual,
             candidates,
             left_over,
+            baseline,
         }
     }
 }
+
+/// The paper's prediction with stage 2 read at the chamber air logged at switch-on (or the set
+/// point channel without one), less its prediction read at the switch-on temperature, per axis and
+/// sample, °/s; `None` without either. The temperatures are shifted so that the switch-on reads the air: the time since switch-on
+/// and the rise, the tables' other inputs, stay as they were.
+fn ambient_term(
+    paper: &drift_core::ModifiedTables,
+    segment: &Segment,
+    switch_on: [f32; 3],
+) -> Option<[Vec<f32>; 3]> {
+    // The chamber air where the bench logged it; otherwise the set point channel, which a field
+    // recording logs as the ambient it went through and a chamber holds to within its ripple.
+    let logged = segment
+        .aux
+        .get(AMBIENT_CHANNEL)
+        .or_else(|| segment.aux.get(SET_POINT_CHANNEL))?;
+    let air = f64::from(*logged.values.first()?);
+    if !air.is_finite() {
+        return None;
+    }
+    let core = paper.settings;
+    let shift: [f64; 3] = switch_on.map(|raw| {
+        let on = f64::from(core.celsius(raw));
+        ((on - air) * f64::from(core.raw_per_celsius)).round()
+    });
+    if shift.iter().any(|s| !s.is_finite()) {
+        return None;
+    }
+    let mut at_air = segment.clone();
+    for (raw, s) in at_air.temperature_raw.iter_mut().zip(shift) {
+        for r in raw.iter_mut().filter(|r| **r != TEMPERATURE_MISSING_RAW) {
+            let shifted = (f64::from(*r) - s).clamp(f64::from(i16::MIN + 1), f64::from(i16::MAX));
+            *r = shifted as i16;
+        }
+    }
+    let on_at_air: [f32; 3] = std::array::from_fn(|a| switch_on[a] - shift[a] as f32);
+    let (paper_rates, _) = correct_segment_after(paper, segment, switch_on, None);
+    let (air_rates, _) = correct_segment_after(paper, &at_air, on_at_air, None);
+    // Corrected = rate − prediction: the difference of the corrections is the difference of the
+    // predictions, the other way round.
+    Some(std::array::from_fn(|a| {
+        paper_rates[a]
+            .iter()
+            .zip(&air_rates[a])
+            .map(|(p, q)| p - q)
+            .collect()
+    }))
+}
+
+/// One quantity per axis and sample.
+type Axes = [Vec<f32>; 3];
 
 /// One candidate's score on one axis.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CandidateScore {
     /// Candidate name.
     pub name: String,
-    /// Out-of-sample share of the residual's variance explained at its level, cross-validated by
-    /// series; 0 when the folds' coefficients disagree in sign.
+    /// Out-of-sample share of the residual's variance explained at its level beyond the baseline
+    /// (for a selected candidate: beyond the baseline and the candidates selected before it),
+    /// cross-validated by series; 0 when the folds' coefficients disagree in sign.
     pub explained: f64,
     /// One-sided p-value of the mean held-out improvement (before multiple-comparison correction).
     pub p_value: f64,
@@ -243,11 +345,23 @@ pub struct AxisDiagnosis {
     pub activations: usize,
     /// RMS of the residual, °/s.
     pub residual_rms_dps: f64,
-    /// The explained share a candidate must exceed to be significant with these activations: an
-    /// effect explaining less of the residual's variance (out of sample) cannot be told from
-    /// chance here.
+    /// The gain a candidate must exceed to be selected with these activations: the larger of what
+    /// the best of every candidate reaches by chance (shuffles, first round) and the size
+    /// threshold. An effect explaining less of the residual's variance beyond the baseline (out of
+    /// sample) cannot be told from chance or from the paper model's own structure here.
     pub detectable_share: f64,
-    /// Candidates, best first.
+    /// The size threshold for this many activations ([`size_threshold`]).
+    pub size_threshold: f64,
+    /// The baseline's columns, fitted before any candidate.
+    pub baseline: Vec<String>,
+    /// Share of the residual's variance within activations the baseline explains out of sample.
+    pub baseline_explained_within: f64,
+    /// Share of the variance of the activations' mean residuals the baseline explains out of
+    /// sample.
+    pub baseline_explained_between: f64,
+    /// The candidates selected into the baseline, in order, with their gains.
+    pub selected: Vec<Selected>,
+    /// Candidates, selected first, then by their gain over the baseline in the first round.
     pub ranking: Vec<CandidateScore>,
 }
 
@@ -443,16 +557,113 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     sum / n.max(1) as f64
 }
 
+/// At most this many candidates are selected per axis, one after the other into the baseline
+/// (drift-core's `MAX_TERMS`).
+pub const MAX_SELECTED: usize = drift_core::MAX_TERMS;
+
+/// The practical size a candidate's gain must reach besides its shuffle test, by how many
+/// activations the axis is diagnosed on: the 95th percentile of the per-axis top gain over the
+/// baseline on null worlds (no effect drawn), per diagnosis-set size, where the shuffle test alone
+/// is liberal on a structured residual. Pairs (at least this many activations, threshold),
+/// descending by size; measured by `experiments/examples/worlds.rs --calibrate-threshold`
+/// (experiments/README.md, *The size threshold*).
+pub const SIZE_THRESHOLDS: [(usize, f64); 3] = [(120, 0.06), (60, 0.09), (0, 0.14)];
+
+/// The size threshold for an axis diagnosed on `activations` activations ([`SIZE_THRESHOLDS`]).
+pub fn size_threshold(activations: usize) -> f64 {
+    SIZE_THRESHOLDS
+        .iter()
+        .find(|(at_least, _)| activations >= *at_least)
+        .map_or(1.0, |(_, tau)| *tau)
+}
+
+/// One candidate selected into the baseline, in order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Selected {
+    /// Its name.
+    pub name: String,
+    /// Its cross-validated gain over the baseline and the candidates selected before it.
+    pub gain: f64,
+    /// Its family-wise p-value in that round.
+    pub family_p_value: f64,
+}
+
+/// Each activation's series as an index unique within its stratum (unit, nominal set point): what
+/// the shuffles move whole.
+fn series_index(activations: &[ActivationSeries]) -> Vec<usize> {
+    let key = |a: &ActivationSeries| (a.labels.series_kind.as_str(), a.labels.series);
+    let mut keys: Vec<_> = activations.iter().map(key).collect();
+    keys.sort();
+    keys.dedup();
+    activations
+        .iter()
+        .map(|a| keys.binary_search(&key(a)).unwrap_or(0))
+        .collect()
+}
+
+/// `column` of every activation less its least-squares fit on `baseline`'s columns within
+/// activations (pooled coefficients, each activation about its means): what is left of a residual
+/// or a candidate once the baseline has explained its part (Frisch–Waugh).
+fn partialled(
+    activations: &[ActivationSeries],
+    axis: usize,
+    baseline: &[String],
+    column: &dyn Fn(&ActivationSeries) -> Vec<f64>,
+) -> Vec<Vec<f64>> {
+    let values: Vec<Vec<f64>> = activations.iter().map(column).collect();
+    if baseline.is_empty() {
+        return values;
+    }
+    let blocks: Vec<crate::gram::Block> = activations
+        .iter()
+        .zip(&values)
+        .map(|(a, y)| {
+            let zeros = vec![0.0; y.len()];
+            let mut columns: Vec<&[f64]> = baseline
+                .iter()
+                .filter_map(|n| a.baseline[axis].get(n).map(Vec::as_slice))
+                .collect();
+            columns.push(&zeros); // no candidate
+            columns.push(y);
+            crate::gram::Block::of(&columns).centred()
+        })
+        .collect();
+    let Some(beta) = crate::gram::fit_baseline(&blocks) else {
+        return values;
+    };
+    activations
+        .iter()
+        .zip(values)
+        .map(|(a, y)| {
+            let mut y = y;
+            for (k, n) in baseline.iter().enumerate() {
+                if let Some(b) = a.baseline[axis].get(n) {
+                    for (v, b) in y.iter_mut().zip(b) {
+                        *v -= beta[k] * b;
+                    }
+                }
+            }
+            y
+        })
+        .collect()
+}
+
 /// Scores every candidate on one axis of `activations` with `folds`-fold cross-validation by
 /// series ([`series_folds`]); `alpha` is the family-wise significance level for the axis, held by
 /// the shuffle test ([`crate::permutation`]).
 ///
-/// Each candidate is scored at two levels, because effects show in two ways: **within**
-/// activations (residual and candidate less their activation means: the shape that the drift
-/// metric sees, e.g. a temperature-rate term) and **between** activations (one point per activation,
-/// the means: offsets that change from one switch-on to the next, e.g. supply voltage or
-/// orientation). The better level is reported; the shuffles' winners are the best of both levels
-/// of every candidate, so the test covers both.
+/// The statistic is a candidate's **gain over the baseline**: the share of the residual's variance
+/// it explains out of sample beyond the baseline's columns (the paper model's ambient gap and the
+/// bench's context, [`ActivationSeries::baseline`]). Each candidate is scored at two levels,
+/// because effects show in two ways: **within** activations (residual and columns less their
+/// activation means: the shape that the drift metric sees, e.g. a temperature-rate term) and
+/// **between** activations (one point per activation, the means: offsets that change from one
+/// switch-on to the next, e.g. supply voltage or orientation). The better level is reported; the
+/// shuffles' winners are the best of both levels of every candidate, so the test covers both.
+///
+/// Selection is forward: the best candidate that is significant (shuffles) and large enough
+/// (gain ≥ [`size_threshold`]) joins the baseline and the rest are scored again over it, up to
+/// [`MAX_SELECTED`]. The ranking is the first round's; `significant` marks the selected.
 pub fn diagnose_axis(
     activations: &[ActivationSeries],
     axis: usize,
@@ -471,6 +682,13 @@ pub fn diagnose_axis(
                 .all(|a| a.candidates[axis].contains_key(n) && a.left_over[axis].contains_key(n))
         })
         .collect();
+    let baseline: Vec<String> = activations
+        .first()
+        .map(|a| a.baseline[axis].keys().cloned().collect::<Vec<_>>())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|n| activations.iter().all(|a| a.baseline[axis].contains_key(n)))
+        .collect();
     let rms = mean(
         activations
             .iter()
@@ -482,7 +700,7 @@ pub fn diagnose_axis(
         .iter()
         .map(|n| (n, absorbed_share(activations, axis, n)))
         .collect();
-    let scored_names: Vec<String> = names
+    let mut remaining: Vec<String> = names
         .iter()
         .filter(|n| absorbed.get(n).is_some_and(|&a| a <= ABSORBED))
         .cloned()
@@ -494,17 +712,72 @@ pub fn diagnose_axis(
     let candidates: Vec<&BTreeMap<String, Vec<f64>>> =
         activations.iter().map(|a| &a.left_over[axis]).collect();
     let strata = set_point_strata(activations);
-    let null = Null::measure(
-        &Scored {
-            residuals: &residuals,
-            candidates: &candidates,
-            strata: &strata,
-            fold_of: &fold_of,
-            folds,
-        },
-        &scored_names,
-        axis as u64,
-    );
+    let series = series_index(activations);
+    let threshold = size_threshold(activations.len());
+    // Forward selection: each round scores what is left over the baseline and the candidates
+    // selected so far.
+    let mut selected: Vec<Selected> = Vec::new();
+    let mut first: Option<Null> = None;
+    while selected.len() < MAX_SELECTED && !remaining.is_empty() {
+        let columns: Vec<Vec<&[f64]>> = activations
+            .iter()
+            .map(|a| {
+                baseline
+                    .iter()
+                    .filter_map(|n| a.baseline[axis].get(n))
+                    .chain(
+                        selected
+                            .iter()
+                            .filter_map(|c| a.left_over[axis].get(&c.name)),
+                    )
+                    .map(Vec::as_slice)
+                    .collect()
+            })
+            .collect();
+        let null = Null::measure(
+            &Scored {
+                residuals: &residuals,
+                baseline: &columns,
+                candidates: &candidates,
+                strata: &strata,
+                series: &series,
+                fold_of: &fold_of,
+                folds,
+            },
+            &remaining,
+            (axis + 3 * selected.len()) as u64,
+        );
+        let best = null
+            .observed
+            .iter()
+            .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+            .map(|(n, (gain, _))| (n.clone(), *gain));
+        let round_first = first.is_none();
+        let chosen = best
+            .filter(|(_, gain)| *gain > 0.0 && *gain >= threshold && null.p_value(*gain) <= alpha);
+        if round_first {
+            first = Some(null.clone());
+        }
+        let Some((name, gain)) = chosen else {
+            break;
+        };
+        remaining.retain(|n| *n != name);
+        selected.push(Selected {
+            family_p_value: null.p_value(gain),
+            name,
+            gain,
+        });
+    }
+    let first = first.unwrap_or_else(|| Null {
+        observed: BTreeMap::new(),
+        maxima: Vec::new(),
+        baselines: Default::default(),
+    });
+    // The per-activation tests and coefficients are read on what the baseline leaves of the
+    // residual and of each candidate.
+    let residual_left = partialled(activations, axis, &baseline, &|a| {
+        a.residual_dps[axis].clone()
+    });
     let mut ranking: Vec<CandidateScore> = names
         .iter()
         .map(|name| {
@@ -527,38 +800,35 @@ pub fn diagnose_axis(
                 return candidate;
             }
             let finite_mean = |v: &[f64]| mean(v.iter().copied().filter(|x| x.is_finite()));
-            let within: Vec<Vec<Point>> = activations
+            let candidate_left = partialled(activations, axis, &baseline, &|a| {
+                a.left_over[axis].get(name).cloned().unwrap_or_default()
+            });
+            let within: Vec<Vec<Point>> = residual_left
                 .iter()
-                .map(|a| {
-                    let (y, c) = (&a.residual_dps[axis], &a.left_over[axis][name]);
+                .zip(&candidate_left)
+                .map(|(y, c)| {
                     let (my, mc) = (finite_mean(y), finite_mean(c));
                     y.iter().zip(c).map(|(y, c)| (y - my, c - mc)).collect()
                 })
                 .collect();
-            let between: Vec<Vec<Point>> = activations
+            let between: Vec<Vec<Point>> = residual_left
                 .iter()
-                .map(|a| {
-                    vec![(
-                        finite_mean(&a.residual_dps[axis]),
-                        finite_mean(&a.left_over[axis][name]),
-                    )]
-                })
+                .zip(&candidate_left)
+                .map(|(y, c)| vec![(finite_mean(y), finite_mean(c))])
                 .collect();
-            let whole: Vec<Vec<Point>> = activations
+            let whole: Vec<Vec<Point>> = residual_left
                 .iter()
-                .map(|a| {
-                    let (y, c) = (&a.residual_dps[axis], &a.left_over[axis][name]);
-                    y.iter().copied().zip(c.iter().copied()).collect()
-                })
+                .zip(&candidate_left)
+                .map(|(y, c)| y.iter().copied().zip(c.iter().copied()).collect())
                 .collect();
             let within = score(&within, &fold_of, folds);
             let between = score(&between, &fold_of, folds);
             candidate.whole_p_value = score(&whole, &fold_of, folds).p_value;
             // Only a shape has a drift; the between level's one point per activation has none.
             candidate.drift_p_value = within.drift_p_value;
-            // The level and share are the shuffle test's (below); the p-value and coefficient
+            // The level and gain are the shuffle test's (first round); the p-value and coefficient
             // are read at that level.
-            let (share, level) = null
+            let (share, level) = first
                 .observed
                 .get(name)
                 .copied()
@@ -569,30 +839,35 @@ pub fn diagnose_axis(
             };
             candidate.stable = best.stable;
             candidate.explained = share;
-            candidate.family_p_value = null.p_value(share);
+            candidate.family_p_value = first.p_value(share);
             (candidate.p_value, candidate.coefficient, candidate.level) =
                 (best.p_value, best.coefficient, level);
+            if let Some(s) = selected.iter().find(|s| s.name == *name) {
+                candidate.significant = true;
+                candidate.explained = s.gain;
+                candidate.family_p_value = s.family_p_value;
+            }
             candidate
         })
         .collect();
-    for c in &mut ranking {
-        // Family-wise by shuffling (crate::permutation): the share must beat what the best of
-        // every candidate reaches by chance on these activations in all but `alpha` of the
-        // shuffles. The per-activation p-values and the whole residual's are reported beside it,
-        // not gated on: each measures something else than whether this relation is there.
-        c.significant = c.explained > 0.0 && c.family_p_value <= alpha;
-    }
-    // Significant first, then by explained share.
-    ranking.sort_by(|a, b| {
-        b.significant
-            .cmp(&a.significant)
-            .then(b.explained.total_cmp(&a.explained))
+    // Selected first, in the order selected, then by gain.
+    let order = |c: &CandidateScore| selected.iter().position(|s| s.name == c.name);
+    ranking.sort_by(|a, b| match (order(a), order(b)) {
+        (Some(x), Some(y)) => x.cmp(&y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => b.explained.total_cmp(&a.explained),
     });
     AxisDiagnosis {
         axis: AXES[axis],
         activations: activations.len(),
         residual_rms_dps: rms,
-        detectable_share: null.detectable(alpha),
+        detectable_share: first.detectable(alpha).max(threshold),
+        size_threshold: threshold,
+        baseline,
+        baseline_explained_within: first.baselines.within_share,
+        baseline_explained_between: first.baselines.between_share,
+        selected,
         ranking,
     }
 }

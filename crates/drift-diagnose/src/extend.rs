@@ -1026,6 +1026,11 @@ mod tests {
             activations: 10,
             residual_rms_dps: 0.01,
             detectable_share: 0.2,
+            size_threshold: 0.1,
+            baseline: Vec::new(),
+            baseline_explained_within: 0.0,
+            baseline_explained_between: 0.0,
+            selected: Vec::new(),
             ranking: ranking
                 .iter()
                 .map(|(candidate, significant)| CandidateScore {

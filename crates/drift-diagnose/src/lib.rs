@@ -14,6 +14,7 @@ pub mod candidates;
 pub mod closing;
 pub mod diagnose;
 pub mod extend;
+pub mod gram;
 pub mod keying;
 pub mod permutation;
 pub mod roles;

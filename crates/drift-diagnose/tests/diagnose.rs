@@ -68,6 +68,7 @@ fn activation(
         residual_dps: [residual.clone(), residual.clone(), residual],
         candidates: [candidates.clone(), candidates.clone(), candidates],
         left_over: [left_over.clone(), left_over.clone(), left_over],
+        baseline: Default::default(),
     }
 }
 
@@ -140,4 +141,48 @@ fn a_ramped_field_series_stays_in_one_fold() {
     for series in fold_of.chunks(5) {
         assert!(series.iter().all(|&f| f == series[0]), "{fold_of:?}");
     }
+}
+
+/// The baseline is fitted before any candidate: a residual that follows the bench's ambient (a
+/// baseline column) is not a discovery, even for a candidate that follows the ambient too, and a
+/// real effect beside it is still found.
+#[test]
+fn what_the_baseline_explains_is_no_discovery() {
+    let mut noise = Lcg(11);
+    let activations: Vec<ActivationSeries> = (0..60)
+        .map(|i| {
+            let mut a = activation(i, |_, _, _| 0.0, &mut noise);
+            a.labels.series = (i / 3) as u32;
+            let ramp: Vec<f64> = (0..300)
+                .map(|k| (k as f64 / 300.0) * (1.0 + (i % 4) as f64) + 0.1 * noise.next())
+                .collect();
+            // The unit's residual follows the ambient ramp; a channel that follows the ambient
+            // too (a housing thermistor) is offered as a candidate.
+            for (y, r) in a.residual_dps[0].iter_mut().zip(&ramp) {
+                *y += 0.01 * r;
+            }
+            let follower: Vec<f64> = ramp.iter().map(|r| r + 0.05 * noise.next()).collect();
+            a.candidates[0].insert("aux:housing".into(), follower.clone());
+            a.left_over[0].insert("aux:housing".into(), follower);
+            a.baseline[0].insert("ambient".into(), ramp);
+            a
+        })
+        .collect();
+    let d = diagnose_axis(&activations, 0, 5, 0.05);
+    assert_eq!(d.baseline, ["ambient"]);
+    assert!(d.baseline_explained_within > 0.5, "{d:?}");
+    assert!(d.chosen().is_none(), "{:?}", d.chosen());
+    let housing = d.ranking.iter().find(|c| c.name == "aux:housing").unwrap();
+    assert!(housing.explained < 0.05, "{housing:?}");
+    // Without the baseline the follower would have been the discovery.
+    let without: Vec<ActivationSeries> = activations
+        .iter()
+        .cloned()
+        .map(|mut a| {
+            a.baseline = Default::default();
+            a
+        })
+        .collect();
+    let d = diagnose_axis(&without, 0, 5, 0.05);
+    assert_eq!(d.chosen().map(|c| c.name.as_str()), Some("aux:housing"));
 }

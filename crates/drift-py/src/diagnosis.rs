@@ -81,6 +81,9 @@ struct RankRecord<'a> {
     significant: bool,
     stable: bool,
     detectable_share: f64,
+    size_threshold: f64,
+    baseline_explained_within: f64,
+    baseline_explained_between: f64,
     coefficient: f64,
     absorbed_by_model: f64,
 }
@@ -265,10 +268,14 @@ impl PyDiagnosis {
 
     /// The ranking of every axis as records (axis, rank, candidate, level, explained,
     /// family_p_value, p_value, whole_p_value, drift_p_value, significant, stable,
-    /// detectable_share, coefficient, absorbed_by_model): a new list of dicts. `significant` is
-    /// `family_p_value` ≤ 0.05 (shuffle test, family-wise over the axis's candidates);
-    /// `detectable_share` is the explained share a candidate on that axis must exceed to be
-    /// significant with these activations. The t-tests' p-values are reported, not gated on.
+    /// detectable_share, size_threshold, baseline_explained_within, baseline_explained_between,
+    /// coefficient, absorbed_by_model): a new list of dicts. `explained` is the candidate's
+    /// out-of-sample gain over the baseline (the paper model's ambient gap and the bench's context
+    /// channels, fitted first); `significant` marks the candidates selected forward: significant
+    /// family-wise (`family_p_value` ≤ 0.05, shuffles of whole series) and with a gain of at
+    /// least `size_threshold` (calibrated on null worlds). `detectable_share` is the gain a
+    /// candidate on that axis must exceed with these activations. The t-tests' p-values are
+    /// reported, not gated on.
     #[getter]
     fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.ranking)
@@ -447,6 +454,9 @@ fn records(axes: &[AxisDiagnosis; 3]) -> Vec<RankRecord<'_>> {
                 significant: c.significant,
                 stable: c.stable,
                 detectable_share: axis.detectable_share,
+                size_threshold: axis.size_threshold,
+                baseline_explained_within: axis.baseline_explained_within,
+                baseline_explained_between: axis.baseline_explained_between,
                 coefficient: c.coefficient,
                 absorbed_by_model: c.absorbed_by_model,
             })

@@ -117,14 +117,18 @@ def test_the_ranking_is_records_with_every_axis(diagnosis: gyrodrift.Diagnosis) 
         "drift_p_value",
         "significant",
         "absorbed_by_model",
+        "size_threshold",
+        "baseline_explained_within",
+        "baseline_explained_between",
     }
-    # Significant means beating the shuffles' winners: above the axis's detectable share, with
-    # the same sign in every fold.
+    # Selected means beating the shuffles' winners and reaching the size threshold over the
+    # baseline, with the same sign in every fold.
     assert all(
-        r["family_p_value"] <= 0.05 and r["explained"] > r["detectable_share"] and r["stable"]
+        r["family_p_value"] <= 0.05 and r["explained"] >= r["size_threshold"] and r["stable"]
         for r in records
         if r["significant"]
     )
+    assert all(0.0 <= r["baseline_explained_within"] <= 1.0 for r in records)
     assert all(0.0 <= r["detectable_share"] < 1.0 for r in records)
     counts = dict(diagnosis.activations)
     assert counts["diagnosed"] == counts["training"] > 0

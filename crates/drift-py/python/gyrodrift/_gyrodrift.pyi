@@ -965,10 +965,14 @@ class Diagnosis:
     def ranking(self) -> list[dict[str, Any]]:
         """The ranking of every axis as records (axis, rank, candidate, level, explained,
         family_p_value, p_value, whole_p_value, drift_p_value, significant, stable,
-        detectable_share, coefficient, absorbed_by_model): a new list of dicts. `significant` is
-        `family_p_value` ≤ 0.05 (shuffle test, family-wise over the axis's candidates);
-        `detectable_share` is the explained share a candidate on that axis must exceed to be
-        significant with these activations. The t-tests' p-values are reported, not gated on."""
+        detectable_share, size_threshold, baseline_explained_within, baseline_explained_between,
+        coefficient, absorbed_by_model): a new list of dicts. `explained` is the candidate's
+        out-of-sample gain over the baseline (the paper model's ambient gap and the bench's context
+        channels, fitted first); `significant` marks the candidates selected forward: significant
+        family-wise (`family_p_value` ≤ 0.05, shuffles of whole series) and with a gain of at
+        least `size_threshold` (calibrated on null worlds). `detectable_share` is the gain a
+        candidate on that axis must exceed with these activations. The t-tests' p-values are
+        reported, not gated on."""
     @property
     def paper_ranking(self) -> list[dict[str, Any]]:
         """The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's
