@@ -198,6 +198,14 @@ impl Kind {
             .collect()
     }
 
+    /// Whether the kind is a known gap of the paper's model rather than a candidate: the
+    /// switch-on temperature and the residual heat at switch-on, constant over an activation,
+    /// which the paper's turn-on bias reads only through a switch-on temperature that residual
+    /// heat and ambient ramps move. The diagnosis's baseline takes them.
+    pub fn is_known_gap(&self) -> bool {
+        matches!(self, Self::SwitchOnTemperature | Self::ResidualHeat)
+    }
+
     /// The candidate's name on `axis` (what reports and the term plan read).
     pub fn name(&self, axis: usize) -> String {
         let own = AXES.get(axis).copied().unwrap_or("?");

@@ -62,9 +62,10 @@ pub struct ActivationSeries {
     pub candidates: [BTreeMap<String, Vec<f64>>; 3],
     /// The same candidates less what the paper's tables predict of them: what is scored.
     pub left_over: [BTreeMap<String, Vec<f64>>; 3],
-    /// The baseline's columns per axis, by name: the paper model's known gap (the tables read at
-    /// the logged ambient, [`AMBIENT_TERM`]) and the bench's context channels, less what the
-    /// tables predict of them. Fitted before any candidate; never ranked, never a term.
+    /// The baseline's columns per axis, by name: the paper model's known gaps (the tables read at
+    /// the logged ambient, [`AMBIENT_TERM`]; the switch-on temperature and residual heat,
+    /// [`Kind::is_known_gap`]) and the bench's context channels, less what the tables predict of
+    /// them. Fitted before any candidate; never ranked, never a term.
     pub baseline: [BTreeMap<String, Vec<f64>>; 3],
 }
 
@@ -178,8 +179,16 @@ impl Diagnoser {
             .into_iter()
             .filter(|c| !bench_channels.contains(c))
             .map(centred);
-        let kinds = absorb(Kind::all(candidates, has_set_point))?;
-        let context = absorb(Kind::context(context_channels.into_iter().map(centred)))?;
+        // The switch-on temperature and the residual heat are the paper model's own offset gap
+        // (its turn-on bias read from a switch-on temperature that residual heat and ramps move):
+        // on null worlds they topped the offsets between activations. They join the baseline.
+        let (gaps, kinds): (Vec<Kind>, Vec<Kind>) = Kind::all(candidates, has_set_point)
+            .into_iter()
+            .partition(Kind::is_known_gap);
+        let kinds = absorb(kinds)?;
+        let mut context_kinds = Kind::context(context_channels.into_iter().map(centred));
+        context_kinds.extend(gaps);
+        let context = absorb(context_kinds)?;
         Ok(Self {
             settings: settings.clone(),
             tables: keying.tables(&fitted.modified, &fitted.by_history),
