@@ -209,20 +209,18 @@ impl fmt::Display for BlobError {
 
 impl core::error::Error for BlobError {}
 
+// Array reads through `first_chunk`, never `copy_from_slice`: its length check panics with a
+// formatted message, which would link `core::fmt` into firmware built without LTO.
+fn array<const N: usize>(bytes: &[u8], at: usize) -> Option<[u8; N]> {
+    bytes.get(at..)?.first_chunk::<N>().copied()
+}
+
 fn le_u16(bytes: &[u8], at: usize) -> u16 {
-    let mut out = [0_u8; 2];
-    if let Some(src) = bytes.get(at..at.saturating_add(2)) {
-        out.copy_from_slice(src);
-    }
-    u16::from_le_bytes(out)
+    u16::from_le_bytes(array(bytes, at).unwrap_or_default())
 }
 
 fn le_u32(bytes: &[u8], at: usize) -> u32 {
-    let mut out = [0_u8; 4];
-    if let Some(src) = bytes.get(at..at.saturating_add(4)) {
-        out.copy_from_slice(src);
-    }
-    u32::from_le_bytes(out)
+    u32::from_le_bytes(array(bytes, at).unwrap_or_default())
 }
 
 /// The length in bytes of `model`'s image, without writing it (to size a buffer exactly).
@@ -254,7 +252,7 @@ pub fn encode<M: Image>(model: &M, buffer: &mut [u8]) -> Result<usize, BlobError
     let header = buffer
         .get_mut(..HEADER_LEN)
         .ok_or(BlobError::BufferTooSmall)?;
-    header.copy_from_slice(&[0; HEADER_LEN]);
+    header.fill(0);
     for (dst, src) in header.iter_mut().zip(
         MAGIC
             .iter()
@@ -265,10 +263,12 @@ pub fn encode<M: Image>(model: &M, buffer: &mut [u8]) -> Result<usize, BlobError
         *dst = *src;
     }
     let crc = CRC32.checksum(buffer.get(..body_len).ok_or(BlobError::BufferTooSmall)?);
-    buffer
+    let trailer = buffer
         .get_mut(body_len..total)
-        .ok_or(BlobError::BufferTooSmall)?
-        .copy_from_slice(&crc.to_le_bytes());
+        .ok_or(BlobError::BufferTooSmall)?;
+    for (dst, src) in trailer.iter_mut().zip(crc.to_le_bytes()) {
+        *dst = src;
+    }
     Ok(total)
 }
 
@@ -314,11 +314,9 @@ fn payload<M: Image>(bytes: &[u8]) -> Result<&[u8], BlobError> {
     let minimum = HEADER_LEN.saturating_add(TRAILER_LEN);
     if bytes.len() < minimum {
         // Check the magic of whatever is there first: a short non-image is "not an image".
-        if let Some(found) = bytes.get(..4) {
+        if let Some(found) = array::<4>(bytes, 0) {
             if found != MAGIC {
-                let mut magic = [0; 4];
-                magic.copy_from_slice(found);
-                return Err(BlobError::BadMagic { found: magic });
+                return Err(BlobError::BadMagic { found });
             }
         }
         return Err(BlobError::Truncated {
@@ -326,10 +324,7 @@ fn payload<M: Image>(bytes: &[u8]) -> Result<&[u8], BlobError> {
             found: bytes.len(),
         });
     }
-    let mut magic = [0; 4];
-    if let Some(found) = bytes.get(..4) {
-        magic.copy_from_slice(found);
-    }
+    let magic = array::<4>(bytes, 0).unwrap_or_default();
     if magic != MAGIC {
         return Err(BlobError::BadMagic { found: magic });
     }
