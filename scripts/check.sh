@@ -57,6 +57,9 @@ step "firmware: clippy, build, and the shared test vectors on QEMU mps2-an386 (C
 (cd embedded && cargo clippy --release --locked -- -D warnings)
 (cd embedded && cargo build --release --locked && cargo run --release --locked --bin vectors)
 
+step "firmware: without LTO, a minimal firmware links no panic or formatting code (llvm-nm) and keeps its empty tables in .bss"
+./scripts/check-firmware-link.sh
+
 step "firmware: executed instructions per 3-axis sample, gated per model and rate (deterministic; ceilings in scripts/count-instructions.py, figures in docs/embedded.md)"
 python3 scripts/count-instructions.py --gate
 

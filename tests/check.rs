@@ -1,11 +1,14 @@
 //! `gyrodrift check`: a unit's stored tables pass on its own recordings, fail on another unit's or
-//! against tight limits (exit status 1, the report still written), and missing tables are named.
+//! against tight limits (exit status 1, the report still written); another unit's image and
+//! missing tables are named (exit status 2). `gyrodrift export image` provisions the same tables.
 
 use std::path::Path;
 
 mod common;
 
 use common::{gyrodrift, ok};
+use drift_core::blob::decode;
+use drift_core::ModifiedTables;
 
 fn path(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -92,7 +95,8 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     let md = std::fs::read_to_string(tight.join("check.md")).unwrap();
     assert!(md.contains("**fail**: drift left"), "{md}");
 
-    // GIU-01's tables flashed into GIU-02: GIU-02 fails, GIU-01 still passes.
+    // GIU-01's image in GIU-02's folder: its header names GIU-01, so check refuses it (exit
+    // status 2), naming both units, and writes nothing.
     let swapped = dir.path().join("swapped");
     for unit in ["GIU-01", "GIU-02"] {
         std::fs::create_dir_all(swapped.join(unit)).unwrap();
@@ -101,6 +105,24 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
             swapped.join(unit).join("modified.bin"),
         )
         .unwrap();
+    }
+    let refused = dir.path().join("refused");
+    let (out, text) = check(&campaign, &swapped, &refused, &[]);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("GIU-02/modified.bin: this image is unit GIU-01's")
+            && text.contains("records unit GIU-02"),
+        "{text}"
+    );
+    assert!(!refused.exists());
+
+    // GIU-01's tables in an image that names no unit, flashed into GIU-02: GIU-02 fails, GIU-01
+    // still passes.
+    let own: ModifiedTables =
+        decode(&std::fs::read(tables.join("GIU-01/modified.bin")).unwrap()).unwrap();
+    let anonymous = drift_evaluate::tables_folder::image_bytes(&own).unwrap();
+    for unit in ["GIU-01", "GIU-02"] {
+        std::fs::write(swapped.join(unit).join("modified.bin"), &anonymous).unwrap();
     }
     let wrong = dir.path().join("wrong");
     let (out, text) = check(&campaign, &swapped, &wrong, &[]);
@@ -167,4 +189,67 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
         std::fs::read(standard.join("check.json")).unwrap(),
         "the relative baseline was checked with the standard one's image"
     );
+
+    // Provisioning: one image per unit, each naming its unit, a manifest, Intel HEX at an address.
+    let images = dir.path().join("images");
+    let text = ok(&[
+        "export",
+        "image",
+        path(&tables),
+        "--model",
+        "modified",
+        "-o",
+        path(&images),
+        "--address",
+        "0x08060000",
+    ]);
+    assert!(text.contains("2 units' modified images"), "{text}");
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(images.join("manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!(manifest["address"], "0x08060000");
+    for (entry, unit) in manifest["units"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(["GIU-01", "GIU-02"])
+    {
+        assert_eq!(entry["unit_id"], unit);
+        let bytes = std::fs::read(images.join(format!("{unit}.bin"))).unwrap();
+        assert_eq!(
+            bytes,
+            std::fs::read(tables.join(unit).join("modified.bin")).unwrap()
+        );
+        assert_eq!(entry["bytes"], bytes.len());
+        let header = drift_core::blob::header(&bytes).unwrap();
+        assert_eq!(header.provenance.unit_id.as_str(), unit);
+        assert_eq!(entry["capacities"]["curves"], header.needs.unwrap().curves);
+        let hex = std::fs::read_to_string(images.join(format!("{unit}.hex"))).unwrap();
+        assert!(hex.starts_with(":020000040806"), "{hex}");
+    }
+    // A unit's folder holding another unit's image is refused, naming both; nothing is made.
+    for unit in ["GIU-01", "GIU-02"] {
+        std::fs::create_dir_all(swapped.join(unit)).unwrap();
+        std::fs::copy(
+            tables.join("GIU-01/modified.bin"),
+            swapped.join(unit).join("modified.bin"),
+        )
+        .unwrap();
+    }
+    let none = dir.path().join("none");
+    let (out, text) = gyrodrift(&[
+        "export",
+        "image",
+        path(&swapped),
+        "--model",
+        "modified",
+        "-o",
+        path(&none),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("this image is unit GIU-01's, but it sits in unit GIU-02's folder"),
+        "{text}"
+    );
+    assert!(!none.exists());
 }

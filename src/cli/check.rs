@@ -44,7 +44,8 @@ pub enum Stored {
 }
 
 impl Stored {
-    fn model(self) -> StoredModel {
+    /// The tables folder's model.
+    pub fn model(self) -> StoredModel {
         match self {
             Self::Modified => StoredModel::Modified,
             Self::ByHistory => StoredModel::ByHistory,
@@ -98,14 +99,28 @@ struct UnitResult {
     activations: Vec<CheckedActivation>,
 }
 
-/// The image a unit carries, decoded; errors name the file.
-fn load<M: Image>(path: &Path) -> anyhow::Result<M> {
-    tables_folder::read_image(path).map_err(|error| match error {
-        TablesError::Io { .. } => {
-            anyhow::anyhow!("{error} (no stored tables for this unit? `gyrodrift fit` writes them)")
-        }
-        other => other.into(),
-    })
+/// The image `unit` carries, decoded; errors name the file. An image whose header names another
+/// unit is refused, naming both: a unit checked (or flashed) with another's tables fails for the
+/// wrong reason. An image that names no unit (written without one) is taken as the unit's.
+fn load<M: Image>(path: &Path, unit: &str, recording: &Path) -> anyhow::Result<M> {
+    let (model, header) =
+        tables_folder::read_image_and_header(path).map_err(|error| match error {
+            TablesError::Io { .. } => {
+                anyhow::anyhow!(
+                    "{error} (no stored tables for this unit? `gyrodrift fit` writes them)"
+                )
+            }
+            other => other.into(),
+        })?;
+    let owner = header.provenance.unit_id.as_str();
+    if !owner.is_empty() && owner != unit {
+        bail!(
+            "{}: this image is unit {owner}'s, but {} records unit {unit}: each unit is checked with its own image (`<tables>/{unit}/`)",
+            path.display(),
+            recording.display()
+        );
+    }
+    Ok(model)
 }
 
 /// Checks every activation of every recording against the unit's stored `M`.
@@ -129,7 +144,7 @@ fn check_all<M: Model + Image>(
             Entry::Occupied(entry) => entry.into_mut(),
             Entry::Vacant(entry) => {
                 let image = args.model.model().image_path(&args.tables, unit);
-                let model: M = load(&image)?;
+                let model: M = load(&image, unit, path)?;
                 let check = UnitCheck::new(unit, model, settings)
                     .with_context(|| image.display().to_string())?;
                 entry.insert((image, check))

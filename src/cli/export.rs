@@ -1,4 +1,5 @@
-//! `gyrodrift export ros2`: a recording → ROS 2 bags with one standard message per sample.
+//! `gyrodrift export ros2`: a recording → ROS 2 bags with one standard message per sample
+//! (`gyrodrift export image`, firmware images per unit: `export_image`).
 //!
 //! The recording format batches 100 samples per message, which ROS tools and Foxglove plot as one
 //! point per message. The export writes one `sensor_msgs/msg/Imu` per sample (`angular_velocity`,
@@ -30,6 +31,9 @@ pub enum Format {
     /// one message per sample.
     #[command(visible_alias = "rosbag")]
     Ros2(Ros2Args),
+    /// Firmware images, one per unit, from a tables folder: `<unit>.bin`, `manifest.json` and,
+    /// with `--address`, Intel HEX.
+    Image(super::export_image::ImageArgs),
 }
 
 /// Options of `gyrodrift export ros2`.
@@ -54,6 +58,7 @@ pub struct Ros2Args {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     match &args.format {
         Format::Ros2(ros2) => run_ros2(ros2),
+        Format::Image(image) => super::export_image::run(image),
     }
 }
 

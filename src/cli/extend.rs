@@ -10,7 +10,7 @@ use drift_diagnose::before_after::group_errors;
 use drift_diagnose::closing::{BeforeAfter, Closed};
 use drift_diagnose::switch_on_rate::SwitchOnRateFit;
 use drift_evaluate::noise_floor::Floor;
-use drift_evaluate::tables_folder;
+use drift_evaluate::tables_folder::{self, TablesError};
 use drift_fit::FittedUnit;
 
 /// Writes the extended model of one unit (image and JSON) and returns its Markdown section.
@@ -55,7 +55,11 @@ pub fn run(
         }
     }
     md.push_str(&before_after_table(before_after, floor));
-    let files = tables_folder::model_files(out, &format!("extended-{unit}"), &*tables)?;
+    let from = tables_folder::provenance(unit).map_err(|problem| TablesError::Encode {
+        path: out.to_owned(),
+        problem,
+    })?;
+    let files = tables_folder::model_files(out, &format!("extended-{unit}"), &*tables, &from)?;
     let image_len = files[1].1.len();
     tables_folder::write_files(&files)?;
     let _ = writeln!(

@@ -9,6 +9,7 @@ pub mod demo;
 pub mod diagnose;
 mod exit;
 pub mod export;
+pub mod export_image;
 mod extend;
 pub mod fit;
 pub mod import;

@@ -1,42 +1,59 @@
 //! The firmware table image: a compact, checksummed binary form of a model.
 //!
-//! Layout (all integers little-endian):
+//! Layout of version 2, the one this build writes (all integers little-endian):
 //!
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 4 | magic `GYDT` |
-//! | 4 | 2 | format version ([`FORMAT_VERSION`]) |
+//! | 4 | 2 | format version, 2 ([`FORMAT_VERSION`]) |
 //! | 6 | 1 | model kind ([`Kind`]) |
 //! | 7 | 1 | reserved, 0 |
 //! | 8 | 4 | payload length `n`, bytes |
-//! | 12 | n | the model, serialised by `postcard` (serde) |
-//! | 12 + n | 4 | CRC-32/ISO-HDLC of bytes `0 .. 12 + n` |
+//! | 12 | 2 | reference times per axis the model needs (`R`; [`Capacities`]) |
+//! | 14 | 2 | ambients per axis it needs (`A`) |
+//! | 16 | 2 | curves per ambient it needs (`C`) |
+//! | 18 | 2 | reserved, 0 |
+//! | 20 | 4 | date written, `YYYYMMDD` as a number, 0 if not said ([`Provenance`]) |
+//! | 24 | 16 | writing tool's version, UTF-8, zero-padded |
+//! | 40 | 24 | unit ID, UTF-8, zero-padded (empty if not said) |
+//! | 64 | n | the model, serialised by `postcard` (serde) |
+//! | 64 + n | 4 | CRC-32/ISO-HDLC of bytes `0 .. 64 + n` |
 //!
-//! The payload codec is postcard's (well kept, no_std, no alloc); only the fixed header is ours.
-//! Decoding checks, in order: length, magic, version, kind, declared length, CRC, payload, contents
-//! (the model's own validation), so every byte string gets one specific error and never a panic.
-
-use core::fmt;
+//! Version 1 (still read) is the first 12 bytes of that header, then the payload at 12 and the CRC
+//! at `12 + n`; its payload is the same. The header is ours; the payload codec is postcard's (well
+//! kept, no_std, no alloc), so a change to a model's fields is a new version, and so is a change
+//! to the header.
+//!
+//! Decoding checks, in order: magic (erased flash, `0xFF`, is named as such), version, header
+//! length, kind, capacities (version 2), declared length, CRC, payload, contents (the model's own
+//! validation), so every byte string gets one specific error and never a panic. [`image_len`]
+//! reads the length from the header alone, so firmware can take an image out of a flash sector
+//! padded with erased bytes.
 
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::error::Error;
 use crate::model::Model;
 use crate::polynomial::{PolynomialTables, RelativePolynomialTables};
 use crate::recommended::RecommendedTables;
 use crate::table::ModifiedTables;
 
+mod error;
+mod header;
 mod in_place;
+mod layout;
 
-/// First four bytes of every image.
-pub const MAGIC: [u8; 4] = *b"GYDT";
-/// The image format version: the only one this build writes and reads. Any change to the
+pub use error::BlobError;
+pub use header::{Capacities, Header, Provenance};
+pub use layout::{
+    header_len, HEADER_LEN_V1, HEADER_LEN_V2, MAGIC, TOOL_VERSION_LEN, TRAILER_LEN, UNIT_ID_LEN,
+    VERSION_1, VERSION_2,
+};
+
+/// The image format version this build writes. It reads it and [`VERSION_1`]. Any change to the
 /// header or to the payload's shape (a model type's fields, in order) is a new version.
-pub const FORMAT_VERSION: u16 = 1;
-/// Bytes before the payload.
-pub const HEADER_LEN: usize = 12;
-/// Bytes after the payload (the CRC).
-pub const TRAILER_LEN: usize = 4;
+pub const FORMAT_VERSION: u16 = VERSION_2;
+/// Bytes before the payload in the version this build writes.
+pub const HEADER_LEN: usize = HEADER_LEN_V2;
 
 const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
 
@@ -60,6 +77,15 @@ pub trait Image: Model + Serialize + DeserializeOwned {
     /// The kind byte written in the header.
     const KIND: Kind;
 
+    /// The entries of each table dimension this type holds (its const generics).
+    const CAPACITIES: Capacities = Capacities::NONE;
+
+    /// The entries of each table dimension this model uses, written into the header so that a
+    /// decoder with smaller capacities names the one it lacks.
+    fn needs(&self) -> Capacities {
+        Capacities::NONE
+    }
+
     /// Decodes `payload` (exactly one model) into `place` and validates it: what [`decode_into`]
     /// does after the header and CRC. The default decodes by value and assigns only a validated
     /// model (`place` unchanged on error), which suits small models; the paper's tables write in
@@ -72,6 +98,11 @@ pub trait Image: Model + Serialize + DeserializeOwned {
 
 impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R, A, C> {
     const KIND: Kind = Kind::Modified;
+    const CAPACITIES: Capacities = Capacities::of(R, A, C);
+
+    fn needs(&self) -> Capacities {
+        needs_of(self.axes.iter())
+    }
 
     /// Field by field into `place`: the stack holds one curve at a time, never the tables. On
     /// error `place` is emptied (validation rejects it).
@@ -88,6 +119,11 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
 
 impl<const R: usize, const A: usize, const C: usize> Image for RecommendedTables<R, A, C> {
     const KIND: Kind = Kind::Recommended;
+    const CAPACITIES: Capacities = Capacities::of(R, A, C);
+
+    fn needs(&self) -> Capacities {
+        needs_of(self.axes.iter().map(|axis| &axis.table))
+    }
 
     /// In place, as the paper's tables it holds (the same stack bound). On error `place` is
     /// emptied (validation rejects it).
@@ -112,6 +148,27 @@ impl Image for RelativePolynomialTables {
     const KIND: Kind = Kind::RelativePolynomial;
 }
 
+/// The largest count of each dimension over `axes`.
+fn needs_of<'a, const R: usize, const A: usize, const C: usize>(
+    axes: impl Iterator<Item = &'a crate::table::AxisTable<R, A, C>>,
+) -> Capacities {
+    let mut needs = Capacities::NONE;
+    for axis in axes {
+        let mut curves = 0;
+        for ambient in &axis.ambients {
+            curves = curves
+                .max(ambient.curves.len())
+                .max(ambient.residual_heat_celsius.len())
+                .max(ambient.warm_starts.len());
+        }
+        let at_least = Capacities::of(axis.reference_ms.len(), axis.ambients.len(), curves);
+        needs.reference_times = needs.reference_times.max(at_least.reference_times);
+        needs.ambients = needs.ambients.max(at_least.ambients);
+        needs.curves = needs.curves.max(at_least.curves);
+    }
+    needs
+}
+
 /// The model of a payload that holds exactly one, validated. Out of line: the model is built,
 /// checked and validated in this one frame and written once into the caller's result, not copied
 /// through `decode`'s frame (firmware decodes ~12-KB tables on a stack it must budget,
@@ -128,103 +185,6 @@ fn from_payload<M: Image>(payload: &[u8]) -> Result<M, BlobError> {
     Ok(model)
 }
 
-/// Why an image could not be encoded or decoded.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum BlobError {
-    /// The byte string ends before the image does.
-    Truncated {
-        /// Bytes the image needs.
-        needed: usize,
-        /// Bytes available.
-        found: usize,
-    },
-    /// The first four bytes are not [`MAGIC`].
-    BadMagic {
-        /// The bytes found.
-        found: [u8; 4],
-    },
-    /// The format version is not [`FORMAT_VERSION`].
-    UnsupportedVersion {
-        /// The version found.
-        found: u16,
-    },
-    /// The image holds another kind of model than the one asked for (or an unknown kind).
-    WrongKind {
-        /// Kind asked for.
-        expected: u8,
-        /// Kind byte found.
-        found: u8,
-    },
-    /// Bytes follow the image's CRC.
-    TrailingBytes {
-        /// How many.
-        count: usize,
-    },
-    /// The stored CRC does not match the image's bytes.
-    CrcMismatch {
-        /// CRC stored in the image.
-        stored: u32,
-        /// CRC computed over the image.
-        computed: u32,
-    },
-    /// The payload is not a valid encoding of the model, or holds more entries than this build's
-    /// capacities.
-    Malformed(postcard::Error),
-    /// The payload decodes but its contents fail validation (the error names the field).
-    Invalid(Error),
-    /// Encoding: the output buffer is too small.
-    BufferTooSmall,
-}
-
-impl fmt::Display for BlobError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Truncated { needed, found } => {
-                write!(f, "table image truncated: needs {needed} bytes, got {found}")
-            }
-            Self::BadMagic { found } => write!(
-                f,
-                "not a gyrodrift table image: magic is {found:02x?}, expected {MAGIC:02x?} (\"GYDT\")"
-            ),
-            Self::UnsupportedVersion { found } => write!(
-                f,
-                "table image format version {found} is not supported (this build reads {FORMAT_VERSION})"
-            ),
-            Self::WrongKind { expected, found } => {
-                write!(f, "table image holds model kind {found}, expected {expected}")
-            }
-            Self::TrailingBytes { count } => {
-                write!(f, "{count} unexpected bytes after the table image's CRC")
-            }
-            Self::CrcMismatch { stored, computed } => write!(
-                f,
-                "table image CRC mismatch: stored {stored:#010x}, computed {computed:#010x} (corrupted)"
-            ),
-            Self::Malformed(error) => write!(f, "table image payload is malformed: {error}"),
-            Self::Invalid(error) => write!(f, "table image contents are invalid: {error}"),
-            Self::BufferTooSmall => f.write_str("output buffer too small for the table image"),
-        }
-    }
-}
-
-impl core::error::Error for BlobError {}
-
-fn le_u16(bytes: &[u8], at: usize) -> u16 {
-    let mut out = [0_u8; 2];
-    if let Some(src) = bytes.get(at..at.saturating_add(2)) {
-        out.copy_from_slice(src);
-    }
-    u16::from_le_bytes(out)
-}
-
-fn le_u32(bytes: &[u8], at: usize) -> u32 {
-    let mut out = [0_u8; 4];
-    if let Some(src) = bytes.get(at..at.saturating_add(4)) {
-        out.copy_from_slice(src);
-    }
-    u32::from_le_bytes(out)
-}
-
 /// The length in bytes of `model`'s image, without writing it (to size a buffer exactly).
 pub fn encoded_len<M: Image>(model: &M) -> Result<usize, BlobError> {
     let payload = postcard::serialize_with_flavor(model, postcard::ser_flavors::Size::default())
@@ -234,9 +194,20 @@ pub fn encoded_len<M: Image>(model: &M) -> Result<usize, BlobError> {
         .saturating_add(TRAILER_LEN))
 }
 
-/// Encodes `model` into `buffer`; returns the image's length. The model is validated first, so an
-/// image is never written from tables the firmware would reject.
+/// Encodes `model` into `buffer` with no [`Provenance`] ([`encode_for`] says where it comes
+/// from); returns the image's length.
 pub fn encode<M: Image>(model: &M, buffer: &mut [u8]) -> Result<usize, BlobError> {
+    encode_for(model, &Provenance::default(), buffer)
+}
+
+/// Encodes `model` into `buffer` as a version-2 image whose header carries the capacities it
+/// needs and `provenance`; returns the image's length. The model is validated first, so an image
+/// is never written from tables the firmware would reject.
+pub fn encode_for<M: Image>(
+    model: &M,
+    provenance: &Provenance,
+    buffer: &mut [u8],
+) -> Result<usize, BlobError> {
     model.validate().map_err(BlobError::Invalid)?;
     let payload_len = {
         let payload = buffer
@@ -254,22 +225,47 @@ pub fn encode<M: Image>(model: &M, buffer: &mut [u8]) -> Result<usize, BlobError
     let header = buffer
         .get_mut(..HEADER_LEN)
         .ok_or(BlobError::BufferTooSmall)?;
-    header.copy_from_slice(&[0; HEADER_LEN]);
-    for (dst, src) in header.iter_mut().zip(
-        MAGIC
-            .iter()
-            .chain(&FORMAT_VERSION.to_le_bytes())
-            .chain(&[M::KIND as u8, 0])
-            .chain(&declared.to_le_bytes()),
-    ) {
-        *dst = *src;
-    }
+    header::write_v2(header, M::KIND as u8, declared, &model.needs(), provenance);
     let crc = CRC32.checksum(buffer.get(..body_len).ok_or(BlobError::BufferTooSmall)?);
-    buffer
+    let trailer = buffer
         .get_mut(body_len..total)
-        .ok_or(BlobError::BufferTooSmall)?
-        .copy_from_slice(&crc.to_le_bytes());
+        .ok_or(BlobError::BufferTooSmall)?;
+    for (dst, src) in trailer.iter_mut().zip(crc.to_le_bytes()) {
+        *dst = src;
+    }
     Ok(total)
+}
+
+/// The header at the start of `bytes` (version 1 or 2), without checking the payload or the CRC:
+/// which unit an image calibrates and what it needs, before decoding it.
+pub fn header(bytes: &[u8]) -> Result<Header, BlobError> {
+    header::read(bytes)
+}
+
+/// The length of the image at the start of `bytes`, read from its header: firmware that keeps
+/// the image in a flash sector (erased to `0xFF` past it) decodes `&sector[..len]`.
+///
+/// ```
+/// # fn image() -> Vec<u8> {
+/// #     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/vectors.json")).unwrap();
+/// #     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+/// #     let hex = json["models"][0]["image_hex"].as_str().unwrap();
+/// #     (0..hex.len()).step_by(2).map(|i| u8::from_str_radix(&hex[i..i + 2], 16).unwrap()).collect()
+/// # }
+/// use drift_core::blob::{decode_into, image_len, BlobError};
+/// use drift_core::ModifiedTables;
+/// let mut sector = [0xff_u8; 16 * 1024];
+/// let image = image();
+/// sector[..image.len()].copy_from_slice(&image);
+///
+/// let mut tables: ModifiedTables<8, 3, 16> = ModifiedTables::EMPTY;
+/// let len = image_len(&sector)?;
+/// decode_into(sector.get(..len).ok_or(BlobError::Truncated { needed: len, found: sector.len() })?, &mut tables)?;
+/// assert_eq!(image_len(&[0xff; 64]), Err(BlobError::Erased));
+/// # Ok::<(), BlobError>(())
+/// ```
+pub fn image_len(bytes: &[u8]) -> Result<usize, BlobError> {
+    header::read_fixed(bytes).map(|header| header.image_len())
 }
 
 /// Decodes and validates an image of model type `M`, returned by value.
@@ -309,44 +305,30 @@ pub fn decode_into<M: Image>(bytes: &[u8], place: &mut M) -> Result<(), BlobErro
     M::payload_into(payload::<M>(bytes)?, place)
 }
 
-/// The payload of an image of model type `M`, after checking the header, the length and the CRC.
+/// The payload of an image of model type `M`, after checking the header (its capacities against
+/// `M`'s), the length and the CRC.
 fn payload<M: Image>(bytes: &[u8]) -> Result<&[u8], BlobError> {
-    let minimum = HEADER_LEN.saturating_add(TRAILER_LEN);
-    if bytes.len() < minimum {
-        // Check the magic of whatever is there first: a short non-image is "not an image".
-        if let Some(found) = bytes.get(..4) {
-            if found != MAGIC {
-                let mut magic = [0; 4];
-                magic.copy_from_slice(found);
-                return Err(BlobError::BadMagic { found: magic });
-            }
+    let header = match header::read_fixed(bytes) {
+        // A header cut short is an image cut short: say how long the shortest image is.
+        Err(BlobError::Truncated { .. }) if bytes.len() < HEADER_LEN_V1 + TRAILER_LEN => {
+            return Err(BlobError::Truncated {
+                needed: HEADER_LEN_V1.saturating_add(TRAILER_LEN),
+                found: bytes.len(),
+            })
         }
-        return Err(BlobError::Truncated {
-            needed: minimum,
-            found: bytes.len(),
-        });
-    }
-    let mut magic = [0; 4];
-    if let Some(found) = bytes.get(..4) {
-        magic.copy_from_slice(found);
-    }
-    if magic != MAGIC {
-        return Err(BlobError::BadMagic { found: magic });
-    }
-    let version = le_u16(bytes, 4);
-    if version != FORMAT_VERSION {
-        return Err(BlobError::UnsupportedVersion { found: version });
-    }
-    let kind = bytes.get(6).copied().unwrap_or(0);
-    if kind != M::KIND as u8 {
+        other => other?,
+    };
+    if header.kind != M::KIND as u8 {
         return Err(BlobError::WrongKind {
             expected: M::KIND as u8,
-            found: kind,
+            found: header.kind,
         });
     }
-    let payload_len = le_u32(bytes, 8) as usize;
-    let body_len = HEADER_LEN.saturating_add(payload_len);
-    let total = body_len.saturating_add(TRAILER_LEN);
+    if let Some(needs) = &header.needs {
+        needs.fit_in(&M::CAPACITIES)?;
+    }
+    let body_len = header.len().saturating_add(header.payload_len as usize);
+    let total = header.image_len();
     if bytes.len() < total {
         return Err(BlobError::Truncated {
             needed: total,
@@ -359,10 +341,10 @@ fn payload<M: Image>(bytes: &[u8]) -> Result<&[u8], BlobError> {
         });
     }
     let body = bytes.get(..body_len).unwrap_or_default();
-    let stored = le_u32(bytes, body_len);
+    let stored = layout::le_u32(bytes, body_len);
     let computed = CRC32.checksum(body);
     if stored != computed {
         return Err(BlobError::CrcMismatch { stored, computed });
     }
-    Ok(body.get(HEADER_LEN..).unwrap_or_default())
+    Ok(body.get(header.len()..).unwrap_or_default())
 }

@@ -4,7 +4,7 @@ use crate::error::{Error, Location, Problem};
 use crate::extension::{ExtensionState, AUX_INPUTS};
 use crate::flags::Flags;
 use crate::history::{Previous, SwitchOn};
-use crate::model::{AxisModel, Model};
+use crate::model::{AxisModel, ConstDefault, Model};
 use crate::settings::Settings;
 use crate::AXES;
 
@@ -53,6 +53,7 @@ pub struct AxisState<S> {
     model: S,
 }
 
+/// Not powered on: `correct` passes rates through, flagged `NOT_POWERED_ON`.
 impl<S: Default> Default for AxisState<S> {
     fn default() -> Self {
         Self {
@@ -65,6 +66,19 @@ impl<S: Default> Default for AxisState<S> {
             model: S::default(),
         }
     }
+}
+
+/// [`Default`]'s value, for `const` contexts (a unit test checks they agree).
+impl<S: ConstDefault> ConstDefault for AxisState<S> {
+    const DEFAULT: Self = Self {
+        switch_on_raw: 0.0,
+        initial_bias_dps: 0.0,
+        bias_dps: 0.0,
+        last_raw: 0.0,
+        repeats: 0,
+        activation_flags: Flags::NOT_POWERED_ON,
+        model: S::DEFAULT,
+    };
 }
 
 impl<S> AxisState<S> {
@@ -93,12 +107,33 @@ pub struct CorrectorState<S> {
     extension: ExtensionState,
 }
 
-impl<S: Copy + Default> CorrectorState<S> {
-    /// A state that has not been powered on: `correct` passes rates through, flagged.
-    pub fn new() -> Self {
-        Self::default()
+impl<S: ConstDefault> CorrectorState<S> {
+    /// A state that has not been powered on: `correct` passes rates through, flagged. A `const fn`,
+    /// so a unit's state can be a `static` (an interrupt handler corrects through it with no
+    /// `Option` to unwrap; docs/embedded.md):
+    ///
+    /// ```
+    /// use drift_core::{CorrectorState, ModifiedAxisState};
+    /// static STATE: CorrectorState<ModifiedAxisState> = CorrectorState::new();
+    /// assert!(!STATE.is_powered_on());
+    /// ```
+    pub const fn new() -> Self {
+        Self {
+            axes: [
+                AxisState::<S>::DEFAULT,
+                AxisState::<S>::DEFAULT,
+                AxisState::<S>::DEFAULT,
+            ],
+            extension: ExtensionState::POWER_ON,
+        }
     }
+}
 
+impl<S: ConstDefault> ConstDefault for CorrectorState<S> {
+    const DEFAULT: Self = Self::new();
+}
+
+impl<S: Copy + Default> CorrectorState<S> {
     /// The per-axis states, X, Y, Z.
     pub fn axes(&self) -> &[AxisState<S>; AXES] {
         &self.axes
@@ -766,6 +801,20 @@ mod tests {
 
     /// The floor for a unit's run-time state, 256 bytes, extension included (docs/embedded.md). The
     /// layout has no pointers, so the host's size is the Cortex-M4's (which the firmware prints).
+    #[test]
+    fn the_constant_state_is_the_default() {
+        use crate::{ConstDefault, PolynomialAxisState};
+        assert_eq!(
+            CorrectorState::<ModifiedAxisState>::new(),
+            CorrectorState::default()
+        );
+        assert_eq!(
+            CorrectorState::<PolynomialAxisState>::new(),
+            CorrectorState::default()
+        );
+        assert_eq!(ModifiedAxisState::DEFAULT, ModifiedAxisState::default());
+    }
+
     #[test]
     fn state_fits_its_floor() {
         assert!(core::mem::size_of::<CorrectorState<ModifiedAxisState>>() <= 256);

@@ -45,7 +45,7 @@ pub use extension::{
 };
 pub use flags::Flags;
 pub use history::{Previous, SwitchOn};
-pub use model::{AxisModel, Model};
+pub use model::{AxisModel, ConstDefault, Model};
 pub use modified::ModifiedAxisState;
 pub use polynomial::{
     PolynomialAxis, PolynomialAxisState, PolynomialTables, RelativePolynomialAxis,

@@ -8,6 +8,14 @@ use crate::history::SwitchOn;
 use crate::settings::Settings;
 use crate::AXES;
 
+/// [`Default`] as a constant, so that a unit's run-time state can be built in a `const` context
+/// ([`crate::CorrectorState::new`] is a `const fn`): firmware declares it as a `static`, with no
+/// `Option` or `RefCell` to fill at start-up.
+pub trait ConstDefault: Sized {
+    /// The value [`Default::default`] returns.
+    const DEFAULT: Self;
+}
+
 /// One axis of a drift model: what it needs at switch-on and per sample.
 ///
 /// Implementations are pure functions of their (immutable) calibration data and the small per-axis
@@ -15,7 +23,7 @@ use crate::AXES;
 /// sensor-fault holds, flags).
 pub trait AxisModel {
     /// Per-axis run-time state the model keeps between switch-on and each sample.
-    type State: Copy + Default + core::fmt::Debug;
+    type State: Copy + Default + ConstDefault + core::fmt::Debug;
 
     /// Prepares `state` at switch-on from the switch-on temperature (°C); returns the initial bias
     /// (°/s) and any envelope flags that hold for the whole activation.

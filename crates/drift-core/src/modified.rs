@@ -7,7 +7,7 @@ use crate::error::{Error, Location};
 use crate::extension::Extension;
 use crate::flags::Flags;
 use crate::history::SwitchOn;
-use crate::model::{AxisModel, Model};
+use crate::model::{AxisModel, ConstDefault, Model};
 use crate::settings::Settings;
 use crate::stage::ambient::AmbientPosition;
 use crate::stage::heating::{by_history, cached_k, search, BlendedCurves, Knots};
@@ -39,6 +39,20 @@ pub struct ModifiedAxisState {
     /// stays within 256 bytes.
     knots: [Knots; 2],
     curve: u8,
+}
+
+impl ConstDefault for ModifiedAxisState {
+    const DEFAULT: Self = Self {
+        ambient_weight: 0.0,
+        ambient_lo: 0,
+        segment_start_ms: 0,
+        segment_len_ms: 0,
+        segment_per_ms: 0.0,
+        segment_lo: 0,
+        segment_kind: SegmentKind::BeforeFirst,
+        knots: [[CurvePoint::ZERO; 2]; 2],
+        curve: 0,
+    };
 }
 
 impl ModifiedAxisState {

@@ -14,7 +14,7 @@ use heapless::Vec;
 
 use crate::error::{check_finite, Error, Location, Problem};
 use crate::flags::Flags;
-use crate::model::{AxisModel, Model};
+use crate::model::{AxisModel, ConstDefault, Model};
 use crate::settings::Settings;
 use crate::AXES;
 
@@ -121,6 +121,12 @@ impl Span {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PolynomialAxisState {
     at_switch_on_dps: f32,
+}
+
+impl ConstDefault for PolynomialAxisState {
+    const DEFAULT: Self = Self {
+        at_switch_on_dps: 0.0,
+    };
 }
 
 impl AxisModel for PolynomialAxis {

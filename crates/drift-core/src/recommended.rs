@@ -156,10 +156,10 @@ pub struct RecommendedTables<const R: usize = 16, const A: usize = 12, const C: 
 }
 
 impl<const R: usize, const A: usize, const C: usize> RecommendedTables<R, A, C> {
-    /// No axis data (which validation rejects), default settings: for a `static` that
-    /// `blob::decode_into` fills.
+    /// No axis data and [`Settings::ZEROED`] (which validation rejects), all-zero bytes: for a
+    /// `static` in `.bss` that `blob::decode_into` fills.
     pub const EMPTY: Self = Self {
-        settings: Settings::DEFAULT,
+        settings: Settings::ZEROED,
         axes: [
             RecommendedAxis::EMPTY,
             RecommendedAxis::EMPTY,

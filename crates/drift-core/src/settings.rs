@@ -47,6 +47,17 @@ impl Settings {
         stuck_after_samples: 2000,
     };
 
+    /// Every field zero (a scale of 0 raw units per °C, which validation rejects): the settings of
+    /// empty tables, so that a `static` holding them is all-zero bytes and the linker places it in
+    /// `.bss` (zeroed at start-up) rather than copying its initial value from flash.
+    pub const ZEROED: Self = Self {
+        raw_per_celsius: 0.0,
+        raw_at_zero_celsius: 0.0,
+        ambient_margin_celsius: 0.0,
+        rise_margin_celsius: 0.0,
+        stuck_after_samples: 0,
+    };
+
     /// Checks that every value is finite and in its documented range.
     pub fn validate(&self) -> Result<(), Error> {
         let at = Location::default();

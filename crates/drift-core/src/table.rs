@@ -36,6 +36,14 @@ pub struct CurvePoint {
     pub k_dps_per_celsius: f32,
 }
 
+impl CurvePoint {
+    /// Rise 0, `k` 0 ([`Default`] as a constant).
+    pub const ZERO: Self = Self {
+        rise_celsius: 0.0,
+        k_dps_per_celsius: 0.0,
+    };
+}
+
 /// One heating-dynamics curve (one activation curve of the calibration: an interval × activation
 /// number, or the merged "independent" first activations): one point per reference time of its axis.
 ///
@@ -120,11 +128,12 @@ pub struct ModifiedTables<const R: usize = 16, const A: usize = 12, const C: usi
 }
 
 impl<const R: usize, const A: usize, const C: usize> ModifiedTables<R, A, C> {
-    /// Tables with no axis data (which validation rejects), default settings and no extension: a
-    /// constant, so firmware can place the tables in a `static` (zero-initialised RAM) and fill them
+    /// Tables with no axis data and [`Settings::ZEROED`] (which validation rejects) and no
+    /// extension: a constant whose bytes are all zero, so that firmware places the tables in a
+    /// `static` that the linker puts in `.bss` (no flash copy of the tables' size) and fills them
     /// with `blob::decode_into` (feature `serde`), without building them on the stack.
     pub const EMPTY: Self = Self {
-        settings: Settings::DEFAULT,
+        settings: Settings::ZEROED,
         axes: [AxisTable::EMPTY, AxisTable::EMPTY, AxisTable::EMPTY],
         extension: Extension::NONE,
     };

@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use drift_core::blob::{self, BlobError, Image};
+use drift_core::blob::{self, BlobError, Image, Provenance};
 use drift_fit::FittedUnit;
 use drift_recording::write_atomic_creating_folder;
 use serde::Serialize;
@@ -101,12 +101,40 @@ impl StoredModel {
     }
 }
 
-/// The firmware image of `model`, exactly as long as it needs to be.
+/// The firmware image of `model`, exactly as long as it needs to be, with no provenance.
 pub fn image_bytes<M: Image>(model: &M) -> Result<Vec<u8>, BlobError> {
+    image_bytes_for(model, &Provenance::default())
+}
+
+/// The firmware image of `model` whose header says where it comes from.
+pub fn image_bytes_for<M: Image>(model: &M, provenance: &Provenance) -> Result<Vec<u8>, BlobError> {
     let mut image = vec![0; blob::encoded_len(model)?];
-    let written = blob::encode(model, &mut image)?;
+    let written = blob::encode_for(model, provenance, &mut image)?;
     image.truncate(written);
     Ok(image)
+}
+
+/// What this tool writes into the header of `unit_id`'s images: the unit, this version, and
+/// today's date (UTC; `SOURCE_DATE_EPOCH`, seconds, when set, for reproducible builds).
+pub fn provenance(unit_id: &str) -> Result<Provenance, BlobError> {
+    Provenance::new(unit_id, env!("CARGO_PKG_VERSION"), today())
+}
+
+/// Today as `YYYYMMDD` (0 if the clock or `SOURCE_DATE_EPOCH` is unusable).
+fn today() -> u32 {
+    let now = match std::env::var("SOURCE_DATE_EPOCH") {
+        Ok(seconds) => seconds
+            .trim()
+            .parse::<i64>()
+            .ok()
+            .and_then(|s| time::OffsetDateTime::from_unix_timestamp(s).ok()),
+        Err(_) => Some(time::OffsetDateTime::now_utc()),
+    };
+    now.and_then(|date| {
+        let year = u32::try_from(date.year()).ok()?;
+        Some(year * 10_000 + u32::from(u8::from(date.month())) * 100 + u32::from(date.day()))
+    })
+    .unwrap_or(0)
 }
 
 /// drift-core's JSON of `model`, pretty-printed.
@@ -114,11 +142,13 @@ fn json_bytes<M: Serialize>(model: &M) -> Result<Vec<u8>, serde_json::Error> {
     serde_json::to_string_pretty(model).map(String::into_bytes)
 }
 
-/// A model's JSON and image files at `<dir>/<stem>.{json,bin}`, encoded in memory.
+/// A model's JSON and image files at `<dir>/<stem>.{json,bin}`, encoded in memory; the image's
+/// header carries `provenance`.
 pub fn model_files<M: Image>(
     dir: &Path,
     stem: &str,
     model: &M,
+    provenance: &Provenance,
 ) -> Result<[(PathBuf, Vec<u8>); 2], TablesError> {
     let (json, bin) = (
         dir.join(format!("{stem}.json")),
@@ -128,7 +158,7 @@ pub fn model_files<M: Image>(
         path: json.clone(),
         problem,
     })?;
-    let image = image_bytes(model).map_err(|problem| TablesError::Encode {
+    let image = image_bytes_for(model, provenance).map_err(|problem| TablesError::Encode {
         path: bin.clone(),
         problem,
     })?;
@@ -141,16 +171,21 @@ pub fn unit_files(
     unit: &FittedUnit,
 ) -> Result<Vec<(PathBuf, Vec<u8>)>, TablesError> {
     let dir = folder.join(&unit.unit_id);
+    // Each image names its unit, so that `gyrodrift check` refuses it for another.
+    let from = provenance(&unit.unit_id).map_err(|problem| TablesError::Encode {
+        path: dir.clone(),
+        problem,
+    })?;
     let mut files = Vec::with_capacity(2 * StoredModel::ALL.len());
     for model in StoredModel::ALL {
         let stem = model.stem();
         let pair = match model {
-            StoredModel::Modified => model_files(&dir, stem, &unit.modified)?,
-            StoredModel::ByHistory => model_files(&dir, stem, &unit.by_history)?,
-            StoredModel::Standard => model_files(&dir, stem, &unit.standard)?,
-            StoredModel::ThirdOrder => model_files(&dir, stem, &unit.third_order)?,
-            StoredModel::Relative => model_files(&dir, stem, &unit.relative)?,
-            StoredModel::Recommended => model_files(&dir, stem, &unit.recommended)?,
+            StoredModel::Modified => model_files(&dir, stem, &unit.modified, &from)?,
+            StoredModel::ByHistory => model_files(&dir, stem, &unit.by_history, &from)?,
+            StoredModel::Standard => model_files(&dir, stem, &unit.standard, &from)?,
+            StoredModel::ThirdOrder => model_files(&dir, stem, &unit.third_order, &from)?,
+            StoredModel::Relative => model_files(&dir, stem, &unit.relative, &from)?,
+            StoredModel::Recommended => model_files(&dir, stem, &unit.recommended, &from)?,
         };
         files.extend(pair);
     }
@@ -184,12 +219,18 @@ pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<(), TablesError> {
 
 /// Reads and decodes the firmware image at `path`.
 pub fn read_image<M: Image>(path: &Path) -> Result<M, TablesError> {
+    read_image_and_header(path).map(|(model, _)| model)
+}
+
+/// Reads and decodes the firmware image at `path`, with its header (which unit it calibrates).
+pub fn read_image_and_header<M: Image>(path: &Path) -> Result<(M, blob::Header), TablesError> {
     let bytes = std::fs::read(path).map_err(|problem| TablesError::Io {
         action: "read",
         path: path.to_owned(),
         problem,
     })?;
-    blob::decode(&bytes).map_err(|problem| TablesError::Decode {
+    let decode = |bytes: &[u8]| Ok((blob::decode(bytes)?, blob::header(bytes)?));
+    decode(&bytes).map_err(|problem| TablesError::Decode {
         path: path.to_owned(),
         problem,
     })

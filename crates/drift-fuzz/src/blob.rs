@@ -1,13 +1,15 @@
 //! Target `blob`: the firmware table image decoder, for both model kinds and two capacities.
 //!
 //! Input: one mode byte, then the image. Mode bit 0 rewrites the declared payload length and
-//! bit 1 recomputes the CRC before decoding, so mutations reach the postcard payload and the
+//! bit 1 recomputes the CRC before decoding (the header's length read from its version byte), so mutations reach the postcard payload and the
 //! model validation behind the checksum instead of all dying at the CRC check.
 //!
 //! Invariants: decoding never panics; an accepted image validates, runs a corrector, and
 //! survives encode → decode unchanged (images are not canonical: finding F1).
 
-use drift_core::blob::{decode, decode_into, encode, Image, HEADER_LEN, TRAILER_LEN};
+use drift_core::blob::{
+    decode, decode_into, encode, header_len, Image, HEADER_LEN, HEADER_LEN_V1, TRAILER_LEN,
+};
 use drift_core::{Corrector, ModifiedTables, PolynomialTables, Sample};
 
 const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
@@ -15,12 +17,17 @@ const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
 /// Fixes the declared length and/or the CRC of `bytes` as the mode byte asks.
 pub fn prepare(mode: u8, bytes: &mut [u8]) {
     let len = bytes.len();
-    if len < HEADER_LEN + TRAILER_LEN {
+    if len < HEADER_LEN_V1 + TRAILER_LEN {
         return;
     }
+    // The version's header length (version 1's for an unknown version), as the decoder reads it.
+    let header = match header_len(u16::from_le_bytes([bytes[4], bytes[5]])) {
+        0 => HEADER_LEN_V1,
+        known => known,
+    };
     let body = len - TRAILER_LEN;
-    if mode & 1 != 0 {
-        let payload = u32::try_from(body - HEADER_LEN).unwrap_or(u32::MAX);
+    if mode & 1 != 0 && body >= header {
+        let payload = u32::try_from(body - header).unwrap_or(u32::MAX);
         bytes[8..12].copy_from_slice(&payload.to_le_bytes());
     }
     if mode & 2 != 0 {
@@ -50,7 +57,12 @@ fn check<M: Image + PartialEq + core::fmt::Debug + Default>(bytes: &[u8]) {
     // ignored, postcard accepts overlong varints), so several byte strings decode to one model.
     // The CRC still covers every byte. What must hold: the model survives encode → decode, and the
     // canonical image is never longer than the one decoded.
-    assert!(len <= bytes.len(), "re-encoding is longer than the image");
+    // A version-1 image is re-encoded behind the longer version-2 header.
+    let grown = HEADER_LEN - header_len(u16::from_le_bytes([bytes[4], bytes[5]]));
+    assert!(
+        len <= bytes.len() + grown,
+        "re-encoding is longer than the image"
+    );
     let again = decode::<M>(&buffer[..len]).expect("a re-encoded model decodes");
     assert_eq!(again, model, "the model changes through encode → decode");
     let mut corrector = Corrector::new(&model).expect("a decoded model is accepted");

@@ -414,21 +414,21 @@ def image(modified: ModifiedTables) -> bytes:
         (lambda b: b'{"axes": []}', "not a gyrodrift table image: magic is [7b, 22, 61, 78]"),
         (
             lambda b: b[:4] + b"\x07\x00" + b[6:],
-            "table image format version 7 is not supported (this build reads 1)",
+            "table image format version 7 is not supported (this build reads 1 and 2)",
         ),
         (
             lambda b: b[:4] + b"\x00\x00" + b[6:],
-            "table image format version 0 is not supported (this build reads 1)",
+            "table image format version 0 is not supported (this build reads 1 and 2)",
         ),
         (lambda b: b[:6] + b"\x02" + b[7:], "table image holds model kind 2, expected 1"),
         (lambda b: b + b"\x00\x00", "2 unexpected bytes after the table image's CRC"),
         (lambda b: b[:20] + bytes([b[20] ^ 1]) + b[21:], "table image CRC mismatch"),
         (
-            lambda b: with_crc(b[:8] + struct.pack("<I", 3) + b"\xff\xff\xff"),
+            lambda b: with_crc(b[:8] + struct.pack("<I", 3) + b[12:64] + b"\xff\xff\xff"),
             "table image payload is malformed",
         ),
         (
-            lambda b: with_crc(b[:12] + struct.pack("<f", -1.0) + b[16:-4]),
+            lambda b: with_crc(b[:64] + struct.pack("<f", -1.0) + b[68:-4]),
             "table image contents are invalid: raw_per_celsius: must be greater than zero",
         ),
     ],
