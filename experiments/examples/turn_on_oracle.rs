@@ -1,7 +1,7 @@
 //! What limits the recommended model's residual bias in field-like use: its switch-on offset or
 //! the drift after it. The tables are fitted on the calibration set points' protocol activations
 //! (recordings only); afterwards every field activation is corrected with the recommended model
-//! and the residual bias RMS (1-s low-passed corrected rate) is measured four ways:
+//! and the residual bias RMS (1-s low-passed corrected rate) is measured six ways:
 //!
 //! - *as fitted*: the recommended model as firmware runs it (started from what it kept of the
 //!   previous activation);
@@ -10,7 +10,9 @@
 //! - *best constant*: the same drift correction with the one offset that minimises the
 //!   activation's RMS (what no switch-on offset model can beat);
 //! - *standard's offset*: the same drift correction started from the standard baseline's bias at
-//!   the switch-on temperature (a fitter-legal hybrid).
+//!   the switch-on temperature (a fitter-legal hybrid);
+//! - *residual heat not held* and *no residual-heat term*: the turn-on bias `q(T_on)` with the
+//!   residual heat's share taken however large, and without it.
 //!
 //! Each is a mean over a unit × axis × set point cell's field activations, set beside the best
 //! baseline's (the lowest of standard, 3rd-order, relative and relative cubic in that cell), and
@@ -34,31 +36,16 @@ use drift_recording::{read_recording, SeriesKind, TRUTH_DIR, TRUTH_EXTENSION};
 use drift_sim::truth::read_truth;
 
 /// The variants measured, in column order.
-const VARIANTS: [&str; 9] = [
+const VARIANTS: [&str; 8] = [
     "as fitted",
     "true offset",
     "best constant",
     "standard's offset",
-    "q linear beyond its range",
-    "q linear beyond, no heat",
-    "heat held at the calibrated most",
+    "residual heat not held",
+    "no residual-heat term",
     "modified",
     "best baseline",
 ];
-
-/// `q` at `celsius`: the polynomial inside its range, continued along its tangent beyond it.
-fn q_linear(q: &drift_core::PolynomialAxis, celsius: f64) -> f64 {
-    let [low, high] = q.range_celsius.map(f64::from);
-    let (mid, half) = ((low + high) / 2.0, (high - low) / 2.0);
-    let x = (celsius - mid) / half;
-    let edge = x.clamp(-1.0, 1.0);
-    let (mut value, mut slope) = (0.0, 0.0);
-    for &c in q.coefficients.iter().rev() {
-        slope = slope * edge + value;
-        value = value * edge + f64::from(c);
-    }
-    value + slope * (x - edge)
-}
 
 /// RMS of the low-passed `rate + shift`.
 fn rms(rate: &[f32], shift: f64, window: usize) -> f64 {
@@ -104,21 +91,6 @@ fn main() -> anyhow::Result<()> {
         ModelKind::Relative,
         ModelKind::RelativeCubic,
     ];
-    // The most residual heat any calibration activation switched on with, per unit and axis.
-    let mut most_heat: BTreeMap<(String, usize), f64> = BTreeMap::new();
-    for fitted in &outcome.fitted {
-        let own: Vec<&drift_fit::analyse::Analysed> = outcome
-            .calibration
-            .iter()
-            .filter(|a| a.labels.unit_id == fitted.unit_id)
-            .collect();
-        for axis in 0..3 {
-            let most = drift_fit::turn_on::residual_heats(&own, axis)
-                .into_iter()
-                .fold(0.0, f64::max);
-            most_heat.insert((fitted.unit_id.clone(), axis), most);
-        }
-    }
     let mut cells: Cells = BTreeMap::new();
     let mut offsets: Vec<(f64, f64, f64)> = Vec::new();
     for path in &files {
@@ -165,7 +137,8 @@ fn main() -> anyhow::Result<()> {
                 let on = core.celsius(switch_on[axis]);
                 let estimate = drift_core::SwitchOn::estimate(on, Some(previous[axis]));
                 let turn_on = &fitted.recommended.axes[axis].turn_on;
-                let q = q_linear(&turn_on.polynomial, f64::from(on));
+                let (q, _) = turn_on.polynomial.continued(on, core.ambient_margin_celsius);
+                let q = f64::from(q);
                 let residual = if estimate.known {
                     f64::from(estimate.residual_heat_celsius).max(0.0)
                 } else {
@@ -173,7 +146,6 @@ fn main() -> anyhow::Result<()> {
                 };
                 let slope = f64::from(turn_on.dps_per_residual_celsius);
                 let heat = slope * residual;
-                let held = slope * residual.min(most_heat[&(recording.unit_id.clone(), axis)]);
                 let of = |kind: ModelKind| {
                     result
                         .models
@@ -188,7 +160,6 @@ fn main() -> anyhow::Result<()> {
                     rms(rec, model_on - standard_on, window),
                     rms(rec, model_on - q - heat, window),
                     rms(rec, model_on - q, window),
-                    rms(rec, model_on - q - held, window),
                     of(ModelKind::Modified),
                     0.0,
                 ];
