@@ -137,7 +137,9 @@ fn main() -> anyhow::Result<()> {
                 let on = core.celsius(switch_on[axis]);
                 let estimate = drift_core::SwitchOn::estimate(on, Some(previous[axis]));
                 let turn_on = &fitted.recommended.axes[axis].turn_on;
-                let (q, _) = turn_on.polynomial.continued(on, core.ambient_margin_celsius);
+                let (q, _) = turn_on
+                    .polynomial
+                    .continued(on, core.ambient_margin_celsius);
                 let q = f64::from(q);
                 let residual = if estimate.known {
                     f64::from(estimate.residual_heat_celsius).max(0.0)
