@@ -45,6 +45,7 @@ fn main() {
             "extended" => "ModelName::Extended",
             "by_history" => "ModelName::ByHistory",
             "warm_started" => "ModelName::WarmStarted",
+            "recommended" => "ModelName::Recommended",
             other => panic!("unknown model {other}"),
         };
         writeln!(

@@ -2,13 +2,16 @@
 //! a stack-use probe.
 #![no_std]
 
-use drift_core::{ModifiedTables, Previous};
+use drift_core::{ModifiedTables, Previous, RecommendedTables};
 
 pub mod stack;
 
 /// Table capacities of this firmware: 8 reference times, 3 ambients, 16 curves per ambient (the
 /// realistic table `docs/embedded.md` reports on).
 pub type FirmwareTables = ModifiedTables<8, 3, 16>;
+
+/// The recommended model at the same capacities.
+pub type FirmwareRecommended = RecommendedTables<8, 3, 16>;
 
 /// Which model a vector case runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,6 +28,8 @@ pub enum ModelName {
     ByHistory,
     /// The paper's tables with warm starts' initial bias.
     WarmStarted,
+    /// The paper's drift correction with the turn-on bias fitted across activations.
+    Recommended,
 }
 
 /// One test-vector case (see `testdata/vectors.json`).

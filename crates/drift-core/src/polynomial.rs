@@ -46,6 +46,27 @@ impl PolynomialAxis {
         (value, span.outside(celsius))
     }
 
+    /// The polynomial at `celsius`, continued beyond the fitted range along its tangent at the
+    /// nearer end (a NaN reads as the low end, as in [`Self::evaluate`]), and whether `celsius`
+    /// lies beyond `margin_celsius`. For a value read once per activation from a fit that must
+    /// keep the temperature's trend where a unit is used outside its calibration (a clamp holds
+    /// the end's value; a polynomial's own curvature swings).
+    pub fn continued(&self, celsius: f32, margin_celsius: f32) -> (f32, bool) {
+        let span = Span::new(self.range_celsius, margin_celsius);
+        let edge = span.normalised(celsius);
+        let x = (celsius - span.mid) / span.half_span;
+        let (mut value, mut slope) = (0.0_f32, 0.0_f32);
+        for &c in self.coefficients.iter().rev() {
+            slope = slope * edge + value;
+            value = value * edge + c;
+        }
+        // Inside the range x − edge is exactly 0 (the same arithmetic as `normalised`); a NaN or
+        // infinite reading takes no tangent.
+        let beyond = x - edge;
+        let beyond = if beyond.is_finite() { beyond } else { 0.0 };
+        (value + slope * beyond, span.outside(celsius))
+    }
+
     /// Checks this axis's polynomial; `at` names the axis in errors.
     pub fn validate(&self, at: Location) -> Result<(), Error> {
         check_finite("range_celsius", at, self.range_celsius)?;

@@ -11,7 +11,7 @@
 //! previous activation, [`crate::SwitchOn`]), the drift after it from the paper's three stages.
 //! Per sample it does exactly what the paper's model does.
 
-use crate::error::{check_finite, Error, Location};
+use crate::error::{check_finite, Error, Location, Problem};
 use crate::flags::Flags;
 use crate::history::SwitchOn;
 use crate::model::{AxisModel, Model};
@@ -27,10 +27,17 @@ use crate::AXES;
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct TurnOn {
     /// `q`: the turn-on bias of a start with no residual heat, as a polynomial of the switch-on
-    /// temperature (clamped to its fitted range, flagged `TEMPERATURE_OUT_OF_RANGE` beyond it).
+    /// temperature over the calibration's switch-on temperatures, continued along its tangent
+    /// beyond them ([`PolynomialAxis::continued`]; flagged `TEMPERATURE_OUT_OF_RANGE` beyond the
+    /// ambient margin).
     pub polynomial: PolynomialAxis,
     /// How much a °C of residual heat at switch-on moves the turn-on bias, (°/s) per °C.
     pub dps_per_residual_celsius: f32,
+    /// The most residual heat a calibration activation switched on with, °C: more is held at it
+    /// (flagged `HISTORY_OUT_OF_SPAN`). Without a clock, an ambient that rose between switch-off
+    /// and switch-on reads as residual heat; the slope is only known over the heats it was
+    /// fitted on.
+    pub most_residual_heat_celsius: f32,
 }
 
 impl TurnOn {
@@ -40,7 +47,7 @@ impl TurnOn {
     pub fn bias(&self, settings: &Settings, switch_on: &SwitchOn) -> (f32, Flags) {
         let (q, outside) = self
             .polynomial
-            .evaluate(switch_on.switch_on_celsius, settings.ambient_margin_celsius);
+            .continued(switch_on.switch_on_celsius, settings.ambient_margin_celsius);
         let mut flags = if outside {
             Flags::TEMPERATURE_OUT_OF_RANGE
         } else {
@@ -48,7 +55,13 @@ impl TurnOn {
         };
         let heat = switch_on.residual_heat_celsius;
         let warm = if switch_on.known && heat > 0.0 {
-            self.dps_per_residual_celsius * heat
+            let held = if heat > self.most_residual_heat_celsius {
+                flags |= Flags::HISTORY_OUT_OF_SPAN;
+                self.most_residual_heat_celsius
+            } else {
+                heat
+            };
+            self.dps_per_residual_celsius * held
         } else {
             0.0
         };
@@ -65,7 +78,20 @@ impl TurnOn {
             "dps_per_residual_celsius",
             at,
             [self.dps_per_residual_celsius],
-        )
+        )?;
+        check_finite(
+            "most_residual_heat_celsius",
+            at,
+            [self.most_residual_heat_celsius],
+        )?;
+        if self.most_residual_heat_celsius < 0.0 {
+            return Err(Error::new(
+                "most_residual_heat_celsius",
+                at,
+                Problem::Negative,
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -91,6 +117,7 @@ impl<const R: usize, const A: usize, const C: usize> RecommendedAxis<R, A, C> {
                 coefficients: heapless::Vec::new(),
             },
             dps_per_residual_celsius: 0.0,
+            most_residual_heat_celsius: 0.0,
         },
     };
 }
@@ -264,6 +291,7 @@ mod tests {
                 coefficients,
             },
             dps_per_residual_celsius: -0.004,
+            most_residual_heat_celsius: 3.0,
         }
     }
 
@@ -312,13 +340,40 @@ mod tests {
     }
 
     #[test]
-    fn beyond_the_fitted_range_the_turn_on_is_clamped_and_flagged() {
+    fn beyond_the_fitted_range_the_turn_on_follows_its_tangent_and_is_flagged() {
         let model = model();
         let mut state = ModifiedAxisState::default();
+        // q = 0.01 + 0.02 · (T − 35) / 5: at 50 °C, 15 °C beyond the middle, 0.07.
         let (bias, flags) = model.axes[1].power_on(&Settings::DEFAULT, 50.0, &mut state);
-        assert_eq!(bias, 0.03);
+        assert!((bias - 0.07).abs() < 1e-7, "{bias}");
         assert!(flags.contains(Flags::TEMPERATURE_OUT_OF_RANGE), "{flags:?}");
         assert!(flags.contains(Flags::AMBIENT_OUT_OF_RANGE), "{flags:?}");
+        let (nan, flags) = model.axes[1].power_on(&Settings::DEFAULT, f32::NAN, &mut state);
+        assert!(flags.contains(Flags::TEMPERATURE_OUT_OF_RANGE), "{flags:?}");
+        assert!(
+            (nan - -0.01).abs() < 1e-7,
+            "a NaN reads as the low end: {nan}"
+        );
+    }
+
+    #[test]
+    fn more_residual_heat_than_calibrated_is_held_and_flagged() {
+        let model = model();
+        let settings = Settings::DEFAULT;
+        let mut state = ModifiedAxisState::default();
+        let at = |heat: f32| SwitchOn {
+            switch_on_celsius: 35.0,
+            ambient_celsius: 35.0 - heat,
+            residual_heat_celsius: heat,
+            remaining: 0.5,
+            known: true,
+        };
+        let (inside, flags) = model.axes[0].power_on_after(&settings, &at(2.0), &mut state);
+        assert!((inside - (0.01 - 0.008)).abs() < 1e-7, "{inside}");
+        assert!(!flags.contains(Flags::HISTORY_OUT_OF_SPAN), "{flags:?}");
+        let (held, flags) = model.axes[0].power_on_after(&settings, &at(9.0), &mut state);
+        assert!((held - (0.01 - 0.012)).abs() < 1e-7, "{held}");
+        assert!(flags.contains(Flags::HISTORY_OUT_OF_SPAN), "{flags:?}");
     }
 
     #[test]
@@ -331,6 +386,13 @@ mod tests {
         model.axes[1].turn_on.polynomial.coefficients.clear();
         let e = model.validate().unwrap_err();
         assert_eq!((e.field, e.at.axis), ("coefficients", Some(1)));
+        let mut model = self::model();
+        model.axes[0].turn_on.most_residual_heat_celsius = -1.0;
+        let e = model.validate().unwrap_err();
+        assert_eq!(
+            (e.field, e.at.axis),
+            ("most_residual_heat_celsius", Some(0))
+        );
         assert!(RecommendedTables::<4, 2, 2>::EMPTY.validate().is_err());
     }
 }

@@ -21,7 +21,8 @@ mod common;
 use drift_core::blob::decode;
 use drift_core::{
     AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialAxis,
-    PolynomialTables, Previous, RelativePolynomialAxis, RelativePolynomialTables, Sample, Settings,
+    PolynomialTables, Previous, RecommendedTables, RelativePolynomialAxis,
+    RelativePolynomialTables, Sample, Settings,
 };
 use proptest::prelude::*;
 
@@ -122,6 +123,7 @@ fn the_shared_vectors_give_the_same_bits_in_blocks() {
     let warm_started: ModifiedTables = decode(&image("warm_started")).unwrap();
     let standard: PolynomialTables = decode(&image("standard")).unwrap();
     let third_order: PolynomialTables = decode(&image("third_order")).unwrap();
+    let recommended: RecommendedTables = decode(&image("recommended")).unwrap();
     for case in &file.cases {
         let samples: Vec<Sample> = case
             .samples
@@ -158,6 +160,7 @@ fn the_shared_vectors_give_the_same_bits_in_blocks() {
             "warm_started" => run!(&warm_started),
             "standard" => run!(&standard),
             "third_order" => run!(&third_order),
+            "recommended" => run!(&recommended),
             other => panic!("unknown model {other}"),
         }
     }

@@ -18,7 +18,9 @@ mod common;
 
 use common::format::{Case, VectorFile};
 use drift_core::blob::{decode, Image};
-use drift_core::{Corrector, Model, ModifiedTables, PolynomialTables, Previous, Sample};
+use drift_core::{
+    Corrector, Model, ModifiedTables, PolynomialTables, Previous, RecommendedTables, Sample,
+};
 
 const PATH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/vectors.json");
 
@@ -124,6 +126,7 @@ fn corrector_reproduces_vectors_bit_for_bit() {
         .axes
         .iter()
         .all(|axis| axis.warm_started() && !axis.keyed_by_history()));
+    let recommended: RecommendedTables = model(&file, "recommended");
     let mut total = 0;
     let mut samples = 0;
     for case in &file.cases {
@@ -135,6 +138,7 @@ fn corrector_reproduces_vectors_bit_for_bit() {
             "extended" => check_case(&extended, case),
             "by_history" => check_case(&by_history, case),
             "warm_started" => check_case(&warm_started, case),
+            "recommended" => check_case(&recommended, case),
             other => panic!("unknown model {other}"),
         };
     }
@@ -164,6 +168,16 @@ fn json_tables_equal_the_images() {
                 assert_eq!(
                     from_json,
                     decode::<PolynomialTables>(&bytes).unwrap(),
+                    "{}",
+                    named.name
+                );
+            }
+            "recommended" => {
+                let from_json: RecommendedTables =
+                    serde_json::from_value(named.tables.clone()).unwrap();
+                assert_eq!(
+                    from_json,
+                    decode::<RecommendedTables>(&bytes).unwrap(),
                     "{}",
                     named.name
                 );

@@ -6,6 +6,7 @@
 //! and above the ambients, and a fit across all of them gives the offset a unit in use starts from.
 //! The residual heat is estimated as firmware estimates it (`drift_core::SwitchOn`), from what it
 //! kept of the series' previous activation; a series' first activation follows a full cool-down.
+//! The most residual heat seen is stored with the slope: firmware holds a larger one there.
 
 use std::collections::BTreeMap;
 
@@ -63,12 +64,33 @@ pub fn residual_heats(activations: &[&Analysed], axis: usize) -> Vec<f64> {
     heats
 }
 
+/// The span of the activations' switch-on temperatures on `axis` (°C), widened to 1 °C around one
+/// temperature: `q`'s fitted range, beyond which firmware continues it along its tangent rather than
+/// trust a cubic's curvature where no switch-on was seen.
+fn switch_on_range(activations: &[&Analysed], axis: usize) -> [f64; 2] {
+    let (low, high) = activations
+        .iter()
+        .map(|a| a.switch_on_celsius[axis])
+        .filter(|t| t.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {
+            (lo.min(t), hi.max(t))
+        });
+    if high - low >= 1.0 {
+        [low, high]
+    } else if low.is_finite() {
+        let mid = 0.5 * (low + high);
+        [mid - 0.5, mid + 0.5]
+    } else {
+        range_of(activations, axis)
+    }
+}
+
 /// The turn-on bias per axis: basis `1, heat, x_on, x_on², x_on³` (`x_on` the switch-on
-/// temperature normalised over the calibration's range), `q`'s order up to the cubic chosen by
+/// temperature normalised over the calibration's switch-on temperatures), `q`'s order up to the cubic chosen by
 /// cross-validation over held-out switch-on temperature bands, as the relative baseline's.
 pub fn turn_on(activations: &[&Analysed]) -> [TurnOn; 3] {
     per_axis(|axis| {
-        let range = range_of(activations, axis);
+        let range = switch_on_range(activations, axis);
         let normalise = Normalise::over(range);
         let heats = residual_heats(activations, axis);
         let mut groups: BTreeMap<i64, Gram> = BTreeMap::new();
@@ -100,9 +122,15 @@ pub fn turn_on(activations: &[&Analysed]) -> [TurnOn; 3] {
         } else {
             0.0
         };
+        let most_heat = heats
+            .iter()
+            .copied()
+            .filter(|h| h.is_finite())
+            .fold(0.0, f64::max);
         TurnOn {
             polynomial: axis_polynomial(range, &q),
             dps_per_residual_celsius: slope as f32,
+            most_residual_heat_celsius: most_heat as f32,
         }
     })
 }

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use drift_core::{
     AxisModel, CorrectorState, Flags, Model, ModifiedTables, Output, PolynomialTables, Previous,
-    RelativePolynomialTables, Sample, AUX_INPUTS,
+    RecommendedTables, RelativePolynomialTables, Sample, AUX_INPUTS,
 };
 use numpy::ndarray::{Array2, ArrayView1};
 use numpy::{IntoPyArray, PyArray2};
@@ -19,7 +19,9 @@ use crate::arrays::{
 };
 use crate::errors::Error;
 use crate::model_io;
-use crate::tables::{PyModifiedTables, PyPolynomialTables, PyRelativePolynomialTables};
+use crate::tables::{
+    PyModifiedTables, PyPolynomialTables, PyRecommendedTables, PyRelativePolynomialTables,
+};
 
 /// Samples staged at a time between the caller's arrays and the corrector (on the stack).
 const BLOCK: usize = 512;
@@ -42,11 +44,16 @@ enum Engine {
         Arc<RelativePolynomialTables>,
         CorrectorState<<RelativeAxis as AxisModel>::State>,
     ),
+    Recommended(
+        Arc<RecommendedTables>,
+        CorrectorState<<RecommendedAxis as AxisModel>::State>,
+    ),
 }
 
 type ModifiedAxis = <ModifiedTables as Model>::Axis;
 type PolynomialAxis = <PolynomialTables as Model>::Axis;
 type RelativeAxis = <RelativePolynomialTables as Model>::Axis;
+type RecommendedAxis = <RecommendedTables as Model>::Axis;
 
 /// The batch's inputs, borrowed from the caller's arrays (no Python object inside, so they can be
 /// used without the GIL).
@@ -158,6 +165,7 @@ impl Engine {
             Self::Modified(model, state) => state.power_on(&**model, raw),
             Self::Polynomial(model, state) => state.power_on(&**model, raw),
             Self::Relative(model, state) => state.power_on(&**model, raw),
+            Self::Recommended(model, state) => state.power_on(&**model, raw),
         }
     }
 
@@ -170,6 +178,7 @@ impl Engine {
             Self::Modified(model, state) => state.power_on_after(&**model, raw, previous),
             Self::Polynomial(model, state) => state.power_on_after(&**model, raw, previous),
             Self::Relative(model, state) => state.power_on_after(&**model, raw, previous),
+            Self::Recommended(model, state) => state.power_on_after(&**model, raw, previous),
         }
     }
 
@@ -178,6 +187,7 @@ impl Engine {
             Self::Modified(model, state) => state.keep(&**model, previous),
             Self::Polynomial(model, state) => state.keep(&**model, previous),
             Self::Relative(model, state) => state.keep(&**model, previous),
+            Self::Recommended(model, state) => state.keep(&**model, previous),
         }
     }
 
@@ -186,6 +196,7 @@ impl Engine {
             Self::Modified(model, _) => model.settings(),
             Self::Polynomial(model, _) => model.settings(),
             Self::Relative(model, _) => model.settings(),
+            Self::Recommended(model, _) => model.settings(),
         }
     }
 
@@ -194,6 +205,7 @@ impl Engine {
             Self::Modified(_, state) => state.power_off(),
             Self::Polynomial(_, state) => state.power_off(),
             Self::Relative(_, state) => state.power_off(),
+            Self::Recommended(_, state) => state.power_off(),
         }
     }
 
@@ -202,6 +214,7 @@ impl Engine {
             Self::Modified(model, state) => correct_one(&**model, state, sample, aux),
             Self::Polynomial(model, state) => correct_one(&**model, state, sample, aux),
             Self::Relative(model, state) => correct_one(&**model, state, sample, aux),
+            Self::Recommended(model, state) => correct_one(&**model, state, sample, aux),
         }
     }
 
@@ -210,6 +223,7 @@ impl Engine {
             Self::Modified(model, state) => correct_all(&**model, state, batch, out),
             Self::Polynomial(model, state) => correct_all(&**model, state, batch, out),
             Self::Relative(model, state) => correct_all(&**model, state, batch, out),
+            Self::Recommended(model, state) => correct_all(&**model, state, batch, out),
         }
     }
 
@@ -218,6 +232,7 @@ impl Engine {
             Self::Modified(_, state) => state.is_powered_on(),
             Self::Polynomial(_, state) => state.is_powered_on(),
             Self::Relative(_, state) => state.is_powered_on(),
+            Self::Recommended(_, state) => state.is_powered_on(),
         }
     }
 
@@ -231,6 +246,9 @@ impl Engine {
                 .axes()
                 .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
             Self::Relative(_, state) => state
+                .axes()
+                .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
+            Self::Recommended(_, state) => state
                 .axes()
                 .map(|axis| (axis.switch_on_raw(), axis.initial_bias_dps())),
         }
@@ -352,8 +370,8 @@ fn to_array<'py, T: numpy::Element>(
 
 #[pymethods]
 impl PyCorrector {
-    /// A corrector for `model` (`ModifiedTables`, `PolynomialTables` or `RelativePolynomialTables`),
-    /// not yet powered on.
+    /// A corrector for `model` (`ModifiedTables`, `PolynomialTables`, `RelativePolynomialTables`
+    /// or `RecommendedTables`), not yet powered on.
     #[new]
     fn new(model: &Bound<'_, PyAny>) -> Result<Self, Error> {
         let engine = if let Ok(tables) = model.cast::<PyModifiedTables>() {
@@ -362,10 +380,12 @@ impl PyCorrector {
             Engine::Polynomial(Arc::clone(&tables.get().0), CorrectorState::new())
         } else if let Ok(tables) = model.cast::<PyRelativePolynomialTables>() {
             Engine::Relative(Arc::clone(&tables.get().0), CorrectorState::new())
+        } else if let Ok(tables) = model.cast::<PyRecommendedTables>() {
+            Engine::Recommended(Arc::clone(&tables.get().0), CorrectorState::new())
         } else {
             return Err(Error::Input(format!(
-                "`model` must be a gyrodrift.ModifiedTables, PolynomialTables or \
-                 RelativePolynomialTables, got {}",
+                "`model` must be a gyrodrift.ModifiedTables, PolynomialTables, \
+                 RelativePolynomialTables or RecommendedTables, got {}",
                 describe(model)
             )));
         };
@@ -384,6 +404,9 @@ impl PyCorrector {
             }
             Engine::Relative(model, _) => {
                 Py::new(py, PyRelativePolynomialTables(Arc::clone(model)))?.into_any()
+            }
+            Engine::Recommended(model, _) => {
+                Py::new(py, PyRecommendedTables(Arc::clone(model)))?.into_any()
             }
         })
     }
@@ -576,6 +599,7 @@ impl PyCorrector {
             Engine::Modified(..) => "ModifiedTables",
             Engine::Polynomial(..) => "PolynomialTables",
             Engine::Relative(..) => "RelativePolynomialTables",
+            Engine::Recommended(..) => "RecommendedTables",
         };
         let state = if self.engine.is_powered_on() {
             "powered on"
@@ -596,6 +620,10 @@ enum EngineState {
         CorrectorState<<PolynomialAxis as AxisModel>::State>,
     ),
     Relative(Vec<u8>, CorrectorState<<RelativeAxis as AxisModel>::State>),
+    Recommended(
+        Vec<u8>,
+        CorrectorState<<RecommendedAxis as AxisModel>::State>,
+    ),
 }
 
 impl crate::pickle_state::Pickled for PyCorrector {
@@ -606,6 +634,7 @@ impl crate::pickle_state::Pickled for PyCorrector {
             Engine::Modified(m, s) => EngineState::Modified(model_io::to_image(&**m)?, *s),
             Engine::Polynomial(m, s) => EngineState::Polynomial(model_io::to_image(&**m)?, *s),
             Engine::Relative(m, s) => EngineState::Relative(model_io::to_image(&**m)?, *s),
+            Engine::Recommended(m, s) => EngineState::Recommended(model_io::to_image(&**m)?, *s),
         };
         crate::pickle_state::encode(Self::KIND, &state)
     }
@@ -620,6 +649,9 @@ impl crate::pickle_state::Pickled for PyCorrector {
             }
             EngineState::Relative(image, s) => {
                 Engine::Relative(Arc::new(model_io::from_image(&image)?), s)
+            }
+            EngineState::Recommended(image, s) => {
+                Engine::Recommended(Arc::new(model_io::from_image(&image)?), s)
             }
         };
         Ok(Self { engine })

@@ -21,7 +21,9 @@ use crate::fit_settings::{self, PyFitSettings};
 use crate::results::{split_from, PyActivationResult};
 use crate::segment::PySegment;
 use crate::sources::{self, Source};
-use crate::tables::{PyModifiedTables, PyPolynomialTables, PyRelativePolynomialTables};
+use crate::tables::{
+    PyModifiedTables, PyPolynomialTables, PyRecommendedTables, PyRelativePolynomialTables,
+};
 use drift_evaluate::tables_folder;
 
 /// Everything fitted for one unit, with the settings it was fitted with.
@@ -163,6 +165,13 @@ impl PyFittedUnit {
     #[getter]
     fn relative(&self) -> PyRelativePolynomialTables {
         PyRelativePolynomialTables(Arc::new(self.unit.relative.clone()))
+    }
+
+    /// The recommended model: the paper's curves with the turn-on bias fitted on every
+    /// calibration activation (`recommended.bin`).
+    #[getter]
+    fn recommended(&self) -> PyRecommendedTables {
+        PyRecommendedTables(Arc::new(self.unit.recommended.clone()))
     }
 
     /// The settings the unit was fitted with (used again by `evaluate`).

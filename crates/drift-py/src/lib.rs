@@ -46,6 +46,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     extension::register(module)?;
     module.add_class::<tables::PyPolynomialTables>()?;
     module.add_class::<tables::PyRelativePolynomialTables>()?;
+    module.add_class::<tables::PyRecommendedTables>()?;
     module.add_class::<corrector::PyCorrector>()?;
     module.add_class::<corrector::PyOutput>()?;
     module.add_class::<stillness::PyStillnessLearner>()?;

@@ -37,7 +37,9 @@ use crate::recording::PyRecording;
 use crate::results::PyActivationResult;
 use crate::segment::{PyAuxChannel, PySegment};
 use crate::settings::PySettings;
-use crate::tables::{PyModifiedTables, PyPolynomialTables, PyRelativePolynomialTables};
+use crate::tables::{
+    PyModifiedTables, PyPolynomialTables, PyRecommendedTables, PyRelativePolynomialTables,
+};
 
 fn rebuild<T: Pickled + Into<PyClassInitializer<T>>>(
     py: Python<'_>,
@@ -61,6 +63,7 @@ pub fn restore(py: Python<'_>, kind: &str, version: &str, state: &[u8]) -> PyRes
         PyModifiedTables::KIND => rebuild::<PyModifiedTables>(py, state),
         PyPolynomialTables::KIND => rebuild::<PyPolynomialTables>(py, state),
         PyRelativePolynomialTables::KIND => rebuild::<PyRelativePolynomialTables>(py, state),
+        PyRecommendedTables::KIND => rebuild::<PyRecommendedTables>(py, state),
         PySettings::KIND => rebuild::<PySettings>(py, state),
         PyExtraTerm::KIND => rebuild::<PyExtraTerm>(py, state),
         PyFitSettings::KIND => rebuild::<PyFitSettings>(py, state),
@@ -100,6 +103,7 @@ pickled_model!(
     RelativePolynomialTables,
     "RelativePolynomialTables"
 );
+pickled_model!(PyRecommendedTables, RecommendedTables, "RecommendedTables");
 
 /// A newtype class over a serde type: its state is the inner value.
 macro_rules! pickled_newtype {

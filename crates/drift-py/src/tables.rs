@@ -1,6 +1,7 @@
 //! The model classes: `gyrodrift.ModifiedTables` (the paper's method),
 //! `gyrodrift.PolynomialTables` (the standard and 3rd-order baselines) and
-//! `gyrodrift.RelativePolynomialTables` (the baseline relative to the switch-on).
+//! `gyrodrift.RelativePolynomialTables` (the baseline relative to the switch-on) and
+//! `gyrodrift.RecommendedTables` (the paper's drift with a turn-on bias fitted across activations).
 //!
 //! All are immutable, validated on construction, and share one API (generated below so it cannot
 //! drift apart): JSON and firmware-image conversion, files, settings. `ModifiedTables` adds the
@@ -9,8 +10,8 @@
 use std::sync::Arc;
 
 use drift_core::{
-    Extension, Model, ModifiedTables, PolynomialTables, RelativePolynomialTables, SwitchOnRate,
-    MAX_TERMS,
+    Extension, Model, ModifiedTables, PolynomialTables, RecommendedTables,
+    RelativePolynomialTables, SwitchOnRate, MAX_TERMS,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
@@ -86,6 +87,29 @@ impl Summary for RelativePolynomialTables {
             })
             .collect();
         format!("per axis: {}", axes.join("; "))
+    }
+}
+
+impl Summary for RecommendedTables {
+    fn summary(&self) -> String {
+        let axes: Vec<String> = self
+            .axes
+            .iter()
+            .map(|axis| {
+                let curves = axis.table.ambients.first().map_or(0, |a| a.curves.len());
+                format!(
+                    "{}x{}x{} + turn-on {} coefficients",
+                    axis.table.reference_ms.len(),
+                    axis.table.ambients.len(),
+                    curves,
+                    axis.turn_on.polynomial.coefficients.len()
+                )
+            })
+            .collect();
+        format!(
+            "reference times x ambients x curves per axis: {}",
+            axes.join(", ")
+        )
     }
 }
 
@@ -326,5 +350,16 @@ model_class!(
     "RelativePolynomialTables",
     "The least-squares baseline relative to the switch-on, bias = q(T_on) + p(T) − p(T_on) \
      (`drift_core::RelativePolynomialTables`).",
+    {}
+);
+
+model_class!(
+    PyRecommendedTables,
+    RecommendedTables,
+    "RecommendedTables",
+    "The recommended model: the paper's drift correction after switch-on with the turn-on bias \
+     q(T_on) + h · residual heat fitted across every calibration activation \
+     (`drift_core::RecommendedTables`, host capacities 16 x 12 x 32). Start it with \
+     `Corrector.power_on_after` to use the residual heat.",
     {}
 );

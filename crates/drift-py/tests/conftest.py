@@ -14,7 +14,7 @@ import gyrodrift
 
 VECTORS = Path(__file__).resolve().parents[3] / "testdata" / "vectors.json"
 
-Model = Union[gyrodrift.ModifiedTables, gyrodrift.PolynomialTables]
+Model = Union[gyrodrift.ModifiedTables, gyrodrift.PolynomialTables, gyrodrift.RecommendedTables]
 
 
 @dataclass
@@ -49,7 +49,11 @@ def load_vectors() -> dict[str, Any]:
 
 
 def model_class(kind: str) -> type[Model]:
-    return {"modified": gyrodrift.ModifiedTables, "polynomial": gyrodrift.PolynomialTables}[kind]
+    return {
+        "modified": gyrodrift.ModifiedTables,
+        "polynomial": gyrodrift.PolynomialTables,
+        "recommended": gyrodrift.RecommendedTables,
+    }[kind]
 
 
 @pytest.fixture(scope="session")

@@ -43,6 +43,7 @@ def test_value_classes_compare_equal_after_a_round_trip(fitted: gyrodrift.Fitted
         fitted.standard,
         fitted.third_order,
         fitted.relative,
+        fitted.recommended,
         fitted.modified.with_extension([term]),
         gyrodrift.Settings(raw_per_celsius=100.0, stuck_after_samples=7),
         term,
@@ -59,7 +60,7 @@ def test_value_classes_compare_equal_after_a_round_trip(fitted: gyrodrift.Fitted
 def test_a_fitted_unit_keeps_its_tables_curves_and_notes(fitted: gyrodrift.FittedUnit) -> None:
     for back in round_trips(fitted):
         assert back.unit_id == fitted.unit_id
-        for name in ("modified", "by_history", "standard", "third_order", "relative"):
+        for name in ("modified", "by_history", "standard", "third_order", "relative", "recommended"):
             assert getattr(back, name) == getattr(fitted, name)
             assert getattr(back, name).to_image() == getattr(fitted, name).to_image()
         assert back.notes == fitted.notes
@@ -209,6 +210,7 @@ COVERED = {
     "Output",
     "PolynomialTables",
     "Recording",
+    "RecommendedTables",
     "RelativePolynomialTables",
     "Segment",
     "Settings",

@@ -31,6 +31,7 @@ def test_vectors_cover_every_model_and_enough_samples(cases: list[Case], models:
             "extended",
             "by_history",
             "warm_started",
+            "recommended",
         }
     )
     assert sum(len(c.times) for c in cases) > 1000
@@ -55,14 +56,20 @@ def test_history_cases_start_with_what_was_kept(cases: list[Case], models: dict[
     exist (history-keyed and not, and the extended model's rate at switch-on), `powered_corrector`
     starts them with `power_on_after`, and they exercise both history flags."""
     with_previous = [c for c in cases if c.previous is not None]
-    assert {c.model for c in with_previous} == {"by_history", "extended", "modified", "warm_started"}
+    assert {c.model for c in with_previous} == {
+        "by_history",
+        "extended",
+        "modified",
+        "warm_started",
+        "recommended",
+    }
     assert all(c.previous is not None and c.previous.shape == (3, 2) for c in with_previous)
     flags = np.concatenate([c.flags for c in cases if c.model == "by_history"])
     for flag in (gyrodrift.Flags.HISTORY_UNKNOWN, gyrodrift.Flags.HISTORY_OUT_OF_SPAN):
         assert (flags & flag).any(), flag
     # The same samples started with `power_on` instead differ: the kept values are read (stage 3
     # keyed by history; the warm starts' initial bias; the rate filter's start).
-    for model in ("by_history", "warm_started", "extended"):
+    for model in ("by_history", "warm_started", "extended", "recommended"):
         case = next(c for c in with_previous if c.model == model and c.switch_on_raw is not None)
         cold = gyrodrift.Corrector(models[case.model])
         cold.power_on(case.switch_on_raw)

@@ -11,7 +11,9 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use drift_core::blob::{decode, decode_into};
 use drift_core::{AxisModel, Corrector, Model, PolynomialTables, Previous, Sample};
-use gyrodrift_embedded::{FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, STANDARD};
+use gyrodrift_embedded::{
+    FirmwareRecommended, FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, RECOMMENDED, STANDARD,
+};
 use panic_semihosting as _;
 
 /// Samples corrected between two markers.
@@ -123,6 +125,7 @@ fn main() -> ! {
     static mut MODIFIED_TABLES: FirmwareTables = FirmwareTables::EMPTY;
     static mut EXTENDED_TABLES: FirmwareTables = FirmwareTables::EMPTY;
     static mut BY_HISTORY_TABLES: FirmwareTables = FirmwareTables::EMPTY;
+    static mut RECOMMENDED_TABLES: FirmwareRecommended = FirmwareRecommended::EMPTY;
     let samples = activation(1000);
     let at_1khz = activation(1);
     let decoded = (
@@ -130,11 +133,13 @@ fn main() -> ! {
         decode::<PolynomialTables>(black_box(STANDARD)),
         decode_into(black_box(EXTENDED), EXTENDED_TABLES),
         decode_into(black_box(BY_HISTORY), BY_HISTORY_TABLES),
+        decode_into(black_box(RECOMMENDED), RECOMMENDED_TABLES),
     );
     let (modified, extended, by_history): (&FirmwareTables, &FirmwareTables, &FirmwareTables) =
         (MODIFIED_TABLES, EXTENDED_TABLES, BY_HISTORY_TABLES);
+    let recommended: &FirmwareRecommended = RECOMMENDED_TABLES;
     match decoded {
-        (Ok(()), Ok(standard), Ok(()), Ok(())) => {
+        (Ok(()), Ok(standard), Ok(()), Ok(()), Ok(())) => {
             hprintln!("samples per interval: {}", SAMPLES);
             hprintln!("interval 1: modified model, samples 1 s apart (worst case)");
             measure(modified, &samples, 1);
@@ -161,6 +166,12 @@ fn main() -> ! {
                 "interval 15: modified model, stage 3 keyed by history (by_history, power_on_after), 1000 Hz windows"
             );
             measure_after(by_history, &at_1khz, 15);
+            hprintln!(
+                "interval 17: recommended model (power_on_after), samples 1 s apart"
+            );
+            measure_after(recommended, &samples, 17);
+            hprintln!("interval 19: recommended model (power_on_after), 1000 Hz windows");
+            measure_after(recommended, &at_1khz, 19);
             debug::exit(debug::EXIT_SUCCESS);
         }
         _ => {

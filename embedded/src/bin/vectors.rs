@@ -14,8 +14,8 @@ use drift_core::{
     Sample,
 };
 use gyrodrift_embedded::{
-    stack, Case, FirmwareTables, ModelName, BY_HISTORY, CASES, EXTENDED, MODIFIED, STANDARD,
-    THIRD_ORDER, WARM_STARTED,
+    stack, Case, FirmwareRecommended, FirmwareTables, ModelName, BY_HISTORY, CASES, EXTENDED,
+    MODIFIED, RECOMMENDED, STANDARD, THIRD_ORDER, WARM_STARTED,
 };
 use panic_semihosting as _;
 
@@ -102,6 +102,7 @@ fn main() -> ! {
     static mut EXTENDED_TABLES: FirmwareTables = FirmwareTables::EMPTY;
     static mut BY_HISTORY_TABLES: FirmwareTables = FirmwareTables::EMPTY;
     static mut WARM_STARTED_TABLES: FirmwareTables = FirmwareTables::EMPTY;
+    static mut RECOMMENDED_TABLES: FirmwareRecommended = FirmwareRecommended::EMPTY;
 
     let painted = stack::paint();
     if decode_into(black_box(MODIFIED), MODIFIED_TABLES).is_err() {
@@ -129,6 +130,12 @@ fn main() -> ! {
         fail("warm_started image");
     }
     let warm_started: &FirmwareTables = WARM_STARTED_TABLES;
+    let painted = stack::paint();
+    if decode_into(black_box(RECOMMENDED), RECOMMENDED_TABLES).is_err() {
+        fail("recommended image did not decode");
+    }
+    let decode_recommended_stack = painted.used();
+    let recommended: &FirmwareRecommended = RECOMMENDED_TABLES;
 
     let mut samples = 0;
     let mut mismatches = 0;
@@ -141,6 +148,7 @@ fn main() -> ! {
             ModelName::Extended => run(extended, case),
             ModelName::ByHistory => run(by_history, case),
             ModelName::WarmStarted => run(warm_started, case),
+            ModelName::Recommended => run(recommended, case),
         };
     }
 
@@ -193,10 +201,19 @@ fn main() -> ! {
         "previous activation kept across power-off ([Previous; 3]), bytes: {}",
         core::mem::size_of::<[Previous; 3]>()
     );
+    hprintln!("recommended image bytes: {}", RECOMMENDED.len());
+    hprintln!(
+        "recommended tables in RAM, bytes: {}",
+        core::mem::size_of::<FirmwareRecommended>()
+    );
     hprintln!("stack bytes, decode_into image: {}", decode_stack);
     hprintln!(
         "stack bytes, decode_into by_history image: {}",
         decode_history_stack
+    );
+    hprintln!(
+        "stack bytes, decode_into recommended image: {}",
+        decode_recommended_stack
     );
     hprintln!(
         "stack bytes, power_on + correct_with_aux (extended model): {}",
@@ -206,7 +223,9 @@ fn main() -> ! {
         "stack bytes, power_on_after + correct + keep (by_history model): {}",
         history_stack
     );
-    let worst_decode = decode_stack.max(decode_history_stack);
+    let worst_decode = decode_stack
+        .max(decode_history_stack)
+        .max(decode_recommended_stack);
     if worst_decode >= stack::DEPTH || worst_decode > DECODE_STACK_CEILING {
         fail("decoding the table image takes more stack than the ceiling (DECODE_STACK_CEILING)");
     }

@@ -350,6 +350,39 @@ fn scenarios() -> Vec<Scenario> {
             previous: None,
         },
         Scenario {
+            name: "recommended-warm-start",
+            description: "the recommended model switched on with power_on_after at 33 °C after a short off-time (ambient 31 °C: 2.0 / 2.2 / 2.0 °C of residual heat): the turn-on bias q(T_on) + slope · residual heat, the paper's drift after it",
+            model: "recommended",
+            switch_on_celsius: Some([33.0, 33.2, 33.0]),
+            final_rise: [3.0, 2.5, 3.5],
+            times: every(1000, 120_000),
+            tamper: untouched,
+            aux: None,
+            previous: Some([[31.0, 36.0], [31.0, 35.5], [31.0, 35.0]]),
+        },
+        Scenario {
+            name: "recommended-history-unknown",
+            description: "the recommended model powered on with plain power_on (nothing kept): q(T_on) alone, flagged HISTORY_UNKNOWN",
+            model: "recommended",
+            switch_on_celsius: Some([36.0, 36.0, 36.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(4000, 120_000),
+            tamper: untouched,
+            aux: None,
+            previous: None,
+        },
+        Scenario {
+            name: "recommended-outside-turn-on-range",
+            description: "the recommended model switched on at 18 °C (after a cool-down: ambient fell), below its turn-on polynomial's 25–45 °C and the 20–40 °C tables: q clamped at 25 °C, flagged TEMPERATURE_OUT_OF_RANGE and AMBIENT_OUT_OF_RANGE",
+            model: "recommended",
+            switch_on_celsius: Some([18.0, 18.0, 18.0]),
+            final_rise: [4.0, 4.0, 4.0],
+            times: every(4000, 120_000),
+            tamper: untouched,
+            aux: None,
+            previous: Some([[25.0, 28.0], [25.0, 28.0], [25.0, 28.0]]),
+        },
+        Scenario {
             name: "modified-ignores-history",
             description: "the paper's tables (keyed by rise) powered on with power_on_after: what was kept is ignored, the outputs are power_on's",
             model: "modified",
@@ -464,6 +497,7 @@ pub fn build() -> VectorFile {
     let extended = fixture::extended();
     let by_history = fixture::by_history();
     let warm_started = fixture::warm_started();
+    let recommended = fixture::recommended();
     let cases = scenarios()
         .iter()
         .enumerate()
@@ -473,6 +507,7 @@ pub fn build() -> VectorFile {
             "extended" => run(&extended, scenario, i as u64 + 1),
             "by_history" => run(&by_history, scenario, i as u64 + 1),
             "warm_started" => run(&warm_started, scenario, i as u64 + 1),
+            "recommended" => run(&recommended, scenario, i as u64 + 1),
             _ => run(&third_order, scenario, i as u64 + 1),
         })
         .collect();
@@ -494,6 +529,7 @@ pub fn build() -> VectorFile {
             named("extended", "modified", &extended),
             named("by_history", "modified", &by_history),
             named("warm_started", "modified", &warm_started),
+            named("recommended", "recommended", &recommended),
         ],
         cases,
     }

@@ -8,7 +8,7 @@
 
 use drift_core::{
     AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, PolynomialAxis, PolynomialTables,
-    Settings, SwitchOnRate, WarmStart,
+    RecommendedTables, Settings, SwitchOnRate, TurnOn, WarmStart,
 };
 
 /// Reference times, ms.
@@ -218,4 +218,32 @@ pub fn by_history() -> FixtureTables {
         }
     }
     tables
+}
+
+/// Capacities of the recommended fixture (the firmware's).
+pub type FixtureRecommended = RecommendedTables<8, 3, 16>;
+
+/// The recommended model: the modified fixture's curves with a turn-on bias fitted across
+/// activations: a cubic of the switch-on temperature over 25–45 °C and a residual-heat slope of
+/// a few mdeg/s per °C (negative on X and Y, positive on Z, as the warm starts' sign) over up to
+/// 3 °C of residual heat.
+pub fn recommended() -> FixtureRecommended {
+    let turn_on = core::array::from_fn(|axis| {
+        let (_, bias0, slope) = AXIS[axis];
+        TurnOn {
+            polynomial: PolynomialAxis {
+                range_celsius: [25.0, 45.0],
+                coefficients: heapless::Vec::from_slice(&[
+                    round5(bias0 + slope * 5.0),
+                    round5(slope * 10.0),
+                    round5(0.0008),
+                    round5(-0.0004),
+                ])
+                .unwrap(),
+            },
+            dps_per_residual_celsius: [-0.0021, -0.0012, 0.0009][axis],
+            most_residual_heat_celsius: 3.0,
+        }
+    });
+    RecommendedTables::try_new(&modified(), turn_on).unwrap()
 }

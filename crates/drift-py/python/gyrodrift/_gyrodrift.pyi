@@ -52,6 +52,7 @@ __all__ = [
     "ModifiedTables",
     "Output",
     "PolynomialTables",
+    "RecommendedTables",
     "Recording",
     "RecordingError",
     "RelativePolynomialTables",
@@ -75,7 +76,7 @@ __all__ = [
 
 _Path: TypeAlias = str | os.PathLike[str]
 _Floats3: TypeAlias = Sequence[float] | NDArray[np.floating]
-_Model: TypeAlias = ModifiedTables | PolynomialTables | RelativePolynomialTables
+_Model: TypeAlias = ModifiedTables | PolynomialTables | RelativePolynomialTables | RecommendedTables
 _Previous: TypeAlias = NDArray[np.floating] | Sequence[Sequence[float]]
 _FloatRows: TypeAlias = NDArray[np.floating] | Sequence[Sequence[float]]
 _Floats: TypeAlias = NDArray[np.float32] | NDArray[np.float64]
@@ -398,6 +399,62 @@ class RelativePolynomialTables:
     def settings(self) -> Settings:
         """The settings stored with the tables."""
     def with_settings(self, settings: Settings) -> RelativePolynomialTables:
+        """The same tables with other settings (validated; `self` is unchanged)."""
+    def check(
+        self,
+        source: _Source,
+        *,
+        max_drift: float = 0.005,
+        max_rms: float = 0.02,
+        min_removed: float = 0.5,
+        settings: FitSettings | None = None,
+    ) -> list[_Record]:
+        """Is this stored calibration still valid? (`gyrodrift check` on the command line.)
+
+        Corrects every activation of `source` (one unit's recordings or segments, the unit held
+        static) as the firmware would, and returns one record per axis: `unit_id`, `axis`,
+        `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
+        `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
+        `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
+        `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the
+        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤
+        `max_rms` °/s, share removed ≥ `min_removed`.
+        Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
+        model that reads an auxiliary input), `FileError` or `RecordingError`."""
+    def __eq__(self, other: object, /) -> bool: ...
+
+@final
+class RecommendedTables:
+    """The recommended model: the paper's drift correction after switch-on with the turn-on bias
+    q(T_on) + h · residual heat fitted across every calibration activation
+    (drift_core::RecommendedTables; firmware image kind 4). Start it with
+    `Corrector.power_on_after` to use the residual heat. Immutable; validated whenever it is
+    built."""
+
+    @staticmethod
+    def from_json(text: str) -> RecommendedTables:
+        """Parses drift-core's JSON form. Raises `TableError` (bad JSON or invalid tables)."""
+    @staticmethod
+    def from_image(data: bytes | bytearray) -> RecommendedTables:
+        """Decodes a firmware table image. Raises `ImageError`."""
+    @staticmethod
+    def load_json(path: _Path) -> RecommendedTables:
+        """Reads a JSON file. Raises `FileError` or `TableError`."""
+    @staticmethod
+    def load_image(path: _Path) -> RecommendedTables:
+        """Reads a firmware table image file. Raises `FileError` or `ImageError`."""
+    def to_json(self) -> str:
+        """drift-core's JSON form, pretty-printed; `from_json` gives back an equal model."""
+    def to_image(self) -> bytes:
+        """The firmware table image (magic, version, kind, length, postcard payload, CRC-32)."""
+    def save_json(self, path: _Path) -> None:
+        """Writes the JSON form (temporary file, then rename). Raises `FileError`."""
+    def save_image(self, path: _Path) -> None:
+        """Writes the firmware table image (temporary file, then rename). Raises `FileError`."""
+    @property
+    def settings(self) -> Settings:
+        """The settings stored with the tables."""
+    def with_settings(self, settings: Settings) -> RecommendedTables:
         """The same tables with other settings (validated; `self` is unchanged)."""
     def check(
         self,
@@ -1059,6 +1116,10 @@ class FittedUnit:
     def relative(self) -> RelativePolynomialTables:
         """The least-squares baseline relative to the switch-on (bias = q(T_on) + p(T) − p(T_on)),
         orders chosen by leave-one-series-out cross-validation on the calibration data."""
+    @property
+    def recommended(self) -> RecommendedTables:
+        """The recommended model: the paper's curves with the turn-on bias fitted on every
+        calibration activation (`recommended.bin`)."""
     @property
     def settings(self) -> FitSettings:
         """The settings the unit was fitted with (used again by `evaluate`)."""
