@@ -27,6 +27,11 @@ use crate::recommended::RecommendedTables;
 use crate::table::ModifiedTables;
 
 mod in_place;
+mod section;
+
+pub use section::{
+    decode_section, encode_section, section_len, SectionError, SECTION_MAGIC, SECTION_VERSION,
+};
 
 /// First four bytes of every image.
 pub const MAGIC: [u8; 4] = *b"GYDT";
