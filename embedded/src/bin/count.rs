@@ -13,9 +13,7 @@ use drift_core::blob::{decode, decode_into, decode_section};
 use drift_core::{
     AxisModel, Corrector, Model, PolynomialTables, Previous, Sample, SwitchOn, Uncertainty,
 };
-use gyrodrift_embedded::{
-    FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, SIGMA_SECTION, STANDARD,
-};
+use gyrodrift_embedded::{FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, SIGMA_SECTION, STANDARD};
 use panic_semihosting as _;
 
 /// Samples corrected between two markers.
