@@ -39,6 +39,7 @@ use crate::segment::{PyAuxChannel, PySegment};
 use crate::settings::PySettings;
 use crate::stillness::PyStillnessLearner;
 use crate::tables::{PyModifiedTables, PyPolynomialTables, PyRelativePolynomialTables};
+use crate::uncertainty::PyUncertainty;
 
 fn rebuild<T: Pickled + Into<PyClassInitializer<T>>>(
     py: Python<'_>,
@@ -77,6 +78,7 @@ pub fn restore(py: Python<'_>, kind: &str, version: &str, state: &[u8]) -> PyRes
         PyDiagnosis::KIND => rebuild::<PyDiagnosis>(py, state),
         PyCorrector::KIND => rebuild::<PyCorrector>(py, state),
         PyStillnessLearner::KIND => rebuild::<PyStillnessLearner>(py, state),
+        PyUncertainty::KIND => rebuild::<PyUncertainty>(py, state),
         _ => Err(Error::Input(format!("cannot unpickle unknown gyrodrift class {kind:?}")).into()),
     }
 }

@@ -229,6 +229,7 @@ COVERED = {
     "Segment",
     "Settings",
     "StillnessLearner",
+    "Uncertainty",
 }
 
 
