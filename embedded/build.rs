@@ -8,6 +8,10 @@ use std::path::PathBuf;
 #[allow(dead_code)]
 mod format;
 
+#[path = "../crates/drift-core/tests/common/sigma_format.rs"]
+#[allow(dead_code)]
+mod sigma_format;
+
 fn unhex(hex: &str) -> Vec<u8> {
     (0..hex.len())
         .step_by(2)
@@ -52,6 +56,29 @@ fn main() {
             code,
             "Case {{ name: {:?}, model: {model}, switch_on_raw: {:?}, previous: {:?}, power_on_fails: {}, samples: &{:?}, expected: &{:?}, aux: &{:?} }},",
             case.name, case.switch_on_raw, case.previous, case.power_on_fails, case.samples, case.expected, case.aux
+        )
+        .unwrap();
+    }
+    writeln!(code, "];").unwrap();
+
+    println!("cargo:rerun-if-changed=../testdata/sigma-vectors.json");
+    let text = std::fs::read_to_string("../testdata/sigma-vectors.json")
+        .expect("testdata/sigma-vectors.json");
+    let sigma: sigma_format::SigmaVectors = serde_json::from_str(&text).expect("σ(t) vector file");
+    let path = out.join("sigma.bin");
+    std::fs::write(&path, unhex(&sigma.section_hex)).expect("write σ(t) section");
+    writeln!(
+        code,
+        "pub static SIGMA_SECTION: &[u8] = include_bytes!({:?});",
+        path.display().to_string()
+    )
+    .unwrap();
+    writeln!(code, "pub static SIGMA_CASES: &[SigmaCase] = &[").unwrap();
+    for case in &sigma.cases {
+        writeln!(
+            code,
+            "SigmaCase {{ name: {:?}, switch_on_celsius: {:?}, previous: {:?}, times_ms: &{:?}, expected: &{:?} }},",
+            case.name, case.switch_on_celsius, case.previous, case.times_ms, case.expected
         )
         .unwrap();
     }

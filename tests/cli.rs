@@ -88,6 +88,23 @@ fn simulate_fit_and_report_from_the_command_line() {
         "{md}"
     );
     assert!(report.join("fig-correlation.svg").exists() && report.join("report.json").exists());
+    // σ(t), fitted on the held-out repeats, checked on the validation set point; the firmware
+    // section in the tables folder is the same σ as its JSON.
+    assert!(md.contains("## Residual uncertainty σ(t)"), "{md}");
+    let sigma: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report.join("uncertainty.json")).unwrap()).unwrap();
+    let validation = &sigma[0]["coverage"][0];
+    assert_eq!(validation["split"], "validation", "{sigma}");
+    assert!(
+        validation["classes"][0]["samples"].as_u64().unwrap() > 0,
+        "{sigma}"
+    );
+    let section = std::fs::read(report.join("tables/GIU-01/uncertainty.bin")).unwrap();
+    let json: drift_core::Uncertainty = serde_json::from_str(
+        &std::fs::read_to_string(report.join("tables/GIU-01/uncertainty.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(drift_core::blob::decode_section(&section).unwrap(), json);
     // The headline names the best baseline; the absolute error stands beside the drift, its
     // flags on the first page, before the paper's table.
     assert!(md.contains("best baseline / modified"), "{md}");

@@ -2,7 +2,7 @@
 //! a stack-use probe.
 #![no_std]
 
-use drift_core::{ModifiedTables, Previous, RecommendedTables};
+use drift_core::{ModifiedTables, Previous, RecommendedTables, SwitchOn, Uncertainty};
 
 pub mod stack;
 
@@ -51,6 +51,38 @@ pub struct Case {
     pub expected: &'static [[u32; 9]],
     /// Auxiliary inputs per sample (floats as bits); empty: corrected without.
     pub aux: &'static [[u32; 4]],
+}
+
+/// One σ(t) test-vector case (see `testdata/sigma-vectors.json`).
+pub struct SigmaCase {
+    /// Case name.
+    pub name: &'static str,
+    /// Switch-on temperature per axis, °C (f32 bits).
+    pub switch_on_celsius: [u32; 3],
+    /// What was kept of the previous activation per axis, `[ambient, switch-off]` °C (f32 bits).
+    pub previous: Option<[[u32; 2]; 3]>,
+    /// Times since switch-on, ms.
+    pub times_ms: &'static [u32],
+    /// σ per time and axis, °/s (f32 bits).
+    pub expected: &'static [[u32; 3]],
+}
+
+impl SigmaCase {
+    /// σ per time and axis as firmware computes it (f32 bits): the switch-on estimate per axis,
+    /// then `Uncertainty::start` and `sigma_dps`.
+    pub fn run(&self, uncertainty: &Uncertainty, mut each: impl FnMut(usize, [u32; 3])) {
+        let switch_on: [SwitchOn; 3] = core::array::from_fn(|a| {
+            let kept = self.previous.map(|p| Previous {
+                ambient_celsius: f32::from_bits(p[a][0]),
+                switch_off_celsius: f32::from_bits(p[a][1]),
+            });
+            SwitchOn::estimate(f32::from_bits(self.switch_on_celsius[a]), kept)
+        });
+        let state = uncertainty.start(&switch_on);
+        for (i, &ms) in self.times_ms.iter().enumerate() {
+            each(i, uncertainty.sigma_dps(&state, ms).map(f32::to_bits));
+        }
+    }
 }
 
 impl Case {

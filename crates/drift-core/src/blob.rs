@@ -41,6 +41,11 @@ mod error;
 mod header;
 mod in_place;
 mod layout;
+mod section;
+
+pub use section::{
+    decode_section, encode_section, section_len, SectionError, SECTION_MAGIC, SECTION_VERSION,
+};
 
 pub use error::BlobError;
 pub use header::{Capacities, Header, Provenance};

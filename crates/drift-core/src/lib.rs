@@ -33,6 +33,7 @@ mod settings;
 mod stage;
 mod stillness;
 mod table;
+mod uncertainty;
 mod warm_start;
 
 pub use corrector::{
@@ -60,6 +61,7 @@ pub use table::{
     AmbientCurves, AxisTable, Curve, CurvePoint, ModifiedTables, MAX_PLAUSIBLE_K,
     MAX_PLAUSIBLE_RISE_CELSIUS, MAX_PLAUSIBLE_STORED_DRIFT_DPS,
 };
+pub use uncertainty::{ActivationClass, SigmaState, Uncertainty, ACTIVATION_CLASSES, SIGMA_KNOTS};
 pub use warm_start::WarmStart;
 
 /// Number of gyro axes in a unit (X, Y, Z). Each axis has its own temperature sensor.

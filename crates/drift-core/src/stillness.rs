@@ -59,6 +59,7 @@ impl Default for StillnessSettings {
 /// A moving mean and variance of one signal (exponential weights): the mean moves by `alpha` of
 /// each deviation, the variance by the West/Finch update, which stays non-negative.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct Moving {
     mean: f32,
     variance: f32,
@@ -76,7 +77,11 @@ impl Moving {
 
 /// The learner: validated coefficients (immutable) and its state (offset, still timer, moving
 /// statistics). Plain data: copy it to persist the learned offset across power-off.
+///
+/// With the `serde` feature it serialises whole (coefficients and state), for a host to save and
+/// restore a learner mid-run; firmware keeps only [`StillnessLearner::offset_dps`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StillnessLearner {
     rate_threshold_dps: f32,
     rate_variance_threshold: f32,

@@ -9,6 +9,8 @@
 //! - [`check`] answers "is a stored calibration still valid?";
 //! - [`noise_floor`] measures a zero-drift twin's floor per group of activations;
 //! - [`measured`] says what measured data the paper's method cannot be fitted on still tells;
+//! - [`uncertainty`] fits σ(t), the residual bias's standard deviation after switch-on, and
+//!   measures how often held-out residuals fall within ±2σ;
 //! - [`tables_folder`] writes and reads a fit's tables folder (JSON and firmware images).
 
 pub mod check;
@@ -19,3 +21,4 @@ pub mod noise_floor;
 pub mod pipeline;
 pub mod summary;
 pub mod tables_folder;
+pub mod uncertainty;

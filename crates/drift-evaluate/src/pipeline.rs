@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 use crate::evaluate::{evaluate_after, kept_before, ActivationResult};
 use crate::summary::Split;
+use crate::uncertainty::{self, Residuals, UnitUncertainty};
 use drift_fit::analyse::{analyse, Analysed};
 use drift_fit::error::FitError;
 use drift_fit::fit::{fit_unit, FittedUnit};
@@ -189,6 +190,9 @@ pub struct Outcome {
     pub timings: Vec<(String, f64)>,
     /// Samples read in the first pass.
     pub samples_read: u64,
+    /// σ(t) of the recommended model per unit, fitted on the held-out repeats, with how often
+    /// validation and field residuals fell within ±2σ.
+    pub uncertainty: Vec<UnitUncertainty>,
 }
 
 /// Reports progress: (step, done, total).
@@ -501,6 +505,9 @@ const ACTIVATIONS_IN_FLIGHT: usize = 4;
 /// several at once (see `STACK_BYTES` in the command's `main.rs`). Only what is touched is
 /// committed.
 const FIT_STACK_BYTES: usize = 64 << 20;
+
+/// One activation's split, result and (but for the noise floor) its residual for σ(t).
+type Evaluated = (Split, ActivationResult, Option<Residuals>);
 
 /// A unit's tables from all its calibration activations, and the refits per left-out repeat.
 type UnitFits = (FittedUnit, Vec<(u32, FittedUnit)>);
@@ -816,6 +823,7 @@ pub fn run(
     let started = Instant::now();
     let evaluated = if options.evaluate { files } else { &[] };
     let mut recorded_set_points = Vec::new();
+    let mut residuals: Vec<(Split, Residuals)> = Vec::new();
     for (i, path) in evaluated.iter().enumerate() {
         progress("correcting and evaluating", i as u64, files.len() as u64);
         let recording = read_recording(path)?;
@@ -840,7 +848,7 @@ pub fn run(
         }
         let segments: Vec<&Segment> = recording.segments.iter().collect();
         let kept = kept_before(&segments, settings, &fitted.by_history.settings, true);
-        let results: Vec<(Split, ActivationResult)> = recording
+        let results: Vec<Evaluated> = recording
             .segments
             .par_iter()
             .zip(kept.par_iter())
@@ -872,10 +880,20 @@ pub fn run(
                 } else {
                     return None;
                 };
-                Some((split, evaluate_after(model, segment, settings, previous)))
+                let result = evaluate_after(model, segment, settings, previous);
+                // σ(t) is fitted on the held-out repeats and checked on what no fit saw.
+                let residual = (split != Split::NoiseFloor).then(|| {
+                    uncertainty::residuals(&model.recommended, segment, settings, previous)
+                });
+                Some((split, result, residual))
             })
             .collect();
-        outcome.results.extend(results);
+        for (split, result, residual) in results {
+            outcome.results.push((split, result));
+            if let Some(residual) = residual {
+                residuals.push((split, residual));
+            }
+        }
     }
     progress(
         "correcting and evaluating",
@@ -903,6 +921,7 @@ pub fn run(
             });
         }
     }
+    outcome.uncertainty = uncertainty::per_unit(&outcome.fitted, &residuals);
     let evaluate_seconds = started.elapsed().as_secs_f64();
     outcome.calibration = by_unit.into_values().flatten().collect();
     outcome.timings = vec![

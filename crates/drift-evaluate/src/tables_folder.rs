@@ -24,6 +24,14 @@ pub enum TablesError {
         /// What the encoder refused.
         problem: BlobError,
     },
+    /// σ(t) could not be encoded as a firmware section (invalid values).
+    #[error("{path}: cannot encode the σ(t) section: {problem}")]
+    Section {
+        /// The section that was to be written.
+        path: PathBuf,
+        /// What the encoder refused.
+        problem: blob::SectionError,
+    },
     /// A model could not be written as JSON.
     #[error("{path}: cannot write the tables as JSON: {problem}")]
     Json {
@@ -203,6 +211,38 @@ pub fn write(folder: &Path, fitted: &[FittedUnit]) -> Result<(), TablesError> {
         files.extend(unit_files(folder, unit)?);
     }
     write_files(&files)
+}
+
+/// Writes each unit's σ(t) beside its tables: `<folder>/<unit>/uncertainty.json` (drift-core's
+/// serde form) and `uncertainty.bin` (the firmware's σ(t) section, `drift_core::blob::encode_section`).
+/// Encoded in memory first, then each file replaced atomically.
+pub fn write_uncertainty(
+    folder: &Path,
+    units: &[crate::uncertainty::UnitUncertainty],
+) -> Result<(), TablesError> {
+    let mut files = Vec::new();
+    for unit in units {
+        let dir = folder.join(&unit.unit_id);
+        let (json, bin) = (dir.join("uncertainty.json"), dir.join("uncertainty.bin"));
+        let text = json_bytes(&unit.sigma).map_err(|problem| TablesError::Json {
+            path: json.clone(),
+            problem,
+        })?;
+        let section = section_bytes(&unit.sigma).map_err(|problem| TablesError::Section {
+            path: bin.clone(),
+            problem,
+        })?;
+        files.extend([(json, text), (bin, section)]);
+    }
+    write_files(&files)
+}
+
+/// The firmware σ(t) section of `uncertainty`, exactly as long as it needs to be.
+pub fn section_bytes(uncertainty: &drift_core::Uncertainty) -> Result<Vec<u8>, blob::SectionError> {
+    let mut bytes = vec![0; blob::section_len(uncertainty)?];
+    let written = blob::encode_section(uncertainty, &mut bytes)?;
+    bytes.truncate(written);
+    Ok(bytes)
 }
 
 /// Writes files encoded in memory, each atomically, creating their folders.

@@ -224,6 +224,7 @@ impl From<TablesError> for Error {
                 model: "tables",
                 source: problem,
             },
+            section @ TablesError::Section { .. } => Self::Input(section.to_string()),
         }
     }
 }

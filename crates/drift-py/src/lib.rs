@@ -32,6 +32,7 @@ mod simulate;
 mod sources;
 mod stillness;
 mod tables;
+mod uncertainty;
 
 use pyo3::prelude::*;
 
@@ -50,6 +51,7 @@ fn _gyrodrift(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<corrector::PyCorrector>()?;
     module.add_class::<corrector::PyOutput>()?;
     module.add_class::<stillness::PyStillnessLearner>()?;
+    module.add_class::<uncertainty::PyUncertainty>()?;
     module.add_class::<labels::PyLabels>()?;
     module.add_class::<segment::PyAuxChannel>()?;
     module.add_class::<segment::PySegment>()?;

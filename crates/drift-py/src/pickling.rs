@@ -37,9 +37,11 @@ use crate::recording::PyRecording;
 use crate::results::PyActivationResult;
 use crate::segment::{PyAuxChannel, PySegment};
 use crate::settings::PySettings;
+use crate::stillness::PyStillnessLearner;
 use crate::tables::{
     PyModifiedTables, PyPolynomialTables, PyRecommendedTables, PyRelativePolynomialTables,
 };
+use crate::uncertainty::PyUncertainty;
 
 fn rebuild<T: Pickled + Into<PyClassInitializer<T>>>(
     py: Python<'_>,
@@ -78,6 +80,8 @@ pub fn restore(py: Python<'_>, kind: &str, version: &str, state: &[u8]) -> PyRes
         PyEvaluation::KIND => rebuild::<PyEvaluation>(py, state),
         PyDiagnosis::KIND => rebuild::<PyDiagnosis>(py, state),
         PyCorrector::KIND => rebuild::<PyCorrector>(py, state),
+        PyStillnessLearner::KIND => rebuild::<PyStillnessLearner>(py, state),
+        PyUncertainty::KIND => rebuild::<PyUncertainty>(py, state),
         _ => Err(Error::Input(format!("cannot unpickle unknown gyrodrift class {kind:?}")).into()),
     }
 }

@@ -158,8 +158,32 @@ impl PyStillnessLearner {
         ))
     }
 
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        crate::pickle_state::reduce(slf)
+    }
+
     fn __repr__(&self) -> String {
         let [x, y, z] = self.learner.offset_dps();
         format!("StillnessLearner(offset_dps=({x}, {y}, {z}))")
+    }
+}
+
+/// The whole learner (coefficients, offset, detector) and the settings it was made from, so a
+/// restored learner continues where the pickled one stood.
+impl crate::pickle_state::Pickled for PyStillnessLearner {
+    const KIND: &'static str = "StillnessLearner";
+
+    fn state(&self, _py: Python<'_>) -> PyResult<Vec<u8>> {
+        crate::pickle_state::encode(Self::KIND, &(self.settings, self.learner))
+    }
+
+    fn restore(_py: Python<'_>, state: &[u8]) -> PyResult<Self> {
+        let (settings, learner): (StillnessSettings, StillnessLearner) =
+            crate::pickle_state::decode(Self::KIND, state)?;
+        // The settings are checked as the constructor checks them: a state edited by hand is
+        // refused by name, not run.
+        StillnessLearner::new(&settings)
+            .map_err(|e| Error::Input(format!("cannot unpickle StillnessLearner: {e}")))?;
+        Ok(Self { learner, settings })
     }
 }

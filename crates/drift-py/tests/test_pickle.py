@@ -193,7 +193,23 @@ def test_a_corrector_continues_its_activation_after_a_round_trip(
     assert checked >= 3
 
 
-NOT_YET_PICKLED = {"StillnessLearner"}
+def test_a_stillness_learner_continues_where_it_was_pickled() -> None:
+    rng = np.random.default_rng(3)
+    n = 12_000  # 12 s at 1 kHz: still long enough to learn
+    rate = (0.02 + 0.001 * rng.standard_normal((n, 3))).astype(np.float32)
+    accel = np.tile(np.float32([0.0, 0.0, 1.0]), (n // 10, 1))
+    whole = gyrodrift.StillnessLearner(still_for_s=2.0)
+    expected, _, learning = whole.update_batch(rate, accel)
+    assert learning.any()
+    half = n // 2
+    learner = gyrodrift.StillnessLearner(still_for_s=2.0)
+    first, _, _ = learner.update_batch(rate[:half], accel[: half // 10])
+    for back in round_trips(learner):
+        assert type(back) is gyrodrift.StillnessLearner
+        assert back.offset_dps == learner.offset_dps
+        rest, _, _ = back.update_batch(rate[half:], accel[half // 10 :])
+        assert same_bits(expected, np.concatenate([first, rest])).all()
+
 
 COVERED = {
     "ActivationResult",
@@ -214,6 +230,8 @@ COVERED = {
     "RelativePolynomialTables",
     "Segment",
     "Settings",
+    "StillnessLearner",
+    "Uncertainty",
 }
 
 
@@ -224,10 +242,8 @@ def test_every_public_class_is_covered_here_and_errors_pickle_too() -> None:
         if isinstance(getattr(gyrodrift, name), type)
         and not issubclass(getattr(gyrodrift, name), BaseException)
     }
-    # Flags is an enum.IntFlag: pickles by value. The stillness learner's run-time state has no
-    # pickled form yet (drift-core's learner carries no serde derive): named here so that any
-    # other class without one still fails this test.
-    assert classes - {"Flags"} - NOT_YET_PICKLED == COVERED
+    # Flags is an enum.IntFlag: pickles by value.
+    assert classes - {"Flags"} == COVERED
     assert pickle.loads(pickle.dumps(gyrodrift.Flags.RATE_INVALID)) is gyrodrift.Flags.RATE_INVALID
     error = pickle.loads(pickle.dumps(gyrodrift.InputError("`x` must be finite")))
     assert isinstance(error, gyrodrift.InputError) and isinstance(error, ValueError)

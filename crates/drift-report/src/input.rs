@@ -2,6 +2,7 @@
 
 use drift_evaluate::evaluate::ActivationResult;
 use drift_evaluate::summary::Split;
+use drift_evaluate::uncertainty::UnitUncertainty;
 use drift_fit::analyse::Analysed;
 use drift_fit::FittedUnit;
 
@@ -23,4 +24,6 @@ pub struct ReportInput<'a> {
     pub independent_after_min: f64,
     /// Measured durations of the pipeline's steps, seconds.
     pub timings: Vec<(String, f64)>,
+    /// σ(t) per unit with its coverage on held-out activations (empty if not fitted).
+    pub uncertainty: &'a [UnitUncertainty],
 }

@@ -8,6 +8,7 @@ mod input;
 pub mod measured;
 pub mod plots;
 pub mod tables;
+mod uncertainty;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -72,6 +73,7 @@ fn write_outcome(
     provenance: Vec<String>,
 ) -> anyhow::Result<(PathBuf, Outcome)> {
     tables_folder::write(&out.join("tables"), &outcome.fitted)?;
+    tables_folder::write_uncertainty(&out.join("tables"), &outcome.uncertainty)?;
     let input = ReportInput {
         title: TITLE,
         provenance,
@@ -81,6 +83,7 @@ fn write_outcome(
         results: &outcome.results,
         independent_after_min: options.fit.independent_after_min,
         timings: outcome.timings.clone(),
+        uncertainty: &outcome.uncertainty,
     };
     let path = write_report(out, &input)?;
     Ok((path, outcome))
@@ -109,7 +112,8 @@ pub fn headline_of(outcome: &Outcome) -> String {
     tables::headline(&records, &outcome.fitted, &noise)
 }
 
-/// Writes `report.md`, `report.json` (the table as data), the figures and `timings.json` (how
+/// Writes `report.md`, `report.json` (the table as data), `uncertainty.json` (σ(t) and its
+/// coverage, when fitted), the figures and `timings.json` (how
 /// long each step took) into `dir`; returns the report's path.
 pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathBuf> {
     let records = summarise(input.results);
@@ -133,6 +137,7 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
     md.push_str(&tables::noise_floor(&records, input.noise_floor_units));
     md.push_str(&tables::residual_rms(&records, input.fitted));
     md.push_str(&tables::absolute_error(&cells));
+    md.push_str(&uncertainty::section(input.uncertainty));
     if !figures.is_empty() {
         writeln!(md, "## Figures\n")?;
         for (file, caption) in &figures {
@@ -173,6 +178,12 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
         &dir.join("absolute_error.json"),
         serde_json::to_string_pretty(&cells)?.as_bytes(),
     )?;
+    if !input.uncertainty.is_empty() {
+        write_atomic(
+            &dir.join("uncertainty.json"),
+            serde_json::to_string_pretty(input.uncertainty)?.as_bytes(),
+        )?;
+    }
     // Durations differ from run to run; kept apart so the report itself is the same bytes for
     // the same inputs.
     let timings: Vec<serde_json::Value> = input

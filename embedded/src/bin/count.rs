@@ -9,10 +9,13 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use drift_core::blob::{decode, decode_into};
-use drift_core::{AxisModel, Corrector, Model, PolynomialTables, Previous, Sample};
+use drift_core::blob::{decode, decode_into, decode_section};
+use drift_core::{
+    AxisModel, Corrector, Model, PolynomialTables, Previous, Sample, SwitchOn, Uncertainty,
+};
 use gyrodrift_embedded::{
-    FirmwareRecommended, FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, RECOMMENDED, STANDARD,
+    FirmwareRecommended, FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, RECOMMENDED,
+    SIGMA_SECTION, STANDARD,
 };
 use panic_semihosting as _;
 
@@ -119,6 +122,24 @@ where
     gyrodrift_marker(id + 1);
 }
 
+/// σ(t) per sample after a warm restart (class and distance fixed at switch-on, as `measure_after`
+/// starts), alone: what a firmware adds beside each corrected sample to hand its filter σ.
+fn measure_sigma(uncertainty: &Uncertainty, samples: &[Sample], id: u32) {
+    let switch_on = [SwitchOn::estimate(
+        33.0,
+        Some(Previous {
+            ambient_celsius: 31.0,
+            switch_off_celsius: 36.0,
+        }),
+    ); 3];
+    let state = uncertainty.start(black_box(&switch_on));
+    gyrodrift_marker(id);
+    for sample in samples {
+        black_box(uncertainty.sigma_dps(&state, black_box(sample).since_power_on_ms));
+    }
+    gyrodrift_marker(id + 1);
+}
+
 #[entry]
 fn main() -> ! {
     // The tables live in `static`s (cortex-m-rt makes these `&'static mut`), decoded in place.
@@ -172,6 +193,16 @@ fn main() -> ! {
             measure_after(recommended, &samples, 17);
             hprintln!("interval 19: recommended model (power_on_after), 1000 Hz windows");
             measure_after(recommended, &at_1khz, 19);
+            let Ok(uncertainty) = decode_section(black_box(SIGMA_SECTION)) else {
+                hprintln!("FAIL: σ(t) section did not decode");
+                debug::exit(debug::EXIT_FAILURE);
+                #[allow(clippy::empty_loop)]
+                loop {}
+            };
+            hprintln!("interval 21: σ(t) beside each sample (sigma), samples 1 s apart");
+            measure_sigma(&uncertainty, &samples, 21);
+            hprintln!("interval 23: σ(t) beside each sample (sigma), 1000 Hz windows");
+            measure_sigma(&uncertainty, &at_1khz, 23);
             debug::exit(debug::EXIT_SUCCESS);
         }
         _ => {

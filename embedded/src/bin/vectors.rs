@@ -8,14 +8,14 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use drift_core::blob::{decode, decode_into};
+use drift_core::blob::{decode, decode_into, decode_section};
 use drift_core::{
     AxisModel, Corrector, CorrectorState, Model, ModifiedAxisState, PolynomialTables, Previous,
     Sample,
 };
 use gyrodrift_embedded::{
     stack, Case, FirmwareRecommended, FirmwareTables, ModelName, BY_HISTORY, CASES, EXTENDED,
-    MODIFIED, RECOMMENDED, STANDARD, THIRD_ORDER, WARM_STARTED,
+    MODIFIED, RECOMMENDED, SIGMA_CASES, SIGMA_SECTION, STANDARD, THIRD_ORDER, WARM_STARTED,
 };
 use panic_semihosting as _;
 
@@ -152,6 +152,30 @@ fn main() -> ! {
         };
     }
 
+    // σ(t) beside the corrected samples: the section decoded, every case's σ bit for bit.
+    let Ok(uncertainty) = decode_section(black_box(SIGMA_SECTION)) else {
+        fail("σ(t) section did not decode")
+    };
+    let mut sigma_outputs = 0;
+    for case in SIGMA_CASES {
+        case.run(&uncertainty, |i, got| {
+            for (k, (&e, &g)) in case.expected[i].iter().zip(&got).enumerate() {
+                sigma_outputs += 1;
+                if !same(e, g) {
+                    mismatches += 1;
+                    hprintln!(
+                        "σ(t) {} time {} axis {}: expected {:#010x}, got {:#010x}",
+                        case.name,
+                        i,
+                        k,
+                        e,
+                        g
+                    );
+                }
+            }
+        });
+    }
+
     // Stack of one power-on plus one corrected sample, measured on a fresh painting.
     let Ok(mut corrector) = Corrector::new(extended) else {
         fail("model rejected")
@@ -186,7 +210,10 @@ fn main() -> ! {
     hprintln!("cases: {}", CASES.len());
     hprintln!("samples: {}", samples);
     hprintln!("outputs compared: {}", samples * 9);
+    hprintln!("σ(t) cases: {}", SIGMA_CASES.len());
+    hprintln!("σ(t) outputs compared: {}", sigma_outputs);
     hprintln!("mismatches: {}", mismatches);
+    hprintln!("σ(t) section bytes: {}", SIGMA_SECTION.len());
     hprintln!("modified image bytes: {}", MODIFIED.len());
     hprintln!(
         "modified tables in RAM, bytes: {}",

@@ -60,6 +60,7 @@ __all__ = [
     "Settings",
     "StillnessLearner",
     "TableError",
+    "Uncertainty",
     "__version__",
     "_read_csv_text",
     "_restore",
@@ -541,6 +542,48 @@ class StillnessLearner:
         """n rate samples `(n, 3)` in order; accelerometer row k `(m, 3)` is read before rate
         sample `k · accel_every`. Returns the rates less the offset `(n, 3)`, and per sample
         whether it was still and whether it moved the offset."""
+
+@final
+class Uncertainty:
+    """σ(t) of one unit: the residual bias's standard deviation after switch-on, per activation
+    class (cold start, warm restart), growing with the switch-on ambient's distance outside the
+    calibrated envelope. A navigation filter takes it as the gyro bias's uncertainty.
+
+    Fitted by `gyrodrift report` / `demo` (tables folder `<unit>/uncertainty.{json,bin}`); values
+    are bit for bit those drift-core returns in firmware.
+    """
+
+    @staticmethod
+    def load(path: _Path) -> Uncertainty:
+        """Reads `uncertainty.json` or the firmware section `uncertainty.bin`; the error names the
+        file and what is wrong."""
+    @property
+    def knots_ms(self) -> list[int]:
+        """Knot times since switch-on, ms."""
+    @property
+    def sigma_dps(self) -> NDArray[np.float32]:
+        """σ at the knots, °/s, `(2, knots)`: cold start, then warm restart."""
+    @property
+    def warm_above_celsius(self) -> float:
+        """Residual heat at switch-on above which a start is a warm restart, °C."""
+    @property
+    def envelope_celsius(self) -> tuple[float, float]:
+        """The calibrated envelope's lowest and highest ambient, °C."""
+    @property
+    def per_celsius_outside_dps(self) -> float:
+        """Growth of σ per °C of switch-on ambient outside the envelope, °/s."""
+    def sigma(
+        self,
+        since_power_on_ms: NDArray[np.uint32],
+        switch_on_celsius: _Floats3,
+        previous: _Previous | None = None,
+    ) -> NDArray[np.float32]:
+        """σ per sample and axis, °/s `(n, 3)`, for an activation switched on at
+        `switch_on_celsius` after `previous` (`(3, 2)` as `Corrector.power_on_after` takes it;
+        None: nothing kept)."""
+    def to_json(self) -> str:
+        """drift-core's JSON of this σ(t)."""
+    def __eq__(self, other: object, /) -> bool: ...
 
 @final
 class Corrector:
