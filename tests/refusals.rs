@@ -372,6 +372,162 @@ fn simulate_refuses_a_non_empty_folder_and_force_replaces_it() {
     assert!(out.join("notes.txt").exists());
 }
 
+/// The names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn every_writer_refuses_a_folder_of_another_run_and_force_replaces_its_own_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = s(campaign());
+    let tables = dir.path().join("tables");
+    let fit = |force: bool| {
+        let mut args = vec!["fit", c, "-q", "-o", s(&tables)];
+        if force {
+            args.push("--force");
+        }
+        args
+    };
+    common::ok(&fit(false));
+    // A stale unit of an earlier run would be used by `check --tables`: a rerun refuses, and
+    // --force replaces the folder whole.
+    std::fs::create_dir(tables.join("GIU-02")).unwrap();
+    refused(
+        &fit(false),
+        &[
+            "is not empty (.gyrodrift-output, GIU-01, GIU-02)",
+            "pass --force to replace the tables folder there, or choose a new folder",
+        ],
+    );
+    assert!(
+        tables.join("GIU-02").exists(),
+        "nothing removed without --force"
+    );
+    common::ok(&fit(true));
+    assert_eq!(names(&tables), [".gyrodrift-output", "GIU-01"]);
+    assert_eq!(names(dir.path()), ["tables"], "no staging folder left");
+
+    // Another command's output, or a folder of the user's, is never replaced.
+    let report = dir.path().join("report");
+    common::ok(&["report", c, "-q", "-o", s(&report)]);
+    refused(
+        &["fit", c, "-q", "-o", s(&report), "--force"],
+        &["holds the output of `gyrodrift report`, not of `fit`"],
+    );
+    let mine = dir.path().join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    for args in [
+        vec!["fit", c, "-q", "-o", s(&mine), "--force"],
+        vec!["report", c, "-q", "-o", s(&mine), "--force"],
+        vec![
+            "check",
+            c,
+            "--tables",
+            s(&tables),
+            "-q",
+            "-o",
+            s(&mine),
+            "--force",
+        ],
+        vec!["demo", "-q", "-o", s(&mine), "--force"],
+    ] {
+        refused(&args, &["holds files", "does not write (notes.txt)"]);
+    }
+    assert_eq!(names(&mine), ["notes.txt"]);
+    refused(
+        &["report", c, "-q", "-o", s(&report)],
+        &["pass --force to replace the report there"],
+    );
+    common::ok(&["report", c, "-q", "-o", s(&report), "--force"]);
+}
+
+#[test]
+fn an_interrupted_demo_leaves_the_earlier_demo_as_it_was_and_no_temporaries() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    // An earlier demo's output, as far as the rule sees it: its marker and what it holds.
+    std::fs::create_dir_all(out.join("campaign")).unwrap();
+    std::fs::write(out.join(".gyrodrift-output"), "demo\n").unwrap();
+    std::fs::write(out.join("campaign/summary.json"), "{}").unwrap();
+    std::fs::create_dir_all(out.join("report")).unwrap();
+    std::fs::write(out.join("report/report.md"), "# earlier\n").unwrap();
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
+        .args(["demo", "-q", "--force", "-o", s(&out)])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let recordings = dir
+        .path()
+        .join(format!(".demo.writing-{pid}/campaign/recordings"));
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while !std::fs::read_dir(&recordings).is_ok_and(|mut d| d.next().is_some()) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the demo wrote nothing"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let finished = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&finished.stderr);
+    assert_eq!(finished.status.code(), Some(130), "{text}");
+    assert!(text.contains("removed the unfinished output"), "{text}");
+    assert_eq!(
+        names(dir.path()),
+        ["demo"],
+        "no staging folder or temporary left"
+    );
+    assert_eq!(names(&out), [".gyrodrift-output", "campaign", "report"]);
+    assert_eq!(names(&out.join("campaign")), ["summary.json"]);
+    assert_eq!(
+        std::fs::read_to_string(out.join("report/report.md")).unwrap(),
+        "# earlier\n"
+    );
+}
+
+#[test]
+fn import_csv_into_a_folder_replaces_an_earlier_import_only_when_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("a.csv");
+    std::fs::write(&csv, CSV).unwrap();
+    let other = dir.path().join("b.csv");
+    std::fs::write(&other, CSV).unwrap();
+    let out = dir.path().join("imported");
+    common::ok(&csv_args(s(&csv), s(&out), &[]));
+    // A second file is not added to the first import (its import.json would list only one).
+    refused(
+        &csv_args(s(&other), s(&out), &[]),
+        &["is not empty", "pass --force to replace the import there"],
+    );
+    assert_eq!(names(&out.join("recordings")), ["csv_a.mcap"]);
+    common::ok(&csv_args(s(&other), s(&out), &["--force"]));
+    assert_eq!(names(&out.join("recordings")), ["csv_b.mcap"]);
+    let manifest = std::fs::read_to_string(out.join("import.json")).unwrap();
+    assert!(
+        manifest.contains("b.csv") && !manifest.contains("a.csv"),
+        "{manifest}"
+    );
+    // An import is not the place for a report, nor a report's folder for an import.
+    let report = dir.path().join("report");
+    common::ok(&["report", s(campaign()), "-q", "-o", s(&report)]);
+    refused(
+        &csv_args(s(&csv), s(&report), &["--force"]),
+        &["holds the output of `gyrodrift report`, not of `import`"],
+    );
+}
+
 // --- writers validate with the reader's rules ---------------------------------------------------
 
 const CSV: &str = "segment_id,t_s,gx,gy,gz,temp\n0,0.000,0.1,0.2,0.3,30.0\n0,0.001,0.1,0.2,0.3,30.0\n0,0.002,0.1,0.2,0.3,30.0\n";

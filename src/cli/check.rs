@@ -15,6 +15,7 @@ use drift_evaluate::check::{AxisVerdict, CheckedActivation, Limits, UnitCheck};
 use drift_evaluate::pipeline;
 use drift_evaluate::tables_folder::{self, StoredModel, TablesError};
 use drift_fit::FitSettings;
+use drift_recording::output_folder::{Owned, Writer};
 use drift_recording::read_recording;
 
 use super::campaign_args::load_settings;
@@ -84,10 +85,21 @@ pub struct Args {
     /// Output folder for `check.md` and `check.json`.
     #[arg(long, short = 'o', default_value = "out/check")]
     pub out: PathBuf,
+    /// Replace an earlier `gyrodrift check` output in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// No progress bars.
     #[arg(long, short = 'q')]
     pub quiet: bool,
 }
+
+/// `check` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "check",
+    product: "check report",
+    doing: "checking",
+    owned: Owned::Marker,
+};
 
 /// One unit's result.
 #[derive(Debug, serde::Serialize)]
@@ -222,6 +234,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let files = pipeline::recording_files(&args.recordings)?;
     let settings = load_settings(args.settings.as_deref())?;
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let steps = Steps::new(args.quiet);
     let results = match args.model {
         Stored::Modified | Stored::ByHistory => {
@@ -243,8 +256,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "limits": limits,
         "units": results,
     }))?;
-    write_atomic(&args.out.join("check.json"), json.as_bytes())?;
-    write_atomic(&args.out.join("check.md"), md.as_bytes())?;
+    write_atomic(&staged.path().join("check.json"), json.as_bytes())?;
+    write_atomic(&staged.path().join("check.md"), md.as_bytes())?;
+    staged.commit()?;
     print!("{}", table(&results));
     println!("report: {}", args.out.join("check.md").display());
     let failed: Vec<String> = results

@@ -30,6 +30,9 @@ pub struct UlogArgs {
     /// Output: a new campaign folder (`recordings/<unit>.mcap`, `import.json`).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
+    /// Replace an earlier import in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// Sample rate of the recording's grid, Hz (must divide 10⁹).
     #[arg(long, default_value_t = 100)]
     pub rate_hz: u32,
@@ -175,7 +178,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         )
     })?;
     let options = log_options(args.rate_hz, args.max_gap, args.set_point, kind);
-    super::campaign_out::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out, args.force)?;
     let files = logs(&args.path)?;
     let mut units: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
     let mut read = Vec::new();
@@ -246,7 +249,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         "off_times": "unknown: ULog headers carry boot time, not wall-clock time",
         "logs": read,
     });
-    let lines = super::campaign_out::write_campaign(&args.out, &recordings, &manifest)?;
+    let lines = super::campaign_out::write_campaign(&args.out, args.force, &recordings, &manifest)?;
     for line in lines {
         println!("{line}");
     }
