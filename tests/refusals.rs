@@ -693,12 +693,15 @@ fn table_json_with_an_unknown_field_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let tables = dir.path().join("tables");
     common::ok(&["fit", s(campaign()), "-q", "-o", s(&tables)]);
-    for name in ["modified", "standard"] {
+    for name in ["modified", "standard", "relative"] {
         let path = tables.join(format!("GIU-01/{name}.json"));
         let text = std::fs::read_to_string(&path).unwrap();
         let misspelt = text.replacen('{', "{\"setings\": {},", 1);
         let error = match name {
             "modified" => serde_json::from_str::<drift_core::ModifiedTables>(&misspelt)
+                .map(|_| ())
+                .unwrap_err(),
+            "relative" => serde_json::from_str::<drift_core::RelativePolynomialTables>(&misspelt)
                 .map(|_| ())
                 .unwrap_err(),
             _ => serde_json::from_str::<drift_core::PolynomialTables>(&misspelt)
