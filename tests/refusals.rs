@@ -401,7 +401,7 @@ fn every_writer_refuses_a_folder_of_another_run_and_force_replaces_its_own_whole
     refused(
         &fit(false),
         &[
-            "is not empty (.gyrodrift-output, GIU-01, GIU-02)",
+            "is not empty (.gyrodrift-output, GIU-01, GIU-02, calibration-data.json)",
             "pass --force to replace the tables folder there, or choose a new folder",
         ],
     );
@@ -410,7 +410,10 @@ fn every_writer_refuses_a_folder_of_another_run_and_force_replaces_its_own_whole
         "nothing removed without --force"
     );
     common::ok(&fit(true));
-    assert_eq!(names(&tables), [".gyrodrift-output", "GIU-01"]);
+    assert_eq!(
+        names(&tables),
+        [".gyrodrift-output", "GIU-01", "calibration-data.json"]
+    );
     assert_eq!(names(dir.path()), ["tables"], "no staging folder left");
 
     // Another command's output, or a folder of the user's, is never replaced.
@@ -495,6 +498,52 @@ fn an_interrupted_demo_leaves_the_earlier_demo_as_it_was_and_no_temporaries() {
         std::fs::read_to_string(out.join("report/report.md")).unwrap(),
         "# earlier\n"
     );
+}
+
+#[test]
+fn check_on_the_tables_own_calibration_data_says_it_is_in_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let tables = dir.path().join("tables");
+    common::ok(&["fit", s(campaign()), "-q", "-o", s(&tables)]);
+    let checked = dir.path().join("check");
+    let (out, text) = gyrodrift(&[
+        "check",
+        s(campaign()),
+        "--tables",
+        s(&tables),
+        "-q",
+        "-o",
+        s(&checked),
+    ]);
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{text}");
+    assert!(
+        text.contains(
+            "in-sample: 2 of 3 recordings checked are calibration data these tables were fitted on"
+        ),
+        "{text}"
+    );
+    let md = std::fs::read_to_string(checked.join("check.md")).unwrap();
+    assert!(md.contains("**In-sample.** 2 of 3"), "{md}");
+    // A copy is recognised by content; a recording the fit did not see is not in-sample.
+    let copy = dir.path().join("copy");
+    copy_tree(campaign(), &copy);
+    for entry in std::fs::read_dir(copy.join("recordings")).unwrap() {
+        let path = entry.unwrap().path();
+        if !path.to_string_lossy().contains("sp+33.0C") {
+            std::fs::remove_file(path).unwrap();
+        }
+    }
+    let (out, text) = gyrodrift(&[
+        "check",
+        s(&copy),
+        "--tables",
+        s(&tables),
+        "-q",
+        "-o",
+        s(&dir.path().join("check-33")),
+    ]);
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{text}");
+    assert!(!text.contains("in-sample"), "{text}");
 }
 
 #[test]

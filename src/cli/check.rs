@@ -215,6 +215,16 @@ fn markdown(results: &[UnitResult], limits: &Limits) -> String {
     md
 }
 
+/// What a check on the tables' own calibration recordings means, if any of `files` is one.
+fn in_sample_note(in_sample: &[(PathBuf, String)], files: usize) -> Option<String> {
+    let (first, name) = in_sample.first()?;
+    Some(format!(
+        "{} of {files} recordings checked are calibration data these tables were fitted on ({} is {name}): on them the check measures how well the tables fit their own data, not whether the calibration still holds; check on recordings made after the calibration",
+        in_sample.len(),
+        first.display()
+    ))
+}
+
 /// Runs `gyrodrift check`; fails with `LimitsMissed` (exit status 1) when any unit × axis
 /// misses a limit, after writing the report; any other error (no tables, unreadable recordings,
 /// bad limits) exits with status 2.
@@ -251,15 +261,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     };
     steps.finish();
-    let md = markdown(&results, &limits);
+    let in_sample = super::in_sample::shared(&args.tables, &files)?;
+    let mut md = markdown(&results, &limits);
+    let note = in_sample_note(&in_sample, files.len());
+    if let Some(note) = &note {
+        md.push_str(&format!("\n**In-sample.** {note}\n"));
+    }
     let json = serde_json::to_string_pretty(&serde_json::json!({
         "limits": limits,
         "units": results,
+        "in_sample_recordings": in_sample.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     }))?;
     write_atomic(&staged.path().join("check.json"), json.as_bytes())?;
     write_atomic(&staged.path().join("check.md"), md.as_bytes())?;
     staged.commit()?;
     print!("{}", table(&results));
+    if let Some(note) = &note {
+        println!("in-sample: {note}");
+    }
     println!("report: {}", args.out.join("check.md").display());
     let failed: Vec<String> = results
         .iter()

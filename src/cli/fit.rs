@@ -39,6 +39,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .map_err(|e| super::measured::explain(e, &files))?;
     steps.finish();
     drift_evaluate::tables_folder::write(staged.path(), &outcome.fitted)?;
+    super::in_sample::write(staged.path(), &files, &options)?;
     staged.commit()?;
     let seconds = |step: &str| {
         outcome

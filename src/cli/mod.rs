@@ -15,6 +15,7 @@ pub mod import;
 pub mod import_campaign;
 pub mod import_rosbag;
 pub mod import_ulog;
+mod in_sample;
 pub mod interrupt;
 mod measured;
 mod progress;

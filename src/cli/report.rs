@@ -82,7 +82,9 @@ pub fn make(
         &|s, d, t| steps.update(s, d, t),
     );
     steps.finish();
-    made
+    let made = made?;
+    super::in_sample::write(&out.join("tables"), &files, options)?;
+    Ok(made)
 }
 
 /// Why a noise floor must be other recordings than the data it is set beside.
@@ -215,6 +217,7 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
     );
     steps.finish();
     let (path, outcome) = made?;
+    super::in_sample::write(&staged.path().join("tables"), &calibration, options)?;
     staged.commit()?;
     print_headline(&outcome);
     println!("report: {}", in_target(&args.out, &path).display());
