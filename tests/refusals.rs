@@ -813,6 +813,32 @@ fn simulate_refuses_a_campaign_too_large_with_its_estimate() {
     assert!(!out.exists());
 }
 
+#[test]
+fn a_campaign_too_large_is_sized_before_it_is_planned() {
+    // Under a 1 GB address-space limit, planning 100 000 units' schedules would abort the
+    // process in the allocator; sized from its first units, it is refused with its size.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c");
+    let started = std::time::Instant::now();
+    let run = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 1000000 && exec '{}' simulate -q -o '{}' --units 100000",
+            env!("CARGO_BIN_EXE_gyrodrift"),
+            s(&out)
+        ))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("would write about") && text.contains("TB (about"),
+        "{text}"
+    );
+    assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
+    assert!(!out.exists());
+}
+
 // --- messages ------------------------------------------------------------------------------------
 
 #[test]

@@ -74,13 +74,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let (paper, noise) = campaigns(args.seed);
     let bytes: f64 = [&paper, &noise]
         .iter()
-        .map(|c| super::simulate::estimate_bytes(c, drift_sim::simulate::total_samples(c)))
+        .map(|c| drift_sim::size::estimate_bytes(c, drift_sim::simulate::total_samples(c)))
         .sum();
     if !args.quiet {
         // Disk use, stated before the large writes start.
         eprintln!(
             "demo: simulating two campaigns, about {} of recordings and truth → {}",
-            super::simulate::gigabytes(bytes / 1e9),
+            drift_sim::size::gigabytes(bytes / 1e9),
             args.out.display()
         );
     }
