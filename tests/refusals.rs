@@ -597,6 +597,56 @@ fn csv_args<'a>(csv: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     args
 }
 
+/// A CSV of `rows` rows at `rate` rows per second, time in seconds.
+fn csv_at(path: &Path, rows: usize, rate: f64) {
+    let mut text = String::from("segment_id,t_s,gx,gy,gz,temp\n");
+    for i in 0..rows {
+        text.push_str(&format!("0,{:.6},0.1,0.2,0.3,30.0\n", i as f64 / rate));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn import_csv_refuses_made_up_samples_and_unused_rows_unless_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("seconds.csv");
+    csv_at(&csv, 2000, 1000.0);
+    let out = dir.path().join("a.mcap");
+    let resample = ["--timing", "resample"];
+    // Seconds read as milliseconds: 2000 rows would become 2 samples.
+    let mut args = csv_args(s(&csv), s(&out), &resample);
+    args.extend(["--time-unit", "ms"]);
+    refused(
+        &args,
+        &[
+            "seconds.csv: 2000 rows became 2 samples at 1000 Hz",
+            "give `--time-unit s`",
+            "`--downsample`",
+        ],
+    );
+    assert!(!out.exists());
+    common::ok(&csv_args(s(&csv), s(&out), &resample));
+    // 100 Hz rows on a 1000 Hz grid: 90 % of the samples made up.
+    let slow = dir.path().join("slow.csv");
+    csv_at(&slow, 200, 100.0);
+    let out = dir.path().join("b.mcap");
+    refused(
+        &csv_args(s(&slow), s(&out), &resample),
+        &[
+            "slow.csv: 200 rows became 1991 samples at 1000 Hz",
+            "90 % of the samples would be made up",
+            "give `--rate-hz 100`, or `--upsample`",
+        ],
+    );
+    let mut args = csv_args(s(&slow), s(&out), &resample);
+    args.push("--upsample");
+    common::ok(&args);
+    let at_100 = dir.path().join("c.mcap");
+    let mut args = csv_args(s(&slow), s(&at_100), &resample);
+    args.extend(["--rate-hz", "100"]);
+    common::ok(&args);
+}
+
 #[test]
 fn import_refuses_a_set_point_the_reader_would_refuse() {
     let dir = tempfile::tempdir().unwrap();

@@ -73,6 +73,12 @@ pub struct CsvArgs {
     /// Series kind of every activation: `protocol` or `field`.
     #[arg(long, default_value = "protocol")]
     pub series_kind: String,
+    /// With `--timing resample`: interpolate onto a grid faster than the rows come.
+    #[arg(long)]
+    pub upsample: bool,
+    /// With `--timing resample`: keep a grid much slower than the rows, leaving most rows unused.
+    #[arg(long)]
+    pub downsample: bool,
 }
 
 impl CsvArgs {
@@ -146,6 +152,22 @@ fn run_csv(args: &CsvArgs) -> anyhow::Result<()> {
     let recording = read_csv(&args.file, &options)?;
     let samples: usize = recording.segments.iter().map(|s| s.len()).sum();
     let fs = f64::from(recording.sample_rate_hz);
+    let rows: usize = recording
+        .metadata
+        .get("csv_rows")
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(samples);
+    super::row_use::refuse_made_up_or_dropped(
+        &args.file,
+        super::row_use::RowUse {
+            rows,
+            samples,
+            rate_hz: recording.sample_rate_hz,
+            time_unit: &args.reading.time_unit,
+        },
+        args.upsample,
+        args.downsample,
+    )?;
     let activations: Vec<serde_json::Value> = recording
         .segments
         .iter()

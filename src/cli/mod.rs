@@ -21,6 +21,7 @@ mod measured;
 mod progress;
 mod reading;
 pub mod report;
+mod row_use;
 mod shared_data;
 mod sheet_logs;
 pub mod simulate;
