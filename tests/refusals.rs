@@ -648,6 +648,39 @@ fn import_csv_refuses_made_up_samples_and_unused_rows_unless_asked() {
 }
 
 #[test]
+fn a_truncated_ulog_is_refused_unless_asked() {
+    let real = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/formats/px4-ulog/sample_log_small.ulg");
+    let Ok(bytes) = std::fs::read(&real) else {
+        println!("skipped: the PX4 fixture is absent");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    let grid = ["--rate-hz", "1", "--max-gap", "1.5"];
+    let mut args = vec!["import", "ulog", s(&real), "-o", s(&whole)];
+    args.extend(grid);
+    common::ok(&args);
+    let cut = dir.path().join("cut.ulg");
+    std::fs::write(&cut, &bytes[..bytes.len() * 9 / 10 + 1]).unwrap();
+    let out = dir.path().join("imported");
+    let mut args = vec!["import", "ulog", s(&cut), "-o", s(&out)];
+    args.extend(grid);
+    refused(
+        &args,
+        &[
+            "cut.ulg: the log ends inside a message at byte",
+            "the file is truncated",
+            "`--truncated` to import the complete messages before the cut",
+        ],
+    );
+    assert!(!out.exists());
+    args.push("--truncated");
+    let text = common::ok(&args);
+    assert!(!text.contains("truncated"), "{text}");
+}
+
+#[test]
 fn import_refuses_a_set_point_the_reader_would_refuse() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("bench.csv");

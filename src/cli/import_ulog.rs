@@ -33,6 +33,9 @@ pub struct UlogArgs {
     /// Replace an earlier import in the output folder, whole.
     #[arg(long)]
     pub force: bool,
+    /// Import a log the file's end cuts inside a message (its complete messages before the cut).
+    #[arg(long)]
+    pub truncated: bool,
     /// Sample rate of the recording's grid, Hz (must divide 10⁹).
     #[arg(long, default_value_t = 100)]
     pub rate_hz: u32,
@@ -169,6 +172,19 @@ pub(super) fn log_options(
     }
 }
 
+/// Refuses a log whose end cuts a message (the logger stopped midway, or the copy is short)
+/// unless `accept`: its time span would silently end early.
+pub fn refuse_cut(log: &Ulog, accept: bool) -> anyhow::Result<()> {
+    if let (Some(cut), false) = (log.cut_at, accept) {
+        let length = std::fs::metadata(&log.path).map_or(0, |m| m.len());
+        anyhow::bail!(
+            "{}: the log ends inside a message at byte {cut} of {length}: the file is truncated (the logger stopped midway, or the copy is short) and whatever followed is missing; give the whole log, or `--truncated` to import the complete messages before the cut",
+            log.path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Runs `gyrodrift import ulog`.
 pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
     let kind = SeriesKind::parse(&args.series_kind).with_context(|| {
@@ -184,6 +200,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
     let mut read = Vec::new();
     for (k, file) in files.iter().enumerate() {
         let log = read_ulog(file)?;
+        refuse_cut(&log, args.truncated)?;
         let topics = gyros(&log);
         anyhow::ensure!(
             !topics.is_empty(),
