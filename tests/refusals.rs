@@ -675,6 +675,25 @@ fn a_truncated_ulog_is_refused_unless_asked() {
         ],
     );
     assert!(!out.exists());
+    // Logged at 1 Hz: the default 100 Hz grid would make up 99 % of its samples.
+    let at_100 = dir.path().join("at-100");
+    refused(
+        &[
+            "import",
+            "ulog",
+            s(&real),
+            "-o",
+            s(&at_100),
+            "--max-gap",
+            "1.5",
+        ],
+        &[
+            "sample_log_small.ulg: 6 `sensor_gyro` instance 0 messages became",
+            "would be made up by interpolation",
+            "give `--rate-hz 1`, or `--upsample`",
+        ],
+    );
+    assert!(!at_100.exists());
     args.push("--truncated");
     let text = common::ok(&args);
     assert!(!text.contains("truncated"), "{text}");

@@ -161,9 +161,10 @@ fn run_csv(args: &CsvArgs) -> anyhow::Result<()> {
         &args.file,
         super::row_use::RowUse {
             rows,
+            what: "rows",
             samples,
             rate_hz: recording.sample_rate_hz,
-            time_unit: &args.reading.time_unit,
+            time_unit: Some(&args.reading.time_unit),
         },
         args.upsample,
         args.downsample,

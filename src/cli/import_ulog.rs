@@ -36,6 +36,9 @@ pub struct UlogArgs {
     /// Import a log the file's end cuts inside a message (its complete messages before the cut).
     #[arg(long)]
     pub truncated: bool,
+    /// Interpolate onto a grid faster than the gyro messages come.
+    #[arg(long)]
+    pub upsample: bool,
     /// Sample rate of the recording's grid, Hz (must divide 10⁹).
     #[arg(long, default_value_t = 100)]
     pub rate_hz: u32,
@@ -211,6 +214,19 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         for (suffix, topic, rates, temperature) in topics {
             let unit = format!("{}-{suffix}", args.unit_id);
             let mut segment = activation(&log, topic, rates, temperature, &options)?;
+            let what = format!("`{}` instance {} messages", topic.name, topic.instance);
+            super::row_use::refuse_made_up_or_dropped(
+                file,
+                super::row_use::RowUse {
+                    rows: topic.len(),
+                    what: &what,
+                    samples: segment.len(),
+                    rate_hz: args.rate_hz,
+                    time_unit: None,
+                },
+                args.upsample,
+                true,
+            )?;
             segment.labels.unit_id = unit.clone();
             segment.labels.series = 1;
             segment.labels.activation = u32::try_from(k + 1).unwrap_or(u32::MAX);

@@ -12,14 +12,16 @@ const GRID_RATES: [u32; 14] = [
 /// How a file's rows became samples.
 #[derive(Debug, Clone, Copy)]
 pub struct RowUse<'a> {
-    /// Rows read.
+    /// Rows (or messages) read.
     pub rows: usize,
+    /// What a row is, plural: `rows`, `sensor_gyro instance 0 messages`.
+    pub what: &'a str,
     /// Samples on the grid.
     pub samples: usize,
     /// The grid's rate, Hz.
     pub rate_hz: u32,
-    /// `--time-unit` as given.
-    pub time_unit: &'a str,
+    /// `--time-unit` as given, if the time column's unit is the user's to give.
+    pub time_unit: Option<&'a str>,
 }
 
 /// Refuses a grid on which more than 5 % of the samples are made up (unless `upsample`) or on
@@ -33,6 +35,7 @@ pub fn refuse_made_up_or_dropped(
 ) -> anyhow::Result<()> {
     let RowUse {
         rows,
+        what,
         samples,
         rate_hz,
         time_unit,
@@ -49,21 +52,25 @@ pub fn refuse_made_up_or_dropped(
         .unwrap_or(1);
     if samples as f64 > rows as f64 * 1.05 && !upsample {
         anyhow::bail!(
-            "{}: {rows} rows became {samples} samples at {rate_hz} Hz ({seconds:.1} s): {:.0} % of the samples would be made up by interpolation (the rows come at about {rows_hz:.1} per second); give `--rate-hz {suggest}`, or `--upsample` to interpolate anyway",
+            "{}: {rows} {what} became {samples} samples at {rate_hz} Hz ({seconds:.1} s): {:.0} % of the samples would be made up by interpolation (the {what} come at about {rows_hz:.1} per second); give `--rate-hz {suggest}`, or `--upsample` to interpolate anyway",
             file.display(),
             100.0 * (1.0 - rows as f64 / samples as f64)
         );
     }
     if (samples as f64) < rows as f64 * 0.5 && !downsample {
-        let other = if time_unit == "ms" { "s" } else { "ms" };
+        let unit = time_unit.map_or(String::new(), |unit| {
+            let other = if unit == "ms" { "s" } else { "ms" };
+            format!(" If the time column is in {other}, give `--time-unit {other}`;")
+        });
         let faster = if suggest > rate_hz {
             format!("if the rows come faster than the grid, give `--rate-hz {suggest}`; ")
         } else {
             String::new()
         };
         anyhow::bail!(
-            "{}: {rows} rows became {samples} samples at {rate_hz} Hz ({seconds:.3} s by the time column read in {time_unit}): {:.0} % of the rows would not be used. If the time column is in {other}, give `--time-unit {other}`; {faster}or `--downsample` to keep the grid's samples only",
+            "{}: {rows} {what} became {samples} samples at {rate_hz} Hz ({seconds:.3} s{}): {:.0} % of the {what} would not be used.{unit} {faster}or `--downsample` to keep the grid's samples only",
             file.display(),
+            time_unit.map_or(String::new(), |u| format!(" by the time column read in {u}")),
             100.0 * (1.0 - samples as f64 / rows as f64)
         );
     }
