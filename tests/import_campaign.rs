@@ -323,7 +323,7 @@ fn bad_sheets_and_files_are_named_by_file_row_and_column_and_leave_nothing() {
         (s.labels.activation, s.labels.off_before_s, s.power_on_ns),
         (2, Some(60.0), 62_000_000_000)
     );
-    // Importing into it again is refused: an import writes a new folder.
+    // Importing into it again is refused unless --force: an import never adds to another.
     let (status, text) = gyrodrift(&[
         "import",
         "campaign",
@@ -334,7 +334,7 @@ fn bad_sheets_and_files_are_named_by_file_row_and_column_and_leave_nothing() {
         "10",
     ]);
     assert!(
-        !status.status.success() && text.contains("not an empty folder"),
+        status.status.code() == Some(2) && text.contains("pass --force to replace the import"),
         "{text}"
     );
     std::fs::remove_dir_all(&out).unwrap();

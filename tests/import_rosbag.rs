@@ -655,7 +655,7 @@ fn an_exported_recording_has_a_message_per_sample_and_imports_back() {
         read_recording(&out2.join(&name)).unwrap().segments,
         back.segments
     );
-    // Exporting into an existing folder is refused.
+    // Exporting into an earlier export is refused unless --force.
     let (status, text) = gyrodrift(&[
         "export",
         "ros2",
@@ -664,7 +664,10 @@ fn an_exported_recording_has_a_message_per_sample_and_imports_back() {
         bags.to_str().unwrap(),
     ]);
     assert_eq!(status.status.code(), Some(2), "{text}");
-    assert!(text.contains("not an empty folder"), "{text}");
+    assert!(
+        text.contains("pass --force to replace the export there"),
+        "{text}"
+    );
 }
 
 /// An export imported back keeps the recording's unit, rate, set point and kind, and each

@@ -372,6 +372,211 @@ fn simulate_refuses_a_non_empty_folder_and_force_replaces_it() {
     assert!(out.join("notes.txt").exists());
 }
 
+/// The names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn every_writer_refuses_a_folder_of_another_run_and_force_replaces_its_own_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = s(campaign());
+    let tables = dir.path().join("tables");
+    let fit = |force: bool| {
+        let mut args = vec!["fit", c, "-q", "-o", s(&tables)];
+        if force {
+            args.push("--force");
+        }
+        args
+    };
+    common::ok(&fit(false));
+    // A stale unit of an earlier run would be used by `check --tables`: a rerun refuses, and
+    // --force replaces the folder whole.
+    std::fs::create_dir(tables.join("GIU-02")).unwrap();
+    refused(
+        &fit(false),
+        &[
+            "is not empty (.gyrodrift-output, GIU-01, GIU-02, calibration-data.json)",
+            "pass --force to replace the tables folder there, or choose a new folder",
+        ],
+    );
+    assert!(
+        tables.join("GIU-02").exists(),
+        "nothing removed without --force"
+    );
+    common::ok(&fit(true));
+    assert_eq!(
+        names(&tables),
+        [".gyrodrift-output", "GIU-01", "calibration-data.json"]
+    );
+    assert_eq!(names(dir.path()), ["tables"], "no staging folder left");
+
+    // Another command's output, or a folder of the user's, is never replaced.
+    let report = dir.path().join("report");
+    common::ok(&["report", c, "-q", "-o", s(&report)]);
+    refused(
+        &["fit", c, "-q", "-o", s(&report), "--force"],
+        &["holds the output of `gyrodrift report`, not of `fit`"],
+    );
+    let mine = dir.path().join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    for args in [
+        vec!["fit", c, "-q", "-o", s(&mine), "--force"],
+        vec!["report", c, "-q", "-o", s(&mine), "--force"],
+        vec![
+            "check",
+            c,
+            "--tables",
+            s(&tables),
+            "-q",
+            "-o",
+            s(&mine),
+            "--force",
+        ],
+        vec!["demo", "-q", "-o", s(&mine), "--force"],
+    ] {
+        refused(&args, &["holds files", "does not write (notes.txt)"]);
+    }
+    assert_eq!(names(&mine), ["notes.txt"]);
+    refused(
+        &["report", c, "-q", "-o", s(&report)],
+        &["pass --force to replace the report there"],
+    );
+    common::ok(&["report", c, "-q", "-o", s(&report), "--force"]);
+}
+
+#[test]
+fn an_interrupted_demo_leaves_the_earlier_demo_as_it_was_and_no_temporaries() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    // An earlier demo's output, as far as the rule sees it: its marker and what it holds.
+    std::fs::create_dir_all(out.join("campaign")).unwrap();
+    std::fs::write(out.join(".gyrodrift-output"), "demo\n").unwrap();
+    std::fs::write(out.join("campaign/summary.json"), "{}").unwrap();
+    std::fs::create_dir_all(out.join("report")).unwrap();
+    std::fs::write(out.join("report/report.md"), "# earlier\n").unwrap();
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
+        .args(["demo", "-q", "--force", "-o", s(&out)])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let recordings = dir
+        .path()
+        .join(format!(".demo.writing-{pid}/campaign/recordings"));
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while !std::fs::read_dir(&recordings).is_ok_and(|mut d| d.next().is_some()) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the demo wrote nothing"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let finished = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&finished.stderr);
+    assert_eq!(finished.status.code(), Some(130), "{text}");
+    assert!(text.contains("removed the unfinished output"), "{text}");
+    assert_eq!(
+        names(dir.path()),
+        ["demo"],
+        "no staging folder or temporary left"
+    );
+    assert_eq!(names(&out), [".gyrodrift-output", "campaign", "report"]);
+    assert_eq!(names(&out.join("campaign")), ["summary.json"]);
+    assert_eq!(
+        std::fs::read_to_string(out.join("report/report.md")).unwrap(),
+        "# earlier\n"
+    );
+}
+
+#[test]
+fn check_on_the_tables_own_calibration_data_says_it_is_in_sample() {
+    let dir = tempfile::tempdir().unwrap();
+    let tables = dir.path().join("tables");
+    common::ok(&["fit", s(campaign()), "-q", "-o", s(&tables)]);
+    let checked = dir.path().join("check");
+    let (out, text) = gyrodrift(&[
+        "check",
+        s(campaign()),
+        "--tables",
+        s(&tables),
+        "-q",
+        "-o",
+        s(&checked),
+    ]);
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{text}");
+    assert!(
+        text.contains(
+            "in-sample: 2 of 3 recordings checked are calibration data these tables were fitted on"
+        ),
+        "{text}"
+    );
+    let md = std::fs::read_to_string(checked.join("check.md")).unwrap();
+    assert!(md.contains("**In-sample.** 2 of 3"), "{md}");
+    // A copy is recognised by content; a recording the fit did not see is not in-sample.
+    let copy = dir.path().join("copy");
+    copy_tree(campaign(), &copy);
+    for entry in std::fs::read_dir(copy.join("recordings")).unwrap() {
+        let path = entry.unwrap().path();
+        if !path.to_string_lossy().contains("sp+33.0C") {
+            std::fs::remove_file(path).unwrap();
+        }
+    }
+    let (out, text) = gyrodrift(&[
+        "check",
+        s(&copy),
+        "--tables",
+        s(&tables),
+        "-q",
+        "-o",
+        s(&dir.path().join("check-33")),
+    ]);
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{text}");
+    assert!(!text.contains("in-sample"), "{text}");
+}
+
+#[test]
+fn import_csv_into_a_folder_replaces_an_earlier_import_only_when_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("a.csv");
+    std::fs::write(&csv, CSV).unwrap();
+    let other = dir.path().join("b.csv");
+    std::fs::write(&other, CSV).unwrap();
+    let out = dir.path().join("imported");
+    common::ok(&csv_args(s(&csv), s(&out), &[]));
+    // A second file is not added to the first import (its import.json would list only one).
+    refused(
+        &csv_args(s(&other), s(&out), &[]),
+        &["is not empty", "pass --force to replace the import there"],
+    );
+    assert_eq!(names(&out.join("recordings")), ["csv_a.mcap"]);
+    common::ok(&csv_args(s(&other), s(&out), &["--force"]));
+    assert_eq!(names(&out.join("recordings")), ["csv_b.mcap"]);
+    let manifest = std::fs::read_to_string(out.join("import.json")).unwrap();
+    assert!(
+        manifest.contains("b.csv") && !manifest.contains("a.csv"),
+        "{manifest}"
+    );
+    // An import is not the place for a report, nor a report's folder for an import.
+    let report = dir.path().join("report");
+    common::ok(&["report", s(campaign()), "-q", "-o", s(&report)]);
+    refused(
+        &csv_args(s(&csv), s(&report), &["--force"]),
+        &["holds the output of `gyrodrift report`, not of `import`"],
+    );
+}
+
 // --- writers validate with the reader's rules ---------------------------------------------------
 
 const CSV: &str = "segment_id,t_s,gx,gy,gz,temp\n0,0.000,0.1,0.2,0.3,30.0\n0,0.001,0.1,0.2,0.3,30.0\n0,0.002,0.1,0.2,0.3,30.0\n";
@@ -390,6 +595,108 @@ fn csv_args<'a>(csv: &'a str, out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     ];
     args.extend_from_slice(extra);
     args
+}
+
+/// A CSV of `rows` rows at `rate` rows per second, time in seconds.
+fn csv_at(path: &Path, rows: usize, rate: f64) {
+    let mut text = String::from("segment_id,t_s,gx,gy,gz,temp\n");
+    for i in 0..rows {
+        text.push_str(&format!("0,{:.6},0.1,0.2,0.3,30.0\n", i as f64 / rate));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn import_csv_refuses_made_up_samples_and_unused_rows_unless_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("seconds.csv");
+    csv_at(&csv, 2000, 1000.0);
+    let out = dir.path().join("a.mcap");
+    let resample = ["--timing", "resample"];
+    // Seconds read as milliseconds: 2000 rows would become 2 samples.
+    let mut args = csv_args(s(&csv), s(&out), &resample);
+    args.extend(["--time-unit", "ms"]);
+    refused(
+        &args,
+        &[
+            "seconds.csv: 2000 rows became 2 samples at 1000 Hz",
+            "give `--time-unit s`",
+            "`--downsample`",
+        ],
+    );
+    assert!(!out.exists());
+    common::ok(&csv_args(s(&csv), s(&out), &resample));
+    // 100 Hz rows on a 1000 Hz grid: 90 % of the samples made up.
+    let slow = dir.path().join("slow.csv");
+    csv_at(&slow, 200, 100.0);
+    let out = dir.path().join("b.mcap");
+    refused(
+        &csv_args(s(&slow), s(&out), &resample),
+        &[
+            "slow.csv: 200 rows became 1991 samples at 1000 Hz",
+            "90 % of the samples would be made up",
+            "give `--rate-hz 100`, or `--upsample`",
+        ],
+    );
+    let mut args = csv_args(s(&slow), s(&out), &resample);
+    args.push("--upsample");
+    common::ok(&args);
+    let at_100 = dir.path().join("c.mcap");
+    let mut args = csv_args(s(&slow), s(&at_100), &resample);
+    args.extend(["--rate-hz", "100"]);
+    common::ok(&args);
+}
+
+#[test]
+fn a_truncated_ulog_is_refused_unless_asked() {
+    let real = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/formats/px4-ulog/sample_log_small.ulg");
+    let Ok(bytes) = std::fs::read(&real) else {
+        println!("skipped: the PX4 fixture is absent");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    let grid = ["--rate-hz", "1", "--max-gap", "1.5"];
+    let mut args = vec!["import", "ulog", s(&real), "-o", s(&whole)];
+    args.extend(grid);
+    common::ok(&args);
+    let cut = dir.path().join("cut.ulg");
+    std::fs::write(&cut, &bytes[..bytes.len() * 9 / 10 + 1]).unwrap();
+    let out = dir.path().join("imported");
+    let mut args = vec!["import", "ulog", s(&cut), "-o", s(&out)];
+    args.extend(grid);
+    refused(
+        &args,
+        &[
+            "cut.ulg: the log ends inside a message at byte",
+            "the file is truncated",
+            "`--truncated` to import the complete messages before the cut",
+        ],
+    );
+    assert!(!out.exists());
+    // Logged at 1 Hz: the default 100 Hz grid would make up 99 % of its samples.
+    let at_100 = dir.path().join("at-100");
+    refused(
+        &[
+            "import",
+            "ulog",
+            s(&real),
+            "-o",
+            s(&at_100),
+            "--max-gap",
+            "1.5",
+        ],
+        &[
+            "sample_log_small.ulg: 6 `sensor_gyro` instance 0 messages became",
+            "would be made up by interpolation",
+            "give `--rate-hz 1`, or `--upsample`",
+        ],
+    );
+    assert!(!at_100.exists());
+    args.push("--truncated");
+    let text = common::ok(&args);
+    assert!(!text.contains("truncated"), "{text}");
 }
 
 #[test]
@@ -537,12 +844,15 @@ fn table_json_with_an_unknown_field_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let tables = dir.path().join("tables");
     common::ok(&["fit", s(campaign()), "-q", "-o", s(&tables)]);
-    for name in ["modified", "standard"] {
+    for name in ["modified", "standard", "relative"] {
         let path = tables.join(format!("GIU-01/{name}.json"));
         let text = std::fs::read_to_string(&path).unwrap();
         let misspelt = text.replacen('{', "{\"setings\": {},", 1);
         let error = match name {
             "modified" => serde_json::from_str::<drift_core::ModifiedTables>(&misspelt)
+                .map(|_| ())
+                .unwrap_err(),
+            "relative" => serde_json::from_str::<drift_core::RelativePolynomialTables>(&misspelt)
                 .map(|_| ())
                 .unwrap_err(),
             _ => serde_json::from_str::<drift_core::PolynomialTables>(&misspelt)
@@ -602,6 +912,32 @@ fn simulate_refuses_a_campaign_too_large_with_its_estimate() {
         &["simulate", "-q", "-o", s(&out), "--units", "100000"],
         &["would write about", "TB", "above --max-gb 20"],
     );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_campaign_too_large_is_sized_before_it_is_planned() {
+    // Under a 1 GB address-space limit, planning 100 000 units' schedules would abort the
+    // process in the allocator; sized from its first units, it is refused with its size.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c");
+    let started = std::time::Instant::now();
+    let run = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 1000000 && exec '{}' simulate -q -o '{}' --units 100000",
+            env!("CARGO_BIN_EXE_gyrodrift"),
+            s(&out)
+        ))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("would write about") && text.contains("TB (about"),
+        "{text}"
+    );
+    assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
     assert!(!out.exists());
 }
 

@@ -1,58 +1,40 @@
-//! Where an import writes: a new campaign folder, made in a temporary folder beside it and renamed
-//! at the end, so a failed import leaves nothing.
+//! Where an import writes: a campaign folder, made in a staging folder beside it and put in place
+//! at the end, so a failed import leaves nothing and an earlier import stays whole.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::Context;
+use drift_recording::output_folder::{Owned, Writer};
 use drift_recording::{write_recording, RECORDINGS_DIR};
 
-/// The temporary folder beside `out` that becomes `out`.
-fn staging(out: &Path) -> PathBuf {
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "campaign".into());
-    out.with_file_name(format!(".{name}.importing-{}", std::process::id()))
-}
+/// `import` as a writer of output folders: every format's import is a campaign folder.
+pub const WRITER: Writer = Writer {
+    command: "import",
+    product: "import",
+    doing: "importing",
+    owned: Owned::Marker,
+};
 
-/// Refuses an output that exists and is not an empty folder: an import writes a new folder.
-pub fn refuse_existing(out: &Path) -> anyhow::Result<()> {
-    if out.exists()
-        && std::fs::read_dir(out)
-            .map(|mut d| d.next().is_some())
-            .unwrap_or(true)
-    {
-        anyhow::bail!(
-            "{}: exists and is not an empty folder (an import writes a new campaign folder)",
-            out.display()
-        );
-    }
+/// Refuses an output folder that holds anything but an earlier import, and an earlier import
+/// unless `force`: checked before any reading, so a long import is not refused at its end.
+pub fn refuse_existing(out: &Path, force: bool) -> anyhow::Result<()> {
+    drift_recording::output_folder::check(out, force, "--force", &WRITER)?;
     Ok(())
 }
 
 /// Writes `recordings` (file stem, recording) and `import.json` (`manifest` with the recordings
-/// listed) into a temporary folder beside `out`, renamed to `out` at the end; on any error the
-/// temporary folder is removed and `out` is not made. Returns a line per recording.
+/// listed) into a staging folder beside `out` that replaces `out` at the end (an earlier import
+/// there only if `force`); on any error `out` stays as it was. Returns a line per recording.
 pub fn write_campaign(
     out: &Path,
+    force: bool,
     recordings: &[(String, drift_recording::Recording)],
     manifest: &serde_json::Value,
 ) -> anyhow::Result<Vec<String>> {
-    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent)
-            .with_context(|| format!("creating {}", parent.display()))?;
-    }
-    let stage = staging(out);
-    let result = write_all(&stage, recordings, manifest).and_then(|lines| {
-        std::fs::rename(&stage, out)
-            .with_context(|| format!("renaming {} to {}", stage.display(), out.display()))?;
-        Ok(lines)
-    });
-    if result.is_err() {
-        // Best effort: the folder may not even exist.
-        let _ = std::fs::remove_dir_all(&stage);
-    }
-    result
+    let staged = super::interrupt::stage(out, force, &WRITER)?;
+    let lines = write_all(staged.path(), recordings, manifest)?;
+    staged.commit()?;
+    Ok(lines)
 }
 
 fn write_all(

@@ -15,6 +15,7 @@ use drift_evaluate::check::{AxisVerdict, CheckedActivation, Limits, UnitCheck};
 use drift_evaluate::pipeline;
 use drift_evaluate::tables_folder::{self, StoredModel, TablesError};
 use drift_fit::FitSettings;
+use drift_recording::output_folder::{Owned, Writer};
 use drift_recording::read_recording;
 
 use super::campaign_args::load_settings;
@@ -85,10 +86,21 @@ pub struct Args {
     /// Output folder for `check.md` and `check.json`.
     #[arg(long, short = 'o', default_value = "out/check")]
     pub out: PathBuf,
+    /// Replace an earlier `gyrodrift check` output in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// No progress bars.
     #[arg(long, short = 'q')]
     pub quiet: bool,
 }
+
+/// `check` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "check",
+    product: "check report",
+    doing: "checking",
+    owned: Owned::Marker,
+};
 
 /// One unit's result.
 #[derive(Debug, serde::Serialize)]
@@ -218,6 +230,16 @@ fn markdown(results: &[UnitResult], limits: &Limits) -> String {
     md
 }
 
+/// What a check on the tables' own calibration recordings means, if any of `files` is one.
+fn in_sample_note(in_sample: &[(PathBuf, String)], files: usize) -> Option<String> {
+    let (first, name) = in_sample.first()?;
+    Some(format!(
+        "{} of {files} recordings checked are calibration data these tables were fitted on ({} is {name}): on them the check measures how well the tables fit their own data, not whether the calibration still holds; check on recordings made after the calibration",
+        in_sample.len(),
+        first.display()
+    ))
+}
+
 /// Runs `gyrodrift check`; fails with `LimitsMissed` (exit status 1) when any unit × axis
 /// misses a limit, after writing the report; any other error (no tables, unreadable recordings,
 /// bad limits) exits with status 2.
@@ -237,6 +259,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let files = pipeline::recording_files(&args.recordings)?;
     let settings = load_settings(args.settings.as_deref())?;
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let steps = Steps::new(args.quiet);
     let results = match args.model {
         Stored::Modified | Stored::ByHistory => {
@@ -253,14 +276,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     };
     steps.finish();
-    let md = markdown(&results, &limits);
+    let in_sample = super::in_sample::shared(&args.tables, &files)?;
+    let mut md = markdown(&results, &limits);
+    let note = in_sample_note(&in_sample, files.len());
+    if let Some(note) = &note {
+        md.push_str(&format!("\n**In-sample.** {note}\n"));
+    }
     let json = serde_json::to_string_pretty(&serde_json::json!({
         "limits": limits,
         "units": results,
+        "in_sample_recordings": in_sample.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     }))?;
-    write_atomic(&args.out.join("check.json"), json.as_bytes())?;
-    write_atomic(&args.out.join("check.md"), md.as_bytes())?;
+    write_atomic(&staged.path().join("check.json"), json.as_bytes())?;
+    write_atomic(&staged.path().join("check.md"), md.as_bytes())?;
+    staged.commit()?;
     print!("{}", table(&results));
+    if let Some(note) = &note {
+        println!("in-sample: {note}");
+    }
     println!("report: {}", args.out.join("check.md").display());
     let failed: Vec<String> = results
         .iter()

@@ -13,6 +13,7 @@ use drift_sim::{Campaign, Field, Protocol, UnitModel};
 use super::progress::Steps;
 use super::report::{make, print_headline};
 use drift_evaluate::pipeline::Options;
+use drift_recording::output_folder::{Owned, Writer};
 
 /// Options of `gyrodrift demo`.
 #[derive(Debug, clap::Args)]
@@ -26,7 +27,18 @@ pub struct Args {
     /// No progress bars.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+    /// Replace an earlier `gyrodrift demo` output in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
 }
+
+/// `demo` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "demo",
+    product: "demo",
+    doing: "writing the demo",
+    owned: Owned::Marker,
+};
 
 /// The demo's campaigns: the paper's, with field sessions; and a small zero-drift one.
 pub fn campaigns(seed: u64) -> (Campaign, Campaign) {
@@ -56,30 +68,33 @@ pub fn campaigns(seed: u64) -> (Campaign, Campaign) {
 /// Runs the demo.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
+    // Everything is written into a staging folder and put in place at the end: an interrupted or
+    // failed demo leaves an earlier demo's campaigns and report as they were.
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let (paper, noise) = campaigns(args.seed);
     let bytes: f64 = [&paper, &noise]
         .iter()
-        .map(|c| super::simulate::estimate_bytes(c, drift_sim::simulate::total_samples(c)))
+        .map(|c| drift_sim::size::estimate_bytes(c, drift_sim::simulate::total_samples(c)))
         .sum();
     if !args.quiet {
         // Disk use, stated before the large writes start.
         eprintln!(
             "demo: simulating two campaigns, about {} of recordings and truth → {}",
-            super::simulate::gigabytes(bytes / 1e9),
+            drift_sim::size::gigabytes(bytes / 1e9),
             args.out.display()
         );
     }
     let steps = Steps::new(args.quiet);
     let mut simulated = Vec::new();
     for (campaign, folder) in [(&paper, "campaign"), (&noise, "noise-floor")] {
-        let dir = args.out.join(folder);
+        let dir = staged.path().join(folder);
         let step = format!("simulating `{}`", campaign.name);
         let total = drift_sim::simulate::total_samples(campaign);
         let summary = drift_sim::simulate_campaign(campaign, &dir, |p| {
             steps.update(&step, p.samples_done, total)
         })
         .with_context(|| format!("simulating into {}", dir.display()))?;
-        simulated.push((campaign.name.clone(), dir, summary));
+        simulated.push((campaign.name.clone(), args.out.join(folder), summary));
     }
     steps.finish();
     let options = Options::default();
@@ -96,15 +111,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             dir.display()
         ));
     }
-    let report_dir = args.out.join("report");
-    let (path, outcome) = make(
-        &args.out.join("campaign"),
-        Some(&args.out.join("noise-floor")),
+    let (_, outcome) = make(
+        &staged.path().join("campaign"),
+        Some(&staged.path().join("noise-floor")),
         &options,
-        &report_dir,
+        &staged.path().join("report"),
         provenance,
         args.quiet,
     )?;
+    staged.commit()?;
+    let report_dir = args.out.join("report");
+    let path = report_dir.join("report.md");
     println!();
     print_headline(&outcome);
     println!("tables:  {}", report_dir.join("tables").display());

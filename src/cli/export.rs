@@ -12,7 +12,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
+use drift_recording::output_folder::{Owned, Writer};
 use drift_recording::read_recording;
 use drift_recording::ros2::{write_ros2_bag, write_ros2_bag_folder, ExportSource, ExportTopics};
 
@@ -45,6 +45,9 @@ pub struct Ros2Args {
     /// per activation (`activation-001/` with `metadata.yaml` and `activation-001_0.mcap`, ...).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
+    /// Replace an earlier `gyrodrift export` output in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// The `sensor_msgs/msg/Imu` topic.
     #[arg(long, default_value = "/imu/data")]
     pub gyro_topic: String,
@@ -53,6 +56,14 @@ pub struct Ros2Args {
     #[arg(long, default_value = "/imu/temperature")]
     pub temperature_topic: String,
 }
+
+/// `export` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "export",
+    product: "export",
+    doing: "exporting",
+    owned: Owned::Marker,
+};
 
 /// Runs `gyrodrift export`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -101,18 +112,10 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    super::campaign_out::refuse_existing(&args.out)?;
-    let stage = staging(&args.out);
-    let written = write_folder(&stage, &recording.segments, source, &topics).and_then(|n| {
-        std::fs::rename(&stage, &args.out)
-            .with_context(|| format!("renaming {} to {}", stage.display(), args.out.display()))?;
-        Ok(n)
-    });
-    if written.is_err() {
-        // Best effort: the folder may not even exist.
-        let _ = std::fs::remove_dir_all(&stage);
-    }
-    let bytes = written?;
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
+    let written = write_folder(staged.path(), &recording.segments, source, &topics)?;
+    staged.commit()?;
+    let bytes = written;
     println!(
         "{}: {} activations, {samples} samples → {} bags in {} ({bytes} bytes)",
         args.recording.display(),
@@ -123,26 +126,12 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The temporary folder beside `out` that becomes `out`.
-fn staging(out: &Path) -> PathBuf {
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "bags".into());
-    out.with_file_name(format!(".{name}.exporting-{}", std::process::id()))
-}
-
 fn write_folder(
     folder: &Path,
     segments: &[drift_recording::Segment],
     source: ExportSource<'_>,
     topics: &ExportTopics,
 ) -> anyhow::Result<u64> {
-    if let Some(parent) = folder.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent)
-            .with_context(|| format!("creating {}", parent.display()))?;
-    }
-    std::fs::create_dir(folder).with_context(|| format!("creating {}", folder.display()))?;
     let mut bytes = 0;
     for (k, segment) in segments.iter().enumerate() {
         let path = folder.join(format!("activation-{:03}", k + 1));

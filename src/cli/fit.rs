@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
 use drift_evaluate::pipeline;
+use drift_recording::output_folder::{Owned, Writer};
 
 /// Options of `gyrodrift fit`.
 #[derive(Debug, clap::Args)]
@@ -15,17 +16,31 @@ pub struct Args {
     /// Output folder: one subfolder per unit.
     #[arg(long, short = 'o', default_value = "out/tables")]
     pub out: PathBuf,
+    /// Replace an earlier `gyrodrift fit` output in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
 }
+
+/// `fit` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "fit",
+    product: "tables folder",
+    doing: "fitting",
+    owned: Owned::Marker,
+};
 
 /// Runs `gyrodrift fit`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let files = pipeline::recording_files(args.input.source())?;
     let options = args.input.options(&[], false)?;
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let steps = Steps::new(args.input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
         .map_err(|e| super::measured::explain(e, &files))?;
     steps.finish();
-    drift_evaluate::tables_folder::write(&args.out, &outcome.fitted)?;
+    drift_evaluate::tables_folder::write(staged.path(), &outcome.fitted)?;
+    super::in_sample::write(staged.path(), &files, &options)?;
+    staged.commit()?;
     let seconds = |step: &str| {
         outcome
             .timings

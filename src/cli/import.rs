@@ -12,6 +12,7 @@ use drift_recording::{read_csv, write_recording, CsvOptions, SeriesKind, RECORDI
 
 use drift_report::write_atomic;
 
+use super::campaign_out::WRITER;
 use super::reading::ReadingArgs;
 
 /// Options of `gyrodrift import`.
@@ -44,9 +45,12 @@ pub struct CsvArgs {
     /// The CSV file.
     pub file: PathBuf,
     /// Output: a `.mcap` file, or a campaign folder (gets `recordings/<unit>_<stem>.mcap` and
-    /// `import.json`).
+    /// `import.json`; it must not exist or be empty, or hold an earlier import and `--force`).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
+    /// Replace an earlier import in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// Column mapping, units and timing.
     #[command(flatten)]
     pub reading: ReadingArgs,
@@ -69,6 +73,12 @@ pub struct CsvArgs {
     /// Series kind of every activation: `protocol` or `field`.
     #[arg(long, default_value = "protocol")]
     pub series_kind: String,
+    /// With `--timing resample`: interpolate onto a grid faster than the rows come.
+    #[arg(long)]
+    pub upsample: bool,
+    /// With `--timing resample`: keep a grid much slower than the rows, leaving most rows unused.
+    #[arg(long)]
+    pub downsample: bool,
 }
 
 impl CsvArgs {
@@ -134,11 +144,31 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 fn run_csv(args: &CsvArgs) -> anyhow::Result<()> {
     let options = args.options()?;
+    let (mcap, manifest) = destination(&args.out, &args.unit_id, &args.file);
+    if manifest.is_some() {
+        super::campaign_out::refuse_existing(&args.out, args.force)?;
+    }
     // Read and validate everything first: an error leaves the output untouched.
     let recording = read_csv(&args.file, &options)?;
-    let (mcap, manifest) = destination(&args.out, &args.unit_id, &args.file);
     let samples: usize = recording.segments.iter().map(|s| s.len()).sum();
     let fs = f64::from(recording.sample_rate_hz);
+    let rows: usize = recording
+        .metadata
+        .get("csv_rows")
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(samples);
+    super::row_use::refuse_made_up_or_dropped(
+        &args.file,
+        super::row_use::RowUse {
+            rows,
+            what: "rows",
+            samples,
+            rate_hz: recording.sample_rate_hz,
+            time_unit: Some(&args.reading.time_unit),
+        },
+        args.upsample,
+        args.downsample,
+    )?;
     let activations: Vec<serde_json::Value> = recording
         .segments
         .iter()
@@ -162,10 +192,21 @@ fn run_csv(args: &CsvArgs) -> anyhow::Result<()> {
         "activations": activations,
     });
     let manifest_bytes = serde_json::to_string_pretty(&manifest_json)?;
-    let bytes = write_recording(&recording, &mcap)?;
-    if let Some(path) = &manifest {
-        write_atomic(path, manifest_bytes.as_bytes())?;
-    }
+    let bytes = match &manifest {
+        None => write_recording(&recording, &mcap)?,
+        Some(_) => {
+            // A campaign folder is written whole, as every import's is: never added to.
+            let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
+            let (staged_mcap, staged_manifest) =
+                destination(staged.path(), &args.unit_id, &args.file);
+            let bytes = write_recording(&recording, &staged_mcap)?;
+            if let Some(path) = &staged_manifest {
+                write_atomic(path, manifest_bytes.as_bytes())?;
+            }
+            staged.commit()?;
+            bytes
+        }
+    };
     let meta = |key: &str| recording.metadata.get(key).cloned().unwrap_or_default();
     println!(
         "{}: {} rows → {} activations, {samples} samples at {} Hz ({:.1} s); longest step between rows {} s, {} steps over two periods ({} s); {bytes} bytes → {}",

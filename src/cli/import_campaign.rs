@@ -21,10 +21,13 @@ pub struct CampaignArgs {
     /// `activation`, `off_before_s`, `series_kind`, `switch_on_s`; optional `interval_min`,
     /// `switch_on_ambient_celsius`). Its `file` cells are relative to its folder.
     pub sheet: PathBuf,
-    /// Output: a new campaign folder (`recordings/<unit>_sp<set point>C_<kind>.mcap`,
-    /// `import.json`); it must not exist or be empty.
+    /// Output: a campaign folder (`recordings/<unit>_sp<set point>C_<kind>.mcap`,
+    /// `import.json`); it must not exist or be empty, or hold an earlier import and `--force`.
     #[arg(long, short = 'o')]
     pub out: PathBuf,
+    /// Replace an earlier import in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// Column mapping, units and timing of every activation file.
     #[command(flatten)]
     pub reading: ReadingArgs,
@@ -36,7 +39,7 @@ pub struct CampaignArgs {
 /// Runs `gyrodrift import campaign`.
 pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
     let options = args.reading.options()?;
-    super::campaign_out::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out, args.force)?;
     let clock = args.logs.clock()?;
     let max_gap = args.reading.max_gap;
     let recordings = read_sheet_campaign_with(&args.sheet, &options, &|path, csv| {
@@ -49,7 +52,8 @@ pub fn run(args: &CampaignArgs) -> anyhow::Result<()> {
         "sample_rate_hz": args.reading.rate_hz,
         "timing": args.reading.timing,
     });
-    let mut lines = super::campaign_out::write_campaign(&args.out, &recordings, &manifest)?;
+    let mut lines =
+        super::campaign_out::write_campaign(&args.out, args.force, &recordings, &manifest)?;
     lines.push(format!(
         "{}: {} recordings → {}",
         args.sheet.display(),

@@ -30,6 +30,9 @@ pub struct RosbagArgs {
     /// Output: a new campaign folder (`recordings/<unit>.mcap`, `import.json`).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
+    /// Replace an earlier import in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// The `sensor_msgs/msg/Imu` topic: `angular_velocity`, rad/s.
     #[arg(long, default_value = "/imu/data")]
     pub gyro_topic: String,
@@ -291,7 +294,7 @@ pub fn run(args: &RosbagArgs) -> anyhow::Result<()> {
             "option `--rate-hz`: must divide 10⁹, got {rate}"
         );
     }
-    super::campaign_out::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out, args.force)?;
     let topics = BagTopics {
         gyro: args.gyro_topic.clone(),
         temperature: args.temperature_topic.clone(),
@@ -440,7 +443,12 @@ pub fn run(args: &RosbagArgs) -> anyhow::Result<()> {
         },
         "bags": listed,
     });
-    let lines = super::campaign_out::write_campaign(&args.out, &[(stem, recording)], &manifest)?;
+    let lines = super::campaign_out::write_campaign(
+        &args.out,
+        args.force,
+        &[(stem, recording)],
+        &manifest,
+    )?;
     for line in lines {
         println!("{line}");
     }

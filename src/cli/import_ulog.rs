@@ -30,6 +30,15 @@ pub struct UlogArgs {
     /// Output: a new campaign folder (`recordings/<unit>.mcap`, `import.json`).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
+    /// Replace an earlier import in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
+    /// Import a log the file's end cuts inside a message (its complete messages before the cut).
+    #[arg(long)]
+    pub truncated: bool,
+    /// Interpolate onto a grid faster than the gyro messages come.
+    #[arg(long)]
+    pub upsample: bool,
     /// Sample rate of the recording's grid, Hz (must divide 10⁹).
     #[arg(long, default_value_t = 100)]
     pub rate_hz: u32,
@@ -166,6 +175,19 @@ pub(super) fn log_options(
     }
 }
 
+/// Refuses a log whose end cuts a message (the logger stopped midway, or the copy is short)
+/// unless `accept`: its time span would silently end early.
+pub fn refuse_cut(log: &Ulog, accept: bool) -> anyhow::Result<()> {
+    if let (Some(cut), false) = (log.cut_at, accept) {
+        let length = std::fs::metadata(&log.path).map_or(0, |m| m.len());
+        anyhow::bail!(
+            "{}: the log ends inside a message at byte {cut} of {length}: the file is truncated (the logger stopped midway, or the copy is short) and whatever followed is missing; give the whole log, or `--truncated` to import the complete messages before the cut",
+            log.path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Runs `gyrodrift import ulog`.
 pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
     let kind = SeriesKind::parse(&args.series_kind).with_context(|| {
@@ -175,12 +197,13 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         )
     })?;
     let options = log_options(args.rate_hz, args.max_gap, args.set_point, kind);
-    super::campaign_out::refuse_existing(&args.out)?;
+    super::campaign_out::refuse_existing(&args.out, args.force)?;
     let files = logs(&args.path)?;
     let mut units: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
     let mut read = Vec::new();
     for (k, file) in files.iter().enumerate() {
         let log = read_ulog(file)?;
+        refuse_cut(&log, args.truncated)?;
         let topics = gyros(&log);
         anyhow::ensure!(
             !topics.is_empty(),
@@ -191,6 +214,19 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         for (suffix, topic, rates, temperature) in topics {
             let unit = format!("{}-{suffix}", args.unit_id);
             let mut segment = activation(&log, topic, rates, temperature, &options)?;
+            let what = format!("`{}` instance {} messages", topic.name, topic.instance);
+            super::row_use::refuse_made_up_or_dropped(
+                file,
+                super::row_use::RowUse {
+                    rows: topic.len(),
+                    what: &what,
+                    samples: segment.len(),
+                    rate_hz: args.rate_hz,
+                    time_unit: None,
+                },
+                args.upsample,
+                true,
+            )?;
             segment.labels.unit_id = unit.clone();
             segment.labels.series = 1;
             segment.labels.activation = u32::try_from(k + 1).unwrap_or(u32::MAX);
@@ -246,7 +282,7 @@ pub fn run(args: &UlogArgs) -> anyhow::Result<()> {
         "off_times": "unknown: ULog headers carry boot time, not wall-clock time",
         "logs": read,
     });
-    let lines = super::campaign_out::write_campaign(&args.out, &recordings, &manifest)?;
+    let lines = super::campaign_out::write_campaign(&args.out, args.force, &recordings, &manifest)?;
     for line in lines {
         println!("{line}");
     }

@@ -2,7 +2,9 @@
 //! when whole, and a campaign folder is vouched for by a completion marker written last, so an
 //! interrupted command leaves nothing a reader accepts; this also removes the half-written
 //! temporaries themselves. A command registers the folders it writes into; on SIGINT (or SIGTERM)
-//! this process's temporaries there are deleted and the process exits with status 130.
+//! this process's temporaries there are deleted and the process exits with status 130. An output
+//! written whole into a staging folder ([`stage`]) loses only that folder: the earlier output
+//! stays as it was.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -12,6 +14,23 @@ pub const INTERRUPTED: i32 = 130;
 
 /// Folders a running command writes into.
 static FOLDERS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Staging folders of outputs not yet in place: removed whole on an interruption.
+static STAGES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Begins writing `writer`'s output for `out` in a staging folder
+/// ([`drift_recording::output_folder::Staged`]) that an interruption removes whole.
+pub fn stage(
+    out: &Path,
+    force: bool,
+    writer: &drift_recording::output_folder::Writer,
+) -> Result<drift_recording::output_folder::Staged, drift_recording::output_folder::FolderError> {
+    let staged = drift_recording::output_folder::Staged::begin(out, force, "--force", writer)?;
+    if let Ok(mut stages) = STAGES.lock() {
+        stages.push(staged.path().to_path_buf());
+    }
+    Ok(staged)
+}
 
 /// Installs the handler (once per process; a second call is a no-op error, ignored).
 pub fn install() {
@@ -28,6 +47,24 @@ pub fn watch(folder: &Path) {
 }
 
 fn on_interrupt() {
+    let stages = STAGES.lock().map(|f| f.clone()).unwrap_or_default();
+    for stage in &stages {
+        // Renamed first: the command may still be writing into it while this runs.
+        let doomed = stage.with_extension("discarded");
+        let gone =
+            std::fs::rename(stage, &doomed).is_ok() && std::fs::remove_dir_all(&doomed).is_ok();
+        // A writer that recreated the folder meanwhile leaves at most what it wrote since.
+        let _ = std::fs::remove_dir_all(stage);
+        if gone {
+            eprintln!(
+                "interrupted: removed the unfinished output {}; an earlier output stays as it was",
+                stage.display()
+            );
+        }
+    }
+    if !stages.is_empty() && FOLDERS.lock().map(|f| f.is_empty()).unwrap_or(true) {
+        std::process::exit(INTERRUPTED);
+    }
     let folders = FOLDERS.lock().map(|f| f.clone()).unwrap_or_default();
     let pid = std::process::id();
     let mut removed = 0;

@@ -8,6 +8,7 @@ use super::progress::Steps;
 use super::shared_data::refuse_shared;
 use drift_evaluate::pipeline::PipelineError;
 use drift_evaluate::pipeline::{self, Options, Outcome};
+use drift_recording::output_folder::{Owned, Writer};
 use drift_recording::paper;
 use drift_report::measured::write_measured_report;
 
@@ -39,7 +40,18 @@ pub struct Args {
     /// Output folder for the report, its figures and the fitted tables.
     #[arg(long, short = 'o', default_value = "out/report")]
     pub out: PathBuf,
+    /// Replace an earlier `gyrodrift report` output in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
 }
+
+/// `report` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "report",
+    product: "report",
+    doing: "reporting",
+    owned: Owned::Marker,
+};
 
 /// Fits, evaluates and writes the report ([`drift_report::make`]) with progress bars; returns the
 /// report's path and the main outcome.
@@ -70,13 +82,21 @@ pub fn make(
         &|s, d, t| steps.update(s, d, t),
     );
     steps.finish();
-    made
+    let made = made?;
+    super::in_sample::write(&out.join("tables"), &files, options)?;
+    Ok(made)
 }
 
 /// Why a noise floor must be other recordings than the data it is set beside.
 const NOISE_FLOOR_APART: &str = "the noise floor is a zero-drift twin recorded like the data \
      (`gyrodrift simulate --zero-drift`, or a unit without a temperature effect), never the data \
      itself; give such a campaign as --noise-floor, or leave the flag out";
+
+/// Where `path`, written into a staging folder, is once the folder is in place as `out`.
+pub fn in_target(out: &Path, path: &Path) -> PathBuf {
+    path.file_name()
+        .map_or_else(|| out.to_owned(), |name| out.join(name))
+}
 
 /// Prints the headline table of a finished report.
 pub fn print_headline(outcome: &Outcome) {
@@ -91,18 +111,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         return run_separate(args, evaluation, &options);
     }
     let provenance = drift_report::provenance(&input.source().display().to_string(), &options);
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let made = make(
         input.source(),
         args.noise_floor.as_deref(),
         &options,
-        &args.out,
+        staged.path(),
         provenance.clone(),
         input.quiet,
     );
     let error = match made {
         Ok((path, outcome)) => {
+            staged.commit()?;
             print_headline(&outcome);
-            println!("report: {}", path.display());
+            println!("report: {}", in_target(&args.out, &path).display());
             return Ok(());
         }
         Err(error) => error,
@@ -123,7 +145,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         println!("{unit}");
     }
     let units = measured::characterise_files(&files)?;
-    let path = write_measured_report(&args.out, &units, &provenance, &error.to_string())?;
+    let path = write_measured_report(staged.path(), &units, &provenance, &error.to_string())?;
+    staged.commit()?;
+    let path = in_target(&args.out, &path);
     for c in &units {
         for axis in &c.axes {
             let correction = axis.correction.map_or(String::new(), |r| {
@@ -159,6 +183,7 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
         options.calibration_set_points,
         evaluation.display()
     )];
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let steps = Steps::new(input.quiet);
     let calibration = pipeline::recording_files(input.source())?;
     let evaluated = pipeline::recording_files(evaluation)?;
@@ -186,13 +211,15 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
         &evaluated,
         noise_files.as_deref(),
         options,
-        &args.out,
+        staged.path(),
         provenance,
         &|s, d, t| steps.update(s, d, t),
     );
     steps.finish();
     let (path, outcome) = made?;
+    super::in_sample::write(&staged.path().join("tables"), &calibration, options)?;
+    staged.commit()?;
     print_headline(&outcome);
-    println!("report: {}", path.display());
+    println!("report: {}", in_target(&args.out, &path).display());
     Ok(())
 }

@@ -30,6 +30,9 @@ pub struct LogArgs {
     /// Bags: interpolate onto a grid faster than the gyro messages come.
     #[arg(long)]
     pub upsample: bool,
+    /// ULog files: import a log the file's end cuts inside a message.
+    #[arg(long)]
+    pub truncated: bool,
     /// ULog files with several gyros: the `sensor_gyro` instance to read.
     #[arg(long)]
     pub ulog_instance: Option<u8>,
@@ -110,6 +113,7 @@ impl LogArgs {
 
     fn read_ulog(&self, path: &Path, options: &CsvOptions) -> anyhow::Result<Segment> {
         let log = read_ulog(path)?;
+        super::import_ulog::refuse_cut(&log, self.truncated)?;
         let gyros = super::import_ulog::gyros(&log);
         let chosen: Vec<_> = gyros
             .iter()

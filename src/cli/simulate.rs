@@ -1,21 +1,10 @@
 //! `gyrodrift simulate`: record a simulated calibration campaign as a folder of MCAP files.
 
 use anyhow::{bail, Context};
-use drift_sim::campaign::TruthBias;
 use drift_sim::overrides::{parse_set_points, Overrides};
+use drift_sim::size;
 use drift_sim::Campaign;
 use std::path::PathBuf;
-
-/// A size in GB or TB, three significant digits.
-pub(crate) fn gigabytes(gb: f64) -> String {
-    if gb >= 1000.0 {
-        format!("{:.3} TB", gb / 1000.0)
-    } else if gb >= 1.0 {
-        format!("{gb:.2} GB")
-    } else {
-        format!("{:.0} MB", gb * 1000.0)
-    }
-}
 
 /// Options of `gyrodrift simulate`. Flags override the campaign file; without a file the
 /// paper's campaign is used (2 units; +30, +40, +33 °C; intervals 1…30 min; 3 repeats).
@@ -70,23 +59,11 @@ pub struct Args {
     #[arg(long)]
     pub force: bool,
     /// Most the campaign may write, GB (estimated before anything is written).
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = size::DEFAULT_MAX_GB)]
     pub max_gb: f64,
     /// No progress bar.
     #[arg(long, short = 'q')]
     pub quiet: bool,
-}
-
-/// Bytes a campaign writes, estimated from its gyro samples: measured 11.5 B per sample of
-/// recording, 17.0 B of truth sidecar at every sample and 6.1 B at the auxiliary rate
-/// (`gyrodrift simulate --units 1 --set-points 30 --repeats 1 --seed 1`, with and without
-/// `--truth-at-aux-rate`: 48.5 MB + 71.5 or 25.6 MB for 4.2 M samples), rounded up.
-pub(crate) fn estimate_bytes(campaign: &Campaign, samples: u64) -> f64 {
-    let truth = match campaign.truth_bias {
-        TruthBias::EverySample => 17.5,
-        TruthBias::AuxRate => 6.5,
-    };
-    samples as f64 * (12.0 + truth)
 }
 
 /// The campaign these flags describe: the file's (or the built-in paper campaign) with the flags
@@ -122,28 +99,18 @@ pub fn campaign_from(args: &Args) -> anyhow::Result<Campaign> {
 /// Runs `gyrodrift simulate`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let campaign = campaign_from(args)?;
-    let total = drift_sim::simulate::total_samples(&campaign);
-    let estimate_gb = estimate_bytes(&campaign, total) / 1e9;
     if !(args.max_gb.is_finite() && args.max_gb > 0.0) {
         bail!("--max-gb must be > 0, got {}", args.max_gb);
     }
-    if estimate_gb > args.max_gb {
-        bail!(
-            "campaign `{}` would write about {} ({} samples over {} units): above --max-gb {}; simulate fewer units, set points or repeats, or raise --max-gb",
-            campaign.name,
-            gigabytes(estimate_gb),
-            total,
-            campaign.units,
-            args.max_gb
-        );
-    }
+    let total = size::within(&campaign, args.max_gb, "--max-gb")?;
+    let estimate_gb = size::estimate_bytes(&campaign, total) / 1e9;
     drift_sim::output_folder::prepare(&args.out, args.force, "--force")?;
     if !args.quiet {
         eprintln!(
             "simulating `{}`: {} samples, about {} → {}",
             campaign.name,
             total,
-            gigabytes(estimate_gb),
+            size::gigabytes(estimate_gb),
             args.out.display()
         );
     }

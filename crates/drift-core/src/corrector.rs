@@ -38,6 +38,7 @@ pub struct Output {
 /// Run-time state of one axis. Plain data: copy it to persist, restore it to resume.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct AxisState<S> {
     switch_on_raw: f32,
     initial_bias_dps: f32,
@@ -102,6 +103,7 @@ impl<S> AxisState<S> {
 /// units, and swapping tables never corrupts a state.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct CorrectorState<S> {
     axes: [AxisState<S>; AXES],
     extension: ExtensionState,

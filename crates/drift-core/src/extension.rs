@@ -259,6 +259,7 @@ impl Extension {
 /// it to persist, restore it to resume.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct ExtensionState {
     /// Per axis, the rise since switch-on through the rate filter's first-order low-pass, °C (for
     /// [`Term::TemperatureRate`]); at switch-on `−rate · τ` for the [`SwitchOnRate`] it starts

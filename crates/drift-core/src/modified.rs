@@ -25,6 +25,7 @@ use crate::AXES;
 /// one-byte indices share one word: a unit's state stays within 256 bytes (docs/embedded.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct ModifiedAxisState {
     ambient_weight: f32,
     ambient_lo: u8,

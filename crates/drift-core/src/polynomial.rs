@@ -140,6 +140,7 @@ impl Span {
 /// Per-axis run-time state of a polynomial baseline: its value at switch-on.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct PolynomialAxisState {
     at_switch_on_dps: f32,
 }
@@ -319,6 +320,7 @@ impl Model for PolynomialTables {
 /// One axis of the baseline relative to the switch-on: `bias = q(T_on) + p(T) − p(T_on)`.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct RelativePolynomialAxis {
     /// `p`: the drift since switch-on is `p(T) − p(T_on)` (its constant term cancels).
     pub drift: PolynomialAxis,
@@ -387,6 +389,7 @@ impl AxisModel for RelativePolynomialAxis {
 /// The baseline relative to the switch-on for a whole unit.
 #[derive(Clone, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct RelativePolynomialTables {
     /// Sensor conversion and envelope settings.
     pub settings: Settings,

@@ -191,13 +191,14 @@ pub fn resolve_campaign<'py>(
 
 /// Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
 /// does: a folder that is not empty is refused unless `force` (then an earlier campaign there is
-/// replaced, and anything else refused); returns the summary (files, samples, bytes, wall time) as a dict. The GIL is released.
+/// replaced, and anything else refused), and a campaign writing more than `max_gb` is refused
+/// before it is planned; returns the summary (files, samples, bytes, wall time) as a dict. The GIL is released.
 #[pyfunction]
 #[pyo3(signature = (
     out, campaign = None, *, seed = None, units = None, set_points = None, intervals = None,
     repeats = None, field = false, field_only = false, zero_drift = false, paper_exact = false,
     effects = None,
-    noise_scale = None, truth_at_aux_rate = false, force = false,
+    noise_scale = None, truth_at_aux_rate = false, force = false, max_gb = 20.0,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -217,8 +218,12 @@ pub fn simulate<'py>(
     noise_scale: Option<&Bound<'py, PyAny>>,
     truth_at_aux_rate: bool,
     force: bool,
+    max_gb: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
     let out = args::path("out", out)?;
+    if !(max_gb.is_finite() && max_gb > 0.0) {
+        return Err(Error::Input(format!("`max_gb` must be > 0, got {max_gb}")).into());
+    }
     let c = resolve(
         py,
         campaign,
@@ -236,6 +241,8 @@ pub fn simulate<'py>(
         truth_at_aux_rate,
     )?;
     let summary = py.detach(|| -> Result<_, Error> {
+        // Sized before anything is planned in full or written.
+        drift_sim::size::within(&c, max_gb, "max_gb").map_err(|e| Error::Input(e.to_string()))?;
         prepare(&out, force, "force=True").map_err(|e| match e {
             FolderError::Io {
                 action,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -103,3 +104,15 @@ def test_a_campaign_already_there_is_refused_unless_force(tmp_path: Path) -> Non
     ):
         gyrodrift.simulate(tmp_path, TINY_PROTOCOL, seed=13, force=True, **TINY)  # type: ignore[arg-type]
     assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
+def test_a_campaign_too_large_is_refused_with_its_size_before_it_is_planned(tmp_path: Path) -> None:
+    """A billion units would need tens of GB to plan: refused at once with what it would write,
+    and nothing is made."""
+    started = time.monotonic()
+    with pytest.raises(gyrodrift.InputError, match=r"would write about [0-9.]+ TB .*above max_gb 20"):
+        gyrodrift.simulate(tmp_path / "c", units=10**9)
+    assert time.monotonic() - started < 10.0
+    assert not (tmp_path / "c").exists()
+    with pytest.raises(gyrodrift.InputError, match=r"`max_gb` must be > 0, got -1"):
+        gyrodrift.simulate(tmp_path / "c", max_gb=-1.0)

@@ -19,6 +19,7 @@ mod csv_file;
 mod error;
 mod layout;
 mod messages;
+pub mod output_folder;
 pub mod paper;
 mod read;
 pub mod ros2;

@@ -162,6 +162,9 @@ pub struct Ulog {
     pub info: BTreeMap<String, String>,
     /// Every subscription, in the order of the file.
     pub topics: Vec<UlogTopic>,
+    /// Byte offset of a last message the file's end cuts (a log whose writing stopped midway):
+    /// the messages before it are read, and what followed it is missing.
+    pub cut_at: Option<usize>,
 }
 
 impl Ulog {
@@ -258,6 +261,7 @@ pub fn read_ulog_bytes(path: &Path, bytes: &[u8]) -> Result<Ulog, UlogError> {
     let mut by_id: BTreeMap<u16, usize> = BTreeMap::new();
     let mut appended: Vec<usize> = Vec::new();
     let mut pos = 16usize;
+    let mut cut_at = None;
     while pos + 3 <= bytes.len() {
         if let Some(&next) = appended.first() {
             if pos >= next || pos + 3 > next {
@@ -280,6 +284,7 @@ pub fn read_ulog_bytes(path: &Path, bytes: &[u8]) -> Result<Ulog, UlogError> {
         }
         if end > bytes.len() {
             // The last message was cut when the log ended: what came before is complete.
+            cut_at = Some(pos);
             break;
         }
         let body = &bytes[start..end];
@@ -383,10 +388,15 @@ pub fn read_ulog_bytes(path: &Path, bytes: &[u8]) -> Result<Ulog, UlogError> {
         }
         pos = end;
     }
+    if cut_at.is_none() && pos < bytes.len() && appended.is_empty() {
+        // Fewer than a message header's 3 bytes left: cut as well.
+        cut_at = Some(pos);
+    }
     Ok(Ulog {
         path: path.to_path_buf(),
         start_us,
         info,
         topics,
+        cut_at,
     })
 }

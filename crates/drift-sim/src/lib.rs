@@ -14,6 +14,7 @@ pub mod overrides;
 mod rng;
 pub mod schedule;
 pub mod simulate;
+pub mod size;
 pub mod thermal;
 pub mod truth;
 pub mod unit;
