@@ -32,6 +32,9 @@ pub struct ImageArgs {
     /// `0x08060000`, the start of the sector the firmware reads with `blob::image_len`).
     #[arg(long, value_parser = parse_address)]
     pub address: Option<u32>,
+    /// Replace an earlier export in `--out` (only an export is ever replaced).
+    #[arg(long)]
+    pub force: bool,
 }
 
 fn parse_address(text: &str) -> Result<u32, String> {
@@ -60,7 +63,13 @@ struct Entry {
 
 /// Runs `gyrodrift export image`.
 pub fn run(args: &ImageArgs) -> anyhow::Result<()> {
-    super::campaign_out::refuse_existing(&args.out)?;
+    // Refused before any reading: the one rule of every writer's output folder.
+    drift_recording::output_folder::check(
+        &args.out,
+        args.force,
+        "--force",
+        &super::export::WRITER,
+    )?;
     let model = args.model.model();
     let mut units: Vec<String> = std::fs::read_dir(&args.tables)
         .with_context(|| format!("cannot read the tables folder {}", args.tables.display()))?
@@ -99,7 +108,7 @@ pub fn run(args: &ImageArgs) -> anyhow::Result<()> {
         PathBuf::from("manifest.json"),
         serde_json::to_string_pretty(&manifest)?.into_bytes(),
     ));
-    write_folder(&args.out, &files)?;
+    write_folder(&args.out, args.force, &files)?;
     println!(
         "{} units' {} images → {} (manifest.json{})",
         units.len(),
@@ -114,31 +123,17 @@ pub fn run(args: &ImageArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Writes `files` (names in the folder) into a temporary folder beside `out`, renamed to `out` at
-/// the end: on any error `out` is not made and the temporary folder is removed.
-fn write_folder(out: &Path, files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
-    let name = out
-        .file_name()
-        .map_or_else(|| "images".into(), |n| n.to_string_lossy().into_owned());
-    let stage = out.with_file_name(format!(".{name}.exporting-{}", std::process::id()));
-    let written = (|| {
-        std::fs::create_dir_all(&stage).with_context(|| format!("creating {}", stage.display()))?;
-        let inside: Vec<_> = files
-            .iter()
-            .map(|(file, bytes)| (stage.join(file), bytes.clone()))
-            .collect();
-        tables_folder::write_files(&inside)?;
-        if out.exists() {
-            // `refuse_existing` let an empty folder through: it is replaced.
-            std::fs::remove_dir(out).with_context(|| format!("replacing {}", out.display()))?;
-        }
-        std::fs::rename(&stage, out)
-            .with_context(|| format!("renaming {} to {}", stage.display(), out.display()))
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_dir_all(&stage);
-    }
-    written
+/// Writes `files` (names in the folder) into a staging folder beside `out` that replaces it at the
+/// end (an earlier export only with `force`): on any error `out` stays as it was.
+fn write_folder(out: &Path, force: bool, files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
+    let staged = super::interrupt::stage(out, force, &super::export::WRITER)?;
+    let inside: Vec<_> = files
+        .iter()
+        .map(|(file, bytes)| (staged.path().join(file), bytes.clone()))
+        .collect();
+    tables_folder::write_files(&inside)?;
+    staged.commit()?;
+    Ok(())
 }
 
 /// Decodes `unit`'s image, stamps it with its unit if it names none, and encodes its files.
