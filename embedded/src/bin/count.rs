@@ -187,9 +187,7 @@ fn main() -> ! {
                 "interval 15: modified model, stage 3 keyed by history (by_history, power_on_after), 1000 Hz windows"
             );
             measure_after(by_history, &at_1khz, 15);
-            hprintln!(
-                "interval 17: recommended model (power_on_after), samples 1 s apart"
-            );
+            hprintln!("interval 17: recommended model (power_on_after), samples 1 s apart");
             measure_after(recommended, &samples, 17);
             hprintln!("interval 19: recommended model (power_on_after), 1000 Hz windows");
             measure_after(recommended, &at_1khz, 19);
