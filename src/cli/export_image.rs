@@ -14,8 +14,17 @@ use anyhow::{bail, Context};
 use drift_core::blob::{self, Header, Image};
 use drift_core::{ModifiedTables, PolynomialTables, RecommendedTables, RelativePolynomialTables};
 use drift_evaluate::tables_folder;
+use drift_recording::output_folder::{Owned, Writer};
 
 use super::check::Stored;
+
+/// `export image` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "export image",
+    product: "export",
+    doing: "exporting",
+    owned: Owned::Marker,
+};
 
 /// Options of `gyrodrift export image`.
 #[derive(Debug, clap::Args)]
@@ -64,12 +73,7 @@ struct Entry {
 /// Runs `gyrodrift export image`.
 pub fn run(args: &ImageArgs) -> anyhow::Result<()> {
     // Refused before any reading: the one rule of every writer's output folder.
-    drift_recording::output_folder::check(
-        &args.out,
-        args.force,
-        "--force",
-        &super::export::WRITER,
-    )?;
+    drift_recording::output_folder::check(&args.out, args.force, "--force", &WRITER)?;
     let model = args.model.model();
     let mut units: Vec<String> = std::fs::read_dir(&args.tables)
         .with_context(|| format!("cannot read the tables folder {}", args.tables.display()))?
@@ -126,7 +130,7 @@ pub fn run(args: &ImageArgs) -> anyhow::Result<()> {
 /// Writes `files` (names in the folder) into a staging folder beside `out` that replaces it at the
 /// end (an earlier export only with `force`): on any error `out` stays as it was.
 fn write_folder(out: &Path, force: bool, files: &[(PathBuf, Vec<u8>)]) -> anyhow::Result<()> {
-    let staged = super::interrupt::stage(out, force, &super::export::WRITER)?;
+    let staged = super::interrupt::stage(out, force, &WRITER)?;
     let inside: Vec<_> = files
         .iter()
         .map(|(file, bytes)| (staged.path().join(file), bytes.clone()))
