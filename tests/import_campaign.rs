@@ -199,9 +199,17 @@ fn a_campaign_exported_as_csv_files_and_a_sheet_imports_fits_and_reports_the_sam
     for (campaign, out) in [(o, "fit-original"), (i, "fit-imported")] {
         ok(&["fit", campaign, "-q", "-o", d.join(out).to_str().unwrap()]);
     }
-    let tables = files(&d.join("fit-original"));
+    // The tables, byte for byte; not `calibration-data.json`, which names each calibration
+    // recording by its bytes (an import writes other bytes for the same data).
+    let fitted = |out: &str| -> Vec<(String, Vec<u8>)> {
+        files(&d.join(out))
+            .into_iter()
+            .filter(|(n, _)| !n.ends_with("calibration-data.json"))
+            .collect()
+    };
+    let tables = fitted("fit-original");
     assert!(tables.iter().any(|(n, _)| n.ends_with("modified.bin")));
-    assert_eq!(tables, files(&d.join("fit-imported")));
+    assert_eq!(tables, fitted("fit-imported"));
     for (campaign, out) in [(o, "report-original"), (i, "report-imported")] {
         ok(&[
             "report",
