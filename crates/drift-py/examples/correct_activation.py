@@ -27,12 +27,20 @@ SECONDS = 120
 AMBIENT_CELSIUS = 33.0
 
 
-def load_models(path: Path) -> dict[str, gyrodrift.ModifiedTables | gyrodrift.PolynomialTables]:
+Model = gyrodrift.ModifiedTables | gyrodrift.PolynomialTables | gyrodrift.RecommendedTables
+
+
+def load_models(path: Path) -> dict[str, Model]:
     """The vectors' models, from their firmware images (as the firmware would receive them)."""
-    models: dict[str, gyrodrift.ModifiedTables | gyrodrift.PolynomialTables] = {}
+    models: dict[str, Model] = {}
     for named in json.loads(path.read_text())["models"]:
-        cls = gyrodrift.ModifiedTables if named["kind"] == "modified" else gyrodrift.PolynomialTables
-        models[named["name"]] = cls.from_image(bytes.fromhex(named["image_hex"]))
+        image = bytes.fromhex(named["image_hex"])
+        if named["kind"] == "modified":
+            models[named["name"]] = gyrodrift.ModifiedTables.from_image(image)
+        elif named["kind"] == "recommended":
+            models[named["name"]] = gyrodrift.RecommendedTables.from_image(image)
+        else:
+            models[named["name"]] = gyrodrift.PolynomialTables.from_image(image)
     return models
 
 

@@ -343,9 +343,7 @@ def test_power_on_rejects_wrong_length(modified: ModifiedTables) -> None:
 
 
 def test_corrector_rejects_a_non_model() -> None:
-    message = (
-        "`model` must be a gyrodrift.ModifiedTables, PolynomialTables or RelativePolynomialTables, got dict"
-    )
+    message = "`model` must be a gyrodrift.ModifiedTables, PolynomialTables, RelativePolynomialTables or RecommendedTables, got dict"
     with pytest.raises(InputError, match=re.escape(message)):
         gyrodrift.Corrector({})  # type: ignore[arg-type]
 

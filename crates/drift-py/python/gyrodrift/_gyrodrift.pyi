@@ -921,11 +921,11 @@ def simulate(
     does: the same campaign and seed give the same bytes. A folder that is not empty is refused
     (`InputError`), as the command line refuses it; `force=True` replaces a campaign there (and
     still refuses a folder holding other files). A campaign that would write more than `max_gb`
-    (GB) is refused (`InputError`, with its size) before it is planned or written. `campaign` is None (the paper's), a dict
-    or TOML/JSON text (drift_sim::Campaign's fields), or a file path (os.PathLike; JSON if it ends in
-    .json, else TOML). The keywords are the command line's flags (`set_points` also takes its text,
-    "30,40,33" or "-40:60:10"). Returns the run's summary. The GIL is released while simulating.
-    Raises `CampaignError`, `InputError` or `FileError`."""
+    (GB) is refused (`InputError`, with its size) before it is planned or written. `campaign` is
+    None (the paper's), a dict or TOML/JSON text (drift_sim::Campaign's fields), or a file path
+    (os.PathLike; JSON if it ends in .json, else TOML). The keywords are the command line's flags
+    (`set_points` also takes its text, "30,40,33" or "-40:60:10"). Returns the run's summary. The
+    GIL is released while simulating. Raises `CampaignError`, `InputError` or `FileError`."""
 
 def resolve_campaign(
     campaign: Mapping[str, Any] | str | os.PathLike[str] | None = None,
