@@ -482,13 +482,20 @@ pub fn series_folds(activations: &[ActivationSeries], folds: usize) -> (Vec<usiz
 /// differs between units or set points (a channel's level, the ambient) stays paired with the
 /// residual it came with.
 fn set_point_strata(activations: &[ActivationSeries]) -> Vec<usize> {
-    let key = |a: &ActivationSeries| {
+    index_by(activations, |a| {
         (
             a.labels.unit_id.clone(),
             (a.labels.nominal_set_point_celsius() * 1000.0).round() as i64,
         )
-    };
-    let mut keys: Vec<_> = activations.iter().map(key).collect();
+    })
+}
+
+/// Each activation's index among the distinct values of `key` over all of them, in their order.
+fn index_by<K: Ord>(
+    activations: &[ActivationSeries],
+    key: impl Fn(&ActivationSeries) -> K,
+) -> Vec<usize> {
+    let mut keys: Vec<K> = activations.iter().map(&key).collect();
     keys.sort();
     keys.dedup();
     activations
@@ -602,14 +609,9 @@ pub struct Selected {
 /// Each activation's series as an index unique within its stratum (unit, nominal set point): what
 /// the shuffles move whole.
 fn series_index(activations: &[ActivationSeries]) -> Vec<usize> {
-    let key = |a: &ActivationSeries| (a.labels.series_kind.as_str(), a.labels.series);
-    let mut keys: Vec<_> = activations.iter().map(key).collect();
-    keys.sort();
-    keys.dedup();
-    activations
-        .iter()
-        .map(|a| keys.binary_search(&key(a)).unwrap_or(0))
-        .collect()
+    index_by(activations, |a| {
+        (a.labels.series_kind.as_str(), a.labels.series)
+    })
 }
 
 /// `column` of every activation less its least-squares fit on `baseline`'s columns within
