@@ -6,8 +6,12 @@
 //! cargo run --release -p experiments --example worlds -- [--families all|humidity,…] \
 //!     [--worlds-per-family 20] [--null-worlds 30] [--first-seed 10000] [--jobs 1] \
 //!     [--out table.md] [--json scores.jsonl] [--small] [--select-on-validation] \
-//!     [--diagnosis-series 20]
+//!     [--diagnosis-series 20] [--magnitude 1]
 //! ```
+//!
+//! `--magnitude m` draws every effect at m × its realistic size (the detection curve). Each
+//! effect world's oracle (`experiments::oracle`: the true regressor scored by the same diagnosis)
+//! runs in a third child after the blind loop.
 //!
 //! `--diagnosis-series N` records, per world, an analyst's diagnosis campaign beside the
 //! calibration one (N ramped field series of 5 at +33 °C) and diagnoses on it, cross-fitted by
@@ -24,6 +28,7 @@ use std::sync::Mutex;
 
 use anyhow::Context;
 use drift_sim::world::effects::EffectFamily;
+use experiments::oracle::{close_oracle, OracleOutcome};
 use experiments::worlds::{
     close_blind, fit_settings, record, score, table, world_lines, Failure, Kind, Outcome, Recorded,
     WorldPaths, WorldScore, DEFAULT_FIRST_SEED,
@@ -31,7 +36,7 @@ use experiments::worlds::{
 
 const USAGE: &str = "worlds [--families all|accelerometer,humidity,…] [--worlds-per-family 20] \
 [--null-worlds 30] [--first-seed 10000] [--jobs 1] [--out table.md] [--json scores.jsonl] [--small] \
-[--select-on-validation] [--diagnosis-series 20]";
+[--select-on-validation] [--diagnosis-series 20] [--magnitude 1]";
 
 /// The value after `flag`.
 fn value(args: &[String], flag: &str) -> Option<String> {
@@ -77,6 +82,7 @@ fn one_world(
     small: bool,
     select: bool,
     diagnosis_series: u32,
+    magnitude: f64,
 ) -> anyhow::Result<WorldScore> {
     let paths = WorldPaths::new(work, kind, seed);
     let small_flag = if small { "yes" } else { "no" };
@@ -84,6 +90,7 @@ fn one_world(
     let seed_text = seed.to_string();
     let work_text = work.display().to_string();
     let series_text = diagnosis_series.to_string();
+    let magnitude_text = magnitude.to_string();
     let recorded: anyhow::Result<Recorded> = child(&[
         "--child-record",
         kind.name(),
@@ -91,6 +98,7 @@ fn one_world(
         &work_text,
         small_flag,
         &series_text,
+        &magnitude_text,
     ]);
     let diagnosis_text = if diagnosis_series > 0 {
         paths.diagnosis_dir.display().to_string()
@@ -108,10 +116,21 @@ fn one_world(
         ]),
         Err(_) => Err(anyhow::anyhow!("not recorded")),
     };
+    let oracle: anyhow::Result<Option<OracleOutcome>> = match (&outcome, kind) {
+        (Ok(_), Kind::Effect(_)) => child(&[
+            "--child-oracle",
+            &paths.dir.display().to_string(),
+            &diagnosis_text,
+            &paths.oracle_dir.display().to_string(),
+            select_flag,
+        ])
+        .map(Some),
+        _ => Ok(None),
+    };
     paths.remove_recordings();
-    let result = match (recorded, outcome) {
-        (Ok(r), Ok(o)) => score(kind, seed, &paths.truth, &r, &o),
-        (Err(e), _) | (_, Err(e)) => Err(e),
+    let result = match (recorded, outcome, oracle) {
+        (Ok(r), Ok(o), Ok(x)) => score(kind, seed, &paths.truth, &r, &o, x.as_ref()),
+        (Err(e), _, _) | (_, Err(e), _) | (_, _, Err(e)) => Err(e),
     };
     paths.remove_truth();
     result
@@ -119,7 +138,8 @@ fn one_world(
 
 /// A child's part: `--child-record <kind> <seed> <work> <small: yes|no> <diagnosis series>`
 /// records one world; `--child-loop <world dir> <floor dir> <small: yes|no> <select on +33 °C:
-/// yes|no> <diagnosis dir or ->` closes the loop on the recordings folders.
+/// yes|no> <diagnosis dir or ->` closes the loop on the recordings folders; `--child-oracle
+/// <world dir> <diagnosis dir or -> <oracle dir> <select: yes|no>` scores the true regressor.
 fn child_part(args: &[String]) -> anyhow::Result<()> {
     let small = |i: usize| args.get(i).is_some_and(|s| s == "yes");
     let arg = |i: usize| args.get(i).context("missing a child argument");
@@ -128,7 +148,17 @@ fn child_part(args: &[String]) -> anyhow::Result<()> {
         let seed: u64 = arg(2)?.parse()?;
         let paths = WorldPaths::new(Path::new(arg(3)?), kind, seed);
         let series: u32 = arg(5)?.parse()?;
-        serde_json::to_string(&record(kind, seed, &paths, small(4), series)?)?
+        let magnitude: f64 = arg(6)?.parse()?;
+        serde_json::to_string(&record(kind, seed, &paths, small(4), series, magnitude)?)?
+    } else if args[0] == "--child-oracle" {
+        let diagnosis = arg(2)?;
+        serde_json::to_string(&close_oracle(
+            Path::new(arg(1)?),
+            (diagnosis != "-").then(|| Path::new(diagnosis)),
+            Path::new(arg(3)?),
+            &fit_settings(),
+            small(4),
+        )?)?
     } else {
         // Sees the two recordings folders and nothing else.
         let settings = fit_settings();
@@ -149,7 +179,7 @@ fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args
         .first()
-        .is_some_and(|a| a == "--child-record" || a == "--child-loop")
+        .is_some_and(|a| a == "--child-record" || a == "--child-loop" || a == "--child-oracle")
     {
         // The loop's tables live on the stack as in the command line's worker (src/main.rs):
         // the main thread's 8 MiB overflowed on some worlds.
@@ -172,7 +202,8 @@ fn main() -> anyhow::Result<()> {
         .iter()
         .filter(|a| *a != "--small" && *a != "--select-on-validation")
         .collect();
-    const FLAGS: [&str; 8] = [
+    const FLAGS: [&str; 9] = [
+        "--magnitude",
         "--diagnosis-series",
         "--families",
         "--worlds-per-family",
@@ -204,6 +235,11 @@ fn main() -> anyhow::Result<()> {
     let first: u64 = number(&args, "--first-seed", DEFAULT_FIRST_SEED)?;
     let jobs: usize = number(&args, "--jobs", 1usize)?.max(1);
     let diagnosis_series: u32 = number(&args, "--diagnosis-series", 0)?;
+    let magnitude: f64 = number(&args, "--magnitude", 1.0)?;
+    anyhow::ensure!(
+        magnitude.is_finite() && magnitude > 0.0,
+        "--magnitude: {magnitude} is not a positive size"
+    );
     let out: Option<PathBuf> = value(&args, "--out").map(PathBuf::from);
     // Every world's score with its whole ranking, one JSON line each: what the significance
     // threshold is calibrated from (experiments/null_threshold.py).
@@ -254,7 +290,15 @@ fn main() -> anyhow::Result<()> {
             s.spawn(|| loop {
                 let next = queue.lock().map(|mut q| q.next()).ok().flatten();
                 let Some((kind, seed)) = next else { break };
-                let result = one_world(kind, seed, work.path(), small, select, diagnosis_series);
+                let result = one_world(
+                    kind,
+                    seed,
+                    work.path(),
+                    small,
+                    select,
+                    diagnosis_series,
+                    magnitude,
+                );
                 let mut guard = match results.lock() {
                     Ok(g) => g,
                     Err(p) => p.into_inner(),

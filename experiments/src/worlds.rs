@@ -30,6 +30,7 @@ use drift_sim::world::{World, WorldCampaign, WorldSpec, WorldTruth};
 use serde::{Deserialize, Serialize};
 
 use crate::closed_loop::segments;
+use crate::oracle::{close_oracle, OracleAxis, OracleOutcome};
 
 /// The set point the loop is measured at (°C): the world campaign's validation one.
 pub const VALIDATION: f64 = paper::VALIDATION_SET_POINT_CELSIUS;
@@ -80,10 +81,13 @@ impl Kind {
             })
     }
 
-    /// The world spec: only this family at realistic magnitude, or a null world.
-    pub fn spec(self) -> WorldSpec {
+    /// The world spec: only this family at `magnitude` × the realistic size, or a null world.
+    pub fn spec(self, magnitude: f64) -> WorldSpec {
         match self {
-            Self::Effect(f) => WorldSpec::with(&[f]),
+            Self::Effect(f) => WorldSpec {
+                magnitude_scale: magnitude,
+                ..WorldSpec::with(&[f])
+            },
             Self::Null => WorldSpec::null(),
         }
     }
@@ -136,6 +140,9 @@ pub struct WorldPaths {
     pub diagnosis_dir: PathBuf,
     /// The truth file (outside both).
     pub truth: PathBuf,
+    /// The simulator's sidecars of the world's and the diagnosis campaign's recordings
+    /// (`world/`, `diagnosis/`): read by the oracle only ([`crate::oracle`]).
+    pub oracle_dir: PathBuf,
 }
 
 impl WorldPaths {
@@ -147,6 +154,7 @@ impl WorldPaths {
             floor_dir: work.join(&name).join("floor"),
             diagnosis_dir: work.join(&name).join("diagnosis"),
             truth: work.join("truth").join(format!("{name}.json")),
+            oracle_dir: work.join(&name).join("oracle"),
         }
     }
 
@@ -176,8 +184,9 @@ pub struct Recorded {
 
 /// Step 1: draws the world of `seed`, records its campaign into `paths.dir` and its zero-drift
 /// twin's (field sessions at +33 °C, behind a one-series protocol the campaign needs) into
-/// `paths.floor_dir`, and writes the truth to `paths.truth`. The simulator's truth sidecars are
-/// deleted: the recordings folders are all the loop can read.
+/// `paths.floor_dir`, and writes the truth to `paths.truth`. The simulator's truth sidecars move
+/// to `paths.oracle_dir` (the twin's are deleted): the recordings folders are all the blind loop
+/// reads. An effect world's family is drawn at `magnitude` × its realistic size.
 ///
 /// With `diagnosis_series` > 0 the unit also records an analyst's diagnosis campaign into
 /// `paths.diagnosis_dir`: that many ramped field series of 5 activations at the validation set
@@ -188,10 +197,11 @@ pub fn record(
     paths: &WorldPaths,
     small: bool,
     diagnosis_series: u32,
+    magnitude: f64,
 ) -> anyhow::Result<Recorded> {
     let started = Instant::now();
     let plan = world_campaign(small);
-    let world = World::draw(seed, &kind.spec());
+    let world = World::draw(seed, &kind.spec(magnitude));
     let summary = world
         .simulate(&world.campaign(&plan), &paths.dir, |_| {})
         .with_context(|| format!("simulating the {} world of seed {seed}", kind.name()))?;
@@ -219,8 +229,13 @@ pub fn record(
             .simulate(&diagnosis, &paths.diagnosis_dir, |_| {})
             .context("simulating the diagnosis campaign")?;
     }
-    for dir in [&paths.dir, &paths.floor_dir, &paths.diagnosis_dir] {
-        let _ = std::fs::remove_dir_all(dir.join(TRUTH_DIR));
+    let _ = std::fs::remove_dir_all(paths.floor_dir.join(TRUTH_DIR));
+    std::fs::create_dir_all(&paths.oracle_dir)?;
+    for (dir, name) in [(&paths.dir, "world"), (&paths.diagnosis_dir, "diagnosis")] {
+        let truth = dir.join(TRUTH_DIR);
+        if truth.exists() {
+            std::fs::rename(&truth, paths.oracle_dir.join(name))?;
+        }
     }
     if let Some(parent) = paths.truth.parent() {
         std::fs::create_dir_all(parent)?;
@@ -493,9 +508,17 @@ pub struct AxisScore {
     pub ranking: Vec<(Ranked, bool)>,
     /// The drift excess cut over the floor with its 95 % interval.
     pub cut: ExcessCut,
+    /// What the loop's diagnosis made of the true regressor on the same data (effect worlds with
+    /// an oracle run).
+    pub oracle: Option<OracleAxis>,
 }
 
 impl AxisScore {
+    /// The true regressor clears the detectable share here.
+    pub fn oracle_detectable(&self) -> bool {
+        self.oracle.as_ref().is_some_and(OracleAxis::detectable)
+    }
+
     /// Right family, ranked first, significant.
     pub fn found(&self) -> bool {
         self.right_family && self.top_significant
@@ -539,6 +562,7 @@ pub fn score(
     truth_path: &Path,
     recorded: &Recorded,
     outcome: &Outcome,
+    oracle: Option<&OracleOutcome>,
 ) -> anyhow::Result<WorldScore> {
     let text = std::fs::read_to_string(truth_path)
         .with_context(|| format!("reading {}", truth_path.display()))?;
@@ -578,6 +602,7 @@ pub fn score(
                     .map(|c| (c.clone(), names(&c.name)))
                     .collect(),
                 cut: excess_cut(&o.before_dps, &o.after_dps, &o.floor_dps),
+                oracle: oracle.and_then(|x| x.axes.get(a).cloned().flatten()),
             }
         })
         .collect();
@@ -599,18 +624,37 @@ pub fn score(
 
 /// All three steps in this process (the example runs each in a child process of its own, for
 /// the memory figures): record, close blind, score, then delete the world's files.
-pub fn run_world(kind: Kind, seed: u64, work: &Path, small: bool) -> anyhow::Result<WorldScore> {
+/// An effect world's family is drawn at `magnitude` × its realistic size; its oracle runs after
+/// the blind loop.
+pub fn run_world(
+    kind: Kind,
+    seed: u64,
+    work: &Path,
+    small: bool,
+    magnitude: f64,
+) -> anyhow::Result<WorldScore> {
     let paths = WorldPaths::new(work, kind, seed);
-    let recorded = record(kind, seed, &paths, small, 0);
+    let recorded = record(kind, seed, &paths, small, 0, magnitude);
     let outcome = recorded
         .as_ref()
         .ok()
         .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(), false, None));
+    let oracle = match (&outcome, kind) {
+        (Some(Ok(_)), Kind::Effect(_)) => Some(close_oracle(
+            &paths.dir,
+            None,
+            &paths.oracle_dir,
+            &fit_settings(),
+            false,
+        )),
+        _ => None,
+    };
     paths.remove_recordings();
-    let result = match (recorded, outcome) {
-        (Ok(r), Some(Ok(o))) => score(kind, seed, &paths.truth, &r, &o),
-        (Err(e), _) | (_, Some(Err(e))) => Err(e),
-        (Ok(_), None) => unreachable!("the loop runs after a recording"),
+    let result = match (recorded, outcome, oracle.transpose()) {
+        (_, _, Err(e)) => Err(e),
+        (Ok(r), Some(Ok(o)), Ok(x)) => score(kind, seed, &paths.truth, &r, &o, x.as_ref()),
+        (Err(e), _, _) | (_, Some(Err(e)), _) => Err(e),
+        (Ok(_), None, _) => unreachable!("the loop runs after a recording"),
     };
     paths.remove_truth();
     result
@@ -688,8 +732,8 @@ pub struct Failure {
 /// the worlds that failed, which no other row counts).
 pub fn table(scores: &[WorldScore], failures: &[Failure], kinds: &[Kind]) -> String {
     let mut out = String::new();
-    out.push_str("| family | worlds | affected axes | right family ranked first and significant | right family first (any significance) | right family admitted | drift excess cut, median (range) | axes surely worse than 0.9× |\n");
-    out.push_str("|---|---:|---:|---|---|---|---|---:|\n");
+    out.push_str("| family | worlds | affected axes | oracle: true regressor's gain, median (range) | oracle-detectable axes | right family first and significant among them | right family ranked first and significant | right family first (any significance) | right family admitted | drift excess cut, median (range) | axes surely worse than 0.9× |\n");
+    out.push_str("|---|---:|---:|---|---:|---|---|---|---|---|---:|\n");
     for kind in kinds.iter().filter(|k| **k != Kind::Null) {
         let worlds: Vec<&WorldScore> = scores.iter().filter(|s| s.kind == kind.name()).collect();
         let affected: Vec<&AxisScore> = worlds
@@ -710,11 +754,33 @@ pub fn table(scores: &[WorldScore], failures: &[Failure], kinds: &[Kind]) -> Str
                 ratio_text(c[c.len() - 1])
             )
         };
+        let mut gains: Vec<f64> = affected
+            .iter()
+            .filter_map(|a| a.oracle.as_ref().map(|o| o.gain))
+            .collect();
+        gains.sort_by(f64::total_cmp);
+        let gain = if gains.is_empty() {
+            "–".to_owned()
+        } else {
+            format!(
+                "{:.2} ({:.2}–{:.2})",
+                median(&gains),
+                gains[0],
+                gains[gains.len() - 1]
+            )
+        };
+        let detectable = count(&AxisScore::oracle_detectable);
         out.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {gain} | {} | {} | {} | {} | {} | {} | {} |\n",
             kind.name(),
             worlds.len(),
             n,
+            if gains.is_empty() {
+                "–".to_owned()
+            } else {
+                detectable.to_string()
+            },
+            share(count(&|a| a.oracle_detectable() && a.found()), detectable),
             share(count(&AxisScore::found), n),
             share(count(&|a| a.right_family), n),
             share(count(&|a| a.right_family_admitted), n),
@@ -782,7 +848,7 @@ pub fn world_lines(s: &WorldScore) -> Vec<String> {
         .iter()
         .map(|a| {
             format!(
-                "{} {} [{}] {}: affected {}, top {}{}, right family {}, admitted [{}], drift {:.4} → {:.4} (floor {:.4}) °/s, cut {}",
+                "{} {} [{}] {}: affected {}, top {}{}, right family {}, admitted [{}], drift {:.4} → {:.4} (floor {:.4}) °/s, cut {}{}",
                 s.kind,
                 s.seed,
                 s.forms.join(","),
@@ -796,6 +862,10 @@ pub fn world_lines(s: &WorldScore) -> Vec<String> {
                 a.drift.1,
                 a.drift.2,
                 a.cut,
+                a.oracle.as_ref().map_or(String::new(), |o| format!(
+                    ", oracle gain {:.3} (detectable from {:.3}, rank {}, {}, absorbed {:.2})",
+                    o.gain, o.detectable_share, o.rank, o.level, o.absorbed_by_model
+                )),
             )
         })
         .collect()

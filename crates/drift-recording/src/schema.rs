@@ -33,6 +33,9 @@ pub const TOPIC_TRUTH_ELEMENT: &str = "/truth/element_temperature";
 pub const TOPIC_TRUTH_ASIC: &str = "/truth/asic_temperature";
 /// Truth: Gauss–Markov bias instability (°/s), 100 Hz.
 pub const TOPIC_TRUTH_INSTABILITY: &str = "/truth/bias_instability";
+/// Truth: a world's undeclared effects alone (°/s), 100 Hz: the part of the systematic bias an
+/// oracle regresses on (only in the sidecars of a drawn world).
+pub const TOPIC_TRUTH_EFFECT: &str = "/truth/hidden_effect_bias";
 
 /// MCAP profile of recordings.
 pub const PROFILE_RECORDING: &str = "gyrodrift";

@@ -71,6 +71,8 @@ struct Buffers {
     truth_element: [Vec<f32>; 3],
     truth_asic: [Vec<f32>; 3],
     truth_instability: [Vec<f32>; 3],
+    /// A world's undeclared effects alone (empty without a world).
+    truth_effect: [Vec<f32>; 3],
     /// A world's named channels (empty without a world).
     named: Vec<Vec<f32>>,
 }
@@ -93,6 +95,7 @@ impl Buffers {
             truth_element: [a(), a(), a()],
             truth_asic: [a(), a(), a()],
             truth_instability: [a(), a(), a()],
+            truth_effect: [a(), a(), a()],
             named: Vec::new(),
         }
     }
@@ -110,6 +113,7 @@ impl Buffers {
             .truth_asic
             .iter_mut()
             .chain(&mut self.truth_instability)
+            .chain(&mut self.truth_effect)
         {
             v.clear();
         }
@@ -196,6 +200,13 @@ impl FileSim<'_> {
             schema::SCHEMA_VECTOR3,
             &[("unit", "deg/s")],
         )?;
+        if self.world.is_some() {
+            f.add_topic(
+                schema::TOPIC_TRUTH_EFFECT,
+                schema::SCHEMA_VECTOR3,
+                &[("unit", "deg/s")],
+            )?;
+        }
         f.add_topic(schema::TOPIC_POWER, schema::SCHEMA_POWER, &[])?;
         f.metadata(schema::METADATA_RECORDING, self.recording_metadata())?;
         Ok(f)
@@ -445,6 +456,7 @@ impl FileSim<'_> {
         let n_aux = runtime.map_or(0, |w| w.aux.len());
         let (mut aux_now, mut aux_next) = (vec![0.0; n_aux], vec![0.0; n_aux]);
         let (mut extra_now, mut extra_next) = ([0.0; 3], [0.0; 3]);
+        let mut effect_next = [0.0; 3];
         let lsb_raw = runtime.map_or(1.0, |w| w.temperature_lsb_raw);
         if let (Some(w), Some(state)) = (runtime, world.as_deref_mut()) {
             state.gravity = accel_true;
@@ -458,7 +470,7 @@ impl FileSim<'_> {
                 supply_v: act.supply_v,
                 aux: &aux_next,
             };
-            w.extra(&inputs, &state.lags, &mut extra_next);
+            w.extra(&inputs, &state.lags, &mut extra_next, &mut effect_next);
         }
         for i in 0..act.samples {
             let t = f64::from(i) * h;
@@ -500,7 +512,23 @@ impl FileSim<'_> {
                         &mut state.lags,
                     );
                     extra_now = extra_next;
-                    w.extra(&at(&next, &aux_next), &state.lags, &mut extra_next);
+                    let effect_now = effect_next;
+                    w.extra(
+                        &at(&next, &aux_next),
+                        &state.lags,
+                        &mut extra_next,
+                        &mut effect_next,
+                    );
+                    for a in 0..3 {
+                        let rate = if w.rate_is_effect {
+                            unit.axes[a].thermal_lag_dps_per_c_per_s
+                                * (next[biasing(a)] - x[biasing(a)])
+                                / grid_s
+                        } else {
+                            0.0
+                        };
+                        buf.truth_effect[a].push((effect_now[a] + rate) as f32);
+                    }
                     for (k, channel) in w.aux.iter().enumerate() {
                         let v = aux_now[k] + channel.noise * noise * normal(r);
                         buf.named[k].push(v as f32);
@@ -633,6 +661,15 @@ impl FileSim<'_> {
                     &mut tru.enc,
                 );
                 tru.write_encoded(schema::TOPIC_TRUTH_INSTABILITY, log_ns)?;
+                if runtime.is_some() {
+                    Vector3Batch::encode(
+                        aux_first,
+                        AUX_RATE_HZ,
+                        as_refs(&buf.truth_effect),
+                        &mut tru.enc,
+                    );
+                    tru.write_encoded(schema::TOPIC_TRUTH_EFFECT, log_ns)?;
+                }
                 progress(buf.rate[0].len() as u64);
                 buf.clear();
             }

@@ -19,6 +19,8 @@ pub struct TruthSegment {
     pub element_celsius: [Vec<f32>; 3],
     /// ASIC (temperature-sensor site) true temperatures at 100 Hz (°C).
     pub asic_celsius: [Vec<f32>; 3],
+    /// A drawn world's undeclared effects alone at 100 Hz (°/s; empty for a campaign).
+    pub effect_dps: [Vec<f32>; 3],
 }
 
 /// Reads a `.truth.mcap` sidecar into per-activation series (in recording order).
@@ -53,14 +55,18 @@ pub fn read_truth(path: &Path) -> Result<Vec<TruthSegment>, ReadError> {
                     out.push(TruthSegment::default());
                 }
             }
-            schema::TOPIC_TRUTH_BIAS | schema::TOPIC_TRUTH_ELEMENT | schema::TOPIC_TRUTH_ASIC => {
+            schema::TOPIC_TRUTH_BIAS
+            | schema::TOPIC_TRUTH_ELEMENT
+            | schema::TOPIC_TRUTH_ASIC
+            | schema::TOPIC_TRUTH_EFFECT => {
                 let seg = out
                     .last_mut()
                     .ok_or_else(|| bad("truth before the first switch-on".into()))?;
                 let target = match topic {
                     schema::TOPIC_TRUTH_BIAS => &mut seg.systematic_bias_dps,
                     schema::TOPIC_TRUTH_ELEMENT => &mut seg.element_celsius,
-                    _ => &mut seg.asic_celsius,
+                    schema::TOPIC_TRUTH_ASIC => &mut seg.asic_celsius,
+                    _ => &mut seg.effect_dps,
                 };
                 Vector3Batch::decode_into(&message.data, target).map_err(bad)?;
             }

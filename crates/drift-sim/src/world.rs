@@ -283,7 +283,12 @@ impl World {
             let mut r = world_stream(c.seed, &[rng::tag("aux"), file]);
             aux.push(aux_schedule(&mut r, plan.activations.len()));
         }
-        let runtime = Runtime::new(&self.truth.unit, s, &self.terms());
+        let mut runtime = Runtime::new(&self.truth.unit, s, &self.terms());
+        runtime.rate_is_effect = self
+            .truth
+            .effects
+            .iter()
+            .any(|e| e.rate_dps_per_c_per_s.is_some());
         let units = [self.truth.unit.clone()];
         record(
             c,

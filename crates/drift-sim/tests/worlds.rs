@@ -308,3 +308,62 @@ fn a_chosen_truth_path_and_a_zero_drift_twin_without_drift() {
         Source::SensorTemperature { .. }
     ));
 }
+
+/// The oracle's regressor: the truth's effect series is exactly what the undeclared effect adds
+/// to the rate (the world's rate less its null twin's, noise-free), for every family whose effect
+/// is additive (self-heating changes the heating itself), and zero in a null world.
+#[test]
+fn the_truth_holds_the_undeclared_effect_alone() {
+    let record = |world: &World, c: &Campaign| {
+        let dir = tempfile::tempdir().unwrap();
+        let summary = world.simulate(c, dir.path(), |_| {}).unwrap();
+        let file = &summary.files[0];
+        let truth = drift_sim::truth::read_truth(&file.truth).unwrap();
+        (read_recording(&file.recording).unwrap().segments, truth)
+    };
+    let additive = EffectFamily::ALL
+        .into_iter()
+        .filter(|f| *f != EffectFamily::SelfHeating);
+    for (k, family) in additive.enumerate() {
+        let seed = 700 + k as u64;
+        let world = World::draw(seed, &WorldSpec::with(&[family]));
+        let c = field_campaign(&world);
+        let (with, truth) = record(&world, &c);
+        let (without, null_truth) = record(&world.null_twin(), &c);
+        assert_eq!(truth.len(), with.len());
+        let mut largest = 0.0f64;
+        for ((s, n), t) in with.iter().zip(&without).zip(&truth) {
+            for a in 0..3 {
+                // 100 Hz: every sample is on the effect's grid.
+                assert_eq!(
+                    t.effect_dps[a].len(),
+                    s.rate_dps[a].len(),
+                    "{}",
+                    family.name()
+                );
+                for (i, e) in t.effect_dps[a].iter().enumerate() {
+                    let added = f64::from(s.rate_dps[a][i]) - f64::from(n.rate_dps[a][i]);
+                    largest = largest.max(f64::from(*e).abs());
+                    // Each rate is quantised to the output's LSB (2⁻¹⁴ °/s) and stored as f32
+                    // beside the field's rotations.
+                    let rounding =
+                        4.0 * f64::from(f32::EPSILON) * f64::from(s.rate_dps[a][i].abs());
+                    assert!(
+                        (added - f64::from(*e)).abs() <= 1.0 / 16384.0 + 1e-7 + rounding,
+                        "{} (seed {seed}) axis {a} sample {i}: rate adds {added:e}, truth says {e:e}",
+                        family.name()
+                    );
+                }
+            }
+        }
+        assert!(
+            largest > 1e-4,
+            "{}: the effect is {largest:e} °/s",
+            family.name()
+        );
+        let zero = null_truth
+            .iter()
+            .flat_map(|t| t.effect_dps.iter().flatten());
+        assert!(zero.into_iter().all(|e| *e == 0.0), "{}", family.name());
+    }
+}

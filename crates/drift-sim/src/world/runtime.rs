@@ -81,6 +81,9 @@ pub(crate) struct Runtime {
     lid: [Option<(usize, f64)>; 3],
     pub temperature_lsb_raw: f64,
     pub aux: Vec<AuxSpec>,
+    /// The unit's element-rate sensitivity is an undeclared effect's (the `temperature_rate`
+    /// family), not the structure's: it belongs in the effect's truth.
+    pub rate_is_effect: bool,
     pub links: Vec<(usize, usize, f64)>,
     any_temperature_lag: bool,
 }
@@ -159,6 +162,7 @@ impl Runtime {
             lid,
             temperature_lsb_raw: structure.temperature_lsb_raw,
             aux,
+            rate_is_effect: false,
             links,
             any_temperature_lag,
         }
@@ -241,8 +245,11 @@ impl Runtime {
     }
 
     /// The world's extra bias per axis (°/s) at one instant.
-    pub fn extra(&self, x: &Inputs, lags: &[f64], out: &mut [f64; 3]) {
+    /// `effect` receives the undeclared effects' part alone (the structure's lags left out): what
+    /// an oracle knows.
+    pub fn extra(&self, x: &Inputs, lags: &[f64], out: &mut [f64; 3], effect: &mut [f64; 3]) {
         *out = [0.0; 3];
+        *effect = [0.0; 3];
         for (a, o) in out.iter_mut().enumerate() {
             let te = x.temps[element(a)];
             if let Some((l, k)) = self.gas[a] {
@@ -268,6 +275,7 @@ impl Runtime {
                 EffectForm::Quadratic => u * u,
             };
             out[t.axis] += t.k * feature;
+            effect[t.axis] += t.k * feature;
         }
     }
 }
