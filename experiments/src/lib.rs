@@ -3,5 +3,6 @@
 //! (after the fact, never inside the fit) compare with the simulator's truth. See the README.
 
 pub mod closed_loop;
+pub mod memory;
 pub mod oracle;
 pub mod worlds;

@@ -20,7 +20,10 @@ use drift_recording::{read_recording, AuxChannel, Segment, RECORDINGS_DIR, TRUTH
 use drift_sim::truth::read_truth;
 use serde::{Deserialize, Serialize};
 
-use crate::worlds::{peak_rss_mb, CALIBRATION, VALIDATION};
+use crate::memory::peak_rss_mb;
+use drift_recording::paper::{
+    CALIBRATION_SET_POINTS_CELSIUS as CALIBRATION, VALIDATION_SET_POINT_CELSIUS as VALIDATION,
+};
 
 /// The recorded channel that carries the truth on axis `axis`.
 pub fn oracle_channel(axis: usize) -> String {

@@ -30,6 +30,7 @@ use drift_sim::world::{World, WorldCampaign, WorldSpec, WorldTruth};
 use serde::{Deserialize, Serialize};
 
 use crate::closed_loop::segments;
+pub use crate::memory::peak_rss_mb;
 use crate::oracle::{close_oracle, OracleAxis, OracleOutcome};
 
 /// The set point the loop is measured at (°C): the world campaign's validation one.
@@ -115,18 +116,6 @@ pub fn world_campaign(small: bool) -> WorldCampaign {
 /// each recording's own rate).
 pub fn fit_settings() -> FitSettings {
     FitSettings::default()
-}
-
-/// Peak resident memory of this process so far (`VmHWM`), MB; NaN where `/proc` has none.
-pub fn peak_rss_mb() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find_map(|l| l.strip_prefix("VmHWM:"))
-                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
-        })
-        .map_or(f64::NAN, |kb| kb / 1024.0)
 }
 
 /// Where one world's files go.
