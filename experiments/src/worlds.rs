@@ -269,6 +269,9 @@ pub struct AxisOutcome {
     pub detectable_share: f64,
     /// Terms the guard admitted on the axis.
     pub admitted: Vec<String>,
+    /// Terms the guard left out on the axis, each with its reason.
+    #[serde(default)]
+    pub refused: Vec<String>,
     /// Drift (max − min of the 1-s mean) of each held-out +33 °C field activation, paper's model,
     /// °/s.
     pub before_dps: Vec<f64>,
@@ -382,6 +385,13 @@ pub fn close_blind(
                     .filter(|x| x.axis == AXES[a] && x.admitted)
                     .map(|x| x.candidate.clone())
                     .collect(),
+                refused: closed
+                    .extended
+                    .iter()
+                    .flat_map(|e| &e.admissions)
+                    .filter(|x| x.axis == AXES[a] && !x.admitted)
+                    .map(|x| format!("{}: {}", x.candidate, x.reason))
+                    .collect(),
                 before_dps: measured.iter().map(|r| r.drift_dps[a].0).collect(),
                 after_dps: measured.iter().map(|r| r.drift_dps[a].1).collect(),
                 floor_dps: floor.iter().map(|p| p[a].0).collect(),
@@ -490,6 +500,8 @@ pub struct AxisScore {
     pub detectable_share: f64,
     /// Terms admitted on the axis.
     pub admitted: Vec<String>,
+    /// Terms the guard left out on the axis, with its reasons.
+    pub refused: Vec<String>,
     /// Mean drift before, after, and the floor's, °/s.
     pub drift: (f64, f64, f64),
     /// Every candidate as the loop ranked it, best first, with whether it names the world's
@@ -584,6 +596,7 @@ pub fn score(
                 any_significant: o.any_significant,
                 detectable_share: o.detectable_share,
                 admitted: o.admitted.clone(),
+                refused: o.refused.clone(),
                 drift: (mean(&o.before_dps), mean(&o.after_dps), mean(&o.floor_dps)),
                 ranking: o
                     .ranking
