@@ -4,7 +4,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-step() { printf '\n=== %s\n' "$*"; }
+# Each step prints the time since the start, so a slow step shows where the budget goes.
+step() { printf '\n=== [%dm%02ds] %s\n' $((SECONDS / 60)) $((SECONDS % 60)) "$*"; }
+trap 'printf "\n=== [%dm%02ds] end (exit %d)\n" $((SECONDS / 60)) $((SECONDS % 60)) $?' EXIT
 
 step "toolchain: Rust stable with rustfmt, clippy, llvm-tools and the Cortex-M4F target"
 rustup show active-toolchain >/dev/null
