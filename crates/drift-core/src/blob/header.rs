@@ -109,7 +109,8 @@ fn text<const N: usize>(value: &str, field: &'static str) -> Result<String<N>, B
 /// An image's header, read without its payload ([`header`](super::header)).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Header {
-    /// Format version, [`VERSION_1`](super::VERSION_1) or [`VERSION_2`].
+    /// Format version, [`VERSION_1`](super::VERSION_1), [`VERSION_2`] or
+    /// [`VERSION_3`](super::VERSION_3).
     pub version: u16,
     /// Model kind byte ([`Kind`](super::Kind)).
     pub kind: u8,
@@ -144,7 +145,7 @@ impl Header {
 /// provenance's text.
 pub(super) fn read(bytes: &[u8]) -> Result<Header, BlobError> {
     let mut header = read_fixed(bytes)?;
-    if header.version == VERSION_2 {
+    if header.version >= VERSION_2 {
         header.provenance = Provenance {
             unit_id: label(bytes, UNIT_AT, "unit ID")?,
             tool_version: label(bytes, TOOL_AT, "tool version")?,
@@ -186,7 +187,7 @@ pub(super) fn read_fixed(bytes: &[u8]) -> Result<Header, BlobError> {
         needs: None,
         provenance: Provenance::default(),
     };
-    if version == VERSION_2 {
+    if version >= VERSION_2 {
         header.needs = Some(Capacities {
             reference_times: le_u16(bytes, CAPACITIES_AT),
             ambients: le_u16(bytes, CAPACITIES_AT.saturating_add(2)),
@@ -210,8 +211,9 @@ fn label<const N: usize>(
         .ok_or(BlobError::BadHeader { field })
 }
 
-/// Writes a version-2 header into `out` (exactly [`HEADER_LEN_V2`] bytes).
-pub(super) fn write_v2(
+/// Writes the header of the version this build writes ([`FORMAT_VERSION`](super::FORMAT_VERSION),
+/// version 2's layout) into `out` (exactly [`HEADER_LEN_V2`] bytes).
+pub(super) fn write(
     out: &mut [u8],
     kind: u8,
     payload_len: u32,
@@ -221,7 +223,7 @@ pub(super) fn write_v2(
     out.fill(0);
     let fields: [(usize, &[u8]); 10] = [
         (0, &MAGIC),
-        (4, &VERSION_2.to_le_bytes()),
+        (4, &super::FORMAT_VERSION.to_le_bytes()),
         (KIND_AT, &[kind]),
         (PAYLOAD_LEN_AT, &payload_len.to_le_bytes()),
         (CAPACITIES_AT, &needs.reference_times.to_le_bytes()),
