@@ -53,14 +53,10 @@ pub use section::{
 pub use error::BlobError;
 pub use header::{Capacities, Header, Provenance};
 pub use layout::{
-    header_len, HEADER_LEN_V1, HEADER_LEN_V2, MAGIC, TOOL_VERSION_LEN, TRAILER_LEN, UNIT_ID_LEN,
-    VERSION_1, VERSION_2, VERSION_3,
+    header_len, FORMAT_VERSION, HEADER_LEN_V1, HEADER_LEN_V2, MAGIC, TOOL_VERSION_LEN, TRAILER_LEN,
+    UNIT_ID_LEN, VERSION_1, VERSION_2, VERSION_3,
 };
 
-/// The image format version this build writes. It reads it, [`VERSION_2`] and [`VERSION_1`]. Any
-/// change to the header or to the payload's shape (a model type's fields, in order) is a new
-/// version.
-pub const FORMAT_VERSION: u16 = VERSION_3;
 /// Bytes before the payload in the version this build writes.
 pub const HEADER_LEN: usize = HEADER_LEN_V2;
 

@@ -1,13 +1,14 @@
-//! The image's fixed header, both versions: what it says (kind, payload length and, from version 2,
-//! the capacities the model needs and where the image comes from), read without the payload, and
-//! written. Layouts: the `blob` module's documentation.
+//! The image's fixed header, every version (2 and 3 share one layout): what it says (kind, payload
+//! length and, from version 2, the capacities the model needs and where the image comes from),
+//! read without the payload, and written. Layouts: the `blob` module's documentation.
 
 use heapless::String;
 
 use super::error::BlobError;
 use super::layout::{
-    array, header_len, le_u16, le_u32, CAPACITIES_AT, DATE_AT, HEADER_LEN_V1, KIND_AT, MAGIC,
-    PAYLOAD_LEN_AT, TOOL_AT, TOOL_VERSION_LEN, TRAILER_LEN, UNIT_AT, UNIT_ID_LEN, VERSION_2,
+    array, header_len, le_u16, le_u32, CAPACITIES_AT, DATE_AT, FORMAT_VERSION, HEADER_LEN_V1,
+    KIND_AT, MAGIC, PAYLOAD_LEN_AT, TOOL_AT, TOOL_VERSION_LEN, TRAILER_LEN, UNIT_AT, UNIT_ID_LEN,
+    VERSION_2,
 };
 
 /// How many entries of each table dimension a model holds: what a firmware's capacities (the
@@ -211,7 +212,7 @@ fn label<const N: usize>(
         .ok_or(BlobError::BadHeader { field })
 }
 
-/// Writes the header of the version this build writes ([`FORMAT_VERSION`](super::FORMAT_VERSION),
+/// Writes the header of the version this build writes ([`FORMAT_VERSION`],
 /// version 2's layout) into `out` (exactly [`HEADER_LEN_V2`] bytes).
 pub(super) fn write(
     out: &mut [u8],
@@ -223,7 +224,7 @@ pub(super) fn write(
     out.fill(0);
     let fields: [(usize, &[u8]); 10] = [
         (0, &MAGIC),
-        (4, &super::FORMAT_VERSION.to_le_bytes()),
+        (4, &FORMAT_VERSION.to_le_bytes()),
         (KIND_AT, &[kind]),
         (PAYLOAD_LEN_AT, &payload_len.to_le_bytes()),
         (CAPACITIES_AT, &needs.reference_times.to_le_bytes()),

@@ -11,6 +11,10 @@ pub const VERSION_2: u16 = 2;
 /// Version 3 has version 2's header; its payload's settings end with `sample_rate_hz`
 /// (versions 1 and 2 read as 0, not stated).
 pub const VERSION_3: u16 = 3;
+/// The image format version this build writes. It reads it, [`VERSION_2`] and [`VERSION_1`]. Any
+/// change to the header or to the payload's shape (a model type's fields, in order) is a new
+/// version.
+pub const FORMAT_VERSION: u16 = VERSION_3;
 /// Header length of a version-1 image.
 pub const HEADER_LEN_V1: usize = 12;
 /// Header length of a version-2 or -3 image.
