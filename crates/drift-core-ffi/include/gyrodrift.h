@@ -156,7 +156,8 @@ enum gyrodrift_status gyrodrift_sample_from_counts(uint32_t since_power_on_ms,
 //
 // # Safety
 //
-// `ctx` and `image` are null or meet the pointer conditions (gyrodrift.h's preamble) (`image`: `len` readable bytes).
+// `ctx` and `image` are null or meet the pointer conditions (gyrodrift.h's preamble) (`image`:
+// `len` readable bytes).
 enum gyrodrift_status gyrodrift_init(struct gyrodrift_context *ctx,
                                      const uint8_t *image,
                                      size_t len);
@@ -168,7 +169,8 @@ enum gyrodrift_status gyrodrift_init(struct gyrodrift_context *ctx,
 //
 // # Safety
 //
-// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw` and `flags` (which may be null).
+// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw` and `flags` (which
+// may be null).
 enum gyrodrift_status gyrodrift_power_on(struct gyrodrift_context *ctx,
                                          const float *switch_on_raw,
                                          uint16_t *flags);
@@ -180,7 +182,8 @@ enum gyrodrift_status gyrodrift_power_on(struct gyrodrift_context *ctx,
 //
 // # Safety
 //
-// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw`, `previous` and `flags` (which may be null).
+// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw`, `previous` and
+// `flags` (which may be null).
 enum gyrodrift_status gyrodrift_power_on_after(struct gyrodrift_context *ctx,
                                                const float *switch_on_raw,
                                                struct gyrodrift_previous *previous,
@@ -224,7 +227,7 @@ enum gyrodrift_status gyrodrift_keep(struct gyrodrift_context *ctx,
 // The pointer conditions (gyrodrift.h's preamble) on `ctx`.
 enum gyrodrift_status gyrodrift_power_off(struct gyrodrift_context *ctx);
 
-// [`gyrodrift_init`] for the large profile (`GyrodriftLargeContext`).
+// [`gyrodrift_init`] for the large profile (`gyrodrift_large_context`).
 //
 // # Safety
 //
@@ -233,7 +236,7 @@ enum gyrodrift_status gyrodrift_large_init(struct gyrodrift_large_context *ctx,
                                            const uint8_t *image,
                                            size_t len);
 
-// [`gyrodrift_power_on`] for the large profile (`GyrodriftLargeContext`).
+// [`gyrodrift_power_on`] for the large profile (`gyrodrift_large_context`).
 //
 // # Safety
 //
@@ -242,7 +245,7 @@ enum gyrodrift_status gyrodrift_large_power_on(struct gyrodrift_large_context *c
                                                const float *switch_on_raw,
                                                uint16_t *flags);
 
-// [`gyrodrift_power_on_after`] for the large profile (`GyrodriftLargeContext`).
+// [`gyrodrift_power_on_after`] for the large profile (`gyrodrift_large_context`).
 //
 // # Safety
 //
@@ -252,7 +255,7 @@ enum gyrodrift_status gyrodrift_large_power_on_after(struct gyrodrift_large_cont
                                                      struct gyrodrift_previous *previous,
                                                      uint16_t *flags);
 
-// [`gyrodrift_correct`] for the large profile (`GyrodriftLargeContext`).
+// [`gyrodrift_correct`] for the large profile (`gyrodrift_large_context`).
 //
 // # Safety
 //
@@ -261,7 +264,7 @@ enum gyrodrift_status gyrodrift_large_correct(struct gyrodrift_large_context *ct
                                               const struct gyrodrift_sample *sample,
                                               struct gyrodrift_output *output);
 
-// [`gyrodrift_correct_with_aux`] for the large profile (`GyrodriftLargeContext`).
+// [`gyrodrift_correct_with_aux`] for the large profile (`gyrodrift_large_context`).
 //
 // # Safety
 //
@@ -271,7 +274,7 @@ enum gyrodrift_status gyrodrift_large_correct_with_aux(struct gyrodrift_large_co
                                                        const float *aux,
                                                        struct gyrodrift_output *output);
 
-// [`gyrodrift_keep`] for the large profile (`GyrodriftLargeContext`).
+// [`gyrodrift_keep`] for the large profile (`gyrodrift_large_context`).
 //
 // # Safety
 //
@@ -279,7 +282,7 @@ enum gyrodrift_status gyrodrift_large_correct_with_aux(struct gyrodrift_large_co
 enum gyrodrift_status gyrodrift_large_keep(struct gyrodrift_large_context *ctx,
                                            struct gyrodrift_previous *previous);
 
-// [`gyrodrift_power_off`] for the large profile (`GyrodriftLargeContext`).
+// [`gyrodrift_power_off`] for the large profile (`gyrodrift_large_context`).
 //
 // # Safety
 //

@@ -21,7 +21,8 @@ use crate::{GyrodriftContext, GyrodriftLargeContext};
 ///
 /// # Safety
 ///
-/// `ctx` is null or meets the pointer conditions (gyrodrift.h's preamble) for a context of this profile.
+/// `ctx` is null or meets the pointer conditions (gyrodrift.h's preamble) for a context of this
+/// profile.
 unsafe fn ready<'a, const R: usize, const A: usize, const C: usize>(
     ctx: *mut Context<R, A, C>,
 ) -> Result<&'a mut Context<R, A, C>, GyrodriftStatus> {
@@ -224,7 +225,8 @@ pub unsafe extern "C" fn gyrodrift_sample_from_counts(
 ///
 /// # Safety
 ///
-/// `ctx` and `image` are null or meet the pointer conditions (gyrodrift.h's preamble) (`image`: `len` readable bytes).
+/// `ctx` and `image` are null or meet the pointer conditions (gyrodrift.h's preamble) (`image`:
+/// `len` readable bytes).
 #[no_mangle]
 pub unsafe extern "C" fn gyrodrift_init(
     ctx: *mut GyrodriftContext,
@@ -242,7 +244,8 @@ pub unsafe extern "C" fn gyrodrift_init(
 ///
 /// # Safety
 ///
-/// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw` and `flags` (which may be null).
+/// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw` and `flags` (which
+/// may be null).
 #[no_mangle]
 pub unsafe extern "C" fn gyrodrift_power_on(
     ctx: *mut GyrodriftContext,
@@ -260,7 +263,8 @@ pub unsafe extern "C" fn gyrodrift_power_on(
 ///
 /// # Safety
 ///
-/// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw`, `previous` and `flags` (which may be null).
+/// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw`, `previous` and
+/// `flags` (which may be null).
 #[no_mangle]
 pub unsafe extern "C" fn gyrodrift_power_on_after(
     ctx: *mut GyrodriftContext,
@@ -344,7 +348,7 @@ pub unsafe extern "C" fn gyrodrift_power_off(ctx: *mut GyrodriftContext) -> Gyro
     unsafe { power_off::<DEFAULT_R, DEFAULT_A, DEFAULT_C>(ctx.cast()) }
 }
 
-/// [`gyrodrift_init`] for the large profile (`GyrodriftLargeContext`).
+/// [`gyrodrift_init`] for the large profile (`gyrodrift_large_context`).
 ///
 /// # Safety
 ///
@@ -359,7 +363,7 @@ pub unsafe extern "C" fn gyrodrift_large_init(
     unsafe { init::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), image, len) }
 }
 
-/// [`gyrodrift_power_on`] for the large profile (`GyrodriftLargeContext`).
+/// [`gyrodrift_power_on`] for the large profile (`gyrodrift_large_context`).
 ///
 /// # Safety
 ///
@@ -374,7 +378,7 @@ pub unsafe extern "C" fn gyrodrift_large_power_on(
     unsafe { power_on::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), switch_on_raw, None, flags) }
 }
 
-/// [`gyrodrift_power_on_after`] for the large profile (`GyrodriftLargeContext`).
+/// [`gyrodrift_power_on_after`] for the large profile (`gyrodrift_large_context`).
 ///
 /// # Safety
 ///
@@ -392,7 +396,7 @@ pub unsafe extern "C" fn gyrodrift_large_power_on_after(
     }
 }
 
-/// [`gyrodrift_correct`] for the large profile (`GyrodriftLargeContext`).
+/// [`gyrodrift_correct`] for the large profile (`gyrodrift_large_context`).
 ///
 /// # Safety
 ///
@@ -407,7 +411,7 @@ pub unsafe extern "C" fn gyrodrift_large_correct(
     unsafe { correct::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), sample, core::ptr::null(), output) }
 }
 
-/// [`gyrodrift_correct_with_aux`] for the large profile (`GyrodriftLargeContext`).
+/// [`gyrodrift_correct_with_aux`] for the large profile (`gyrodrift_large_context`).
 ///
 /// # Safety
 ///
@@ -426,7 +430,7 @@ pub unsafe extern "C" fn gyrodrift_large_correct_with_aux(
     unsafe { correct::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), sample, aux, output) }
 }
 
-/// [`gyrodrift_keep`] for the large profile (`GyrodriftLargeContext`).
+/// [`gyrodrift_keep`] for the large profile (`gyrodrift_large_context`).
 ///
 /// # Safety
 ///
@@ -440,7 +444,7 @@ pub unsafe extern "C" fn gyrodrift_large_keep(
     unsafe { keep::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), previous) }
 }
 
-/// [`gyrodrift_power_off`] for the large profile (`GyrodriftLargeContext`).
+/// [`gyrodrift_power_off`] for the large profile (`gyrodrift_large_context`).
 ///
 /// # Safety
 ///
