@@ -13,14 +13,17 @@ rustup show active-toolchain >/dev/null
 rustup component add rustfmt clippy llvm-tools >/dev/null 2>&1 || true
 rustup target add thumbv7em-none-eabihf >/dev/null
 
-step "system packages: qemu-system-arm (emulated Cortex-M4)"
-if ! command -v qemu-system-arm >/dev/null; then
+step "system packages: qemu-system-arm (emulated Cortex-M4), arm-none-eabi-gcc and newlib (the C example)"
+if ! command -v qemu-system-arm >/dev/null || ! command -v arm-none-eabi-gcc >/dev/null \
+    || [ ! -e /usr/lib/arm-none-eabi/newlib/thumb/v7e-m+fp/hard/librdimon_nano.a ]; then
     SUDO=""
     [ "$(id -u)" -eq 0 ] || SUDO="sudo"
     $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq qemu-system-arm >/dev/null
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq qemu-system-arm \
+        gcc-arm-none-eabi libnewlib-arm-none-eabi >/dev/null
 fi
 qemu-system-arm --version | head -n 1
+arm-none-eabi-gcc --version | head -n 1
 
 step "format"
 cargo fmt --all --check
@@ -32,9 +35,10 @@ python3 scripts/module-cycles.py
 step "clippy: host workspace, all targets and features"
 cargo clippy --workspace --all-targets --all-features --locked -- -D warnings
 
-step "clippy: drift-core for thumbv7em-none-eabihf, each feature set"
+step "clippy: drift-core for thumbv7em-none-eabihf, each feature set, and its C interface (no_std there)"
 cargo clippy -p drift-core --target thumbv7em-none-eabihf --locked -- -D warnings
 cargo clippy -p drift-core --target thumbv7em-none-eabihf --no-default-features --locked -- -D warnings
+cargo clippy -p drift-core-ffi --target thumbv7em-none-eabihf --locked -- -D warnings
 
 step "build: drift-core for thumbv7em-none-eabihf (release, no_std, no heap)"
 cargo build -p drift-core --target thumbv7em-none-eabihf --release --locked
@@ -61,6 +65,9 @@ step "firmware: clippy, build, and the shared test vectors on QEMU mps2-an386 (C
 
 step "firmware: without LTO, a minimal firmware links no panic or formatting code (llvm-nm) and keeps its empty tables in .bss"
 ./scripts/check-firmware-link.sh
+
+step "firmware in C: drift-core-ffi's static library (no LTO) and its C example replay the shared test vectors on QEMU, linking no panic or formatting code"
+./scripts/check-c-example.sh
 
 step "firmware: executed instructions per 3-axis sample, gated per model and rate (deterministic; ceilings in scripts/count-instructions.py, figures in docs/embedded.md)"
 python3 scripts/count-instructions.py --gate

@@ -1,11 +1,12 @@
 //! The firmware table image: a compact, checksummed binary form of a model.
 //!
-//! Layout of version 2, the one this build writes (all integers little-endian):
+//! Layout of version 3, the one this build writes (all integers little-endian; version 2's
+//! header):
 //!
 //! | offset | size | content |
 //! |---|---|---|
 //! | 0 | 4 | magic `GYDT` |
-//! | 4 | 2 | format version, 2 ([`FORMAT_VERSION`]) |
+//! | 4 | 2 | format version, 3 ([`FORMAT_VERSION`]) |
 //! | 6 | 1 | model kind ([`Kind`]) |
 //! | 7 | 1 | reserved, 0 |
 //! | 8 | 4 | payload length `n`, bytes |
@@ -19,8 +20,9 @@
 //! | 64 | n | the model, serialised by `postcard` (serde) |
 //! | 64 + n | 4 | CRC-32/ISO-HDLC of bytes `0 .. 64 + n` |
 //!
-//! Version 1 (still read) is the first 12 bytes of that header, then the payload at 12 and the CRC
-//! at `12 + n`; its payload is the same. The header is ours; the payload codec is postcard's (well
+//! Versions 1 and 2 are still read. Version 2 is the same header; its payload's settings lack
+//! their last field, `sample_rate_hz` (read as 0, not stated). Version 1 is the first 12 bytes of
+//! that header, then version 2's payload at 12 and the CRC at `12 + n`. The header is ours; the payload codec is postcard's (well
 //! kept, no_std, no alloc), so a change to a model's fields is a new version, and so is a change
 //! to the header.
 //!
@@ -41,6 +43,7 @@ mod error;
 mod header;
 mod in_place;
 mod layout;
+mod legacy;
 mod section;
 
 pub use section::{
@@ -50,13 +53,10 @@ pub use section::{
 pub use error::BlobError;
 pub use header::{Capacities, Header, Provenance};
 pub use layout::{
-    header_len, HEADER_LEN_V1, HEADER_LEN_V2, MAGIC, TOOL_VERSION_LEN, TRAILER_LEN, UNIT_ID_LEN,
-    VERSION_1, VERSION_2,
+    header_len, FORMAT_VERSION, HEADER_LEN_V1, HEADER_LEN_V2, MAGIC, TOOL_VERSION_LEN, TRAILER_LEN,
+    UNIT_ID_LEN, VERSION_1, VERSION_2, VERSION_3,
 };
 
-/// The image format version this build writes. It reads it and [`VERSION_1`]. Any change to the
-/// header or to the payload's shape (a model type's fields, in order) is a new version.
-pub const FORMAT_VERSION: u16 = VERSION_2;
 /// Bytes before the payload in the version this build writes.
 pub const HEADER_LEN: usize = HEADER_LEN_V2;
 
@@ -91,12 +91,12 @@ pub trait Image: Model + Serialize + DeserializeOwned {
         Capacities::NONE
     }
 
-    /// Decodes `payload` (exactly one model) into `place` and validates it: what [`decode_into`]
-    /// does after the header and CRC. The default decodes by value and assigns only a validated
-    /// model (`place` unchanged on error), which suits small models; the paper's tables write in
-    /// place instead.
-    fn payload_into(payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
-        *place = from_payload(payload)?;
+    /// Decodes a format-`version` `payload` (exactly one model) into `place` and validates it:
+    /// what [`decode_into`] does after the header and CRC. The default decodes by value and
+    /// assigns only a validated model (`place` unchanged on error), which suits small models; the
+    /// paper's tables write in place instead.
+    fn payload_into(version: u16, payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
+        *place = from_payload(version, payload)?;
         Ok(())
     }
 }
@@ -111,8 +111,9 @@ impl<const R: usize, const A: usize, const C: usize> Image for ModifiedTables<R,
 
     /// Field by field into `place`: the stack holds one curve at a time, never the tables. On
     /// error `place` is emptied (validation rejects it).
-    fn payload_into(payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
-        let decoded = in_place::fill_modified(place, payload)
+    fn payload_into(version: u16, payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
+        let decoded = legacy::payload(version, payload)
+            .and_then(|payload| in_place::fill_modified(place, payload))
             .map_err(BlobError::Malformed)
             .and_then(|()| place.validate().map_err(BlobError::Invalid));
         if decoded.is_err() {
@@ -132,8 +133,9 @@ impl<const R: usize, const A: usize, const C: usize> Image for RecommendedTables
 
     /// In place, as the paper's tables it holds (the same stack bound). On error `place` is
     /// emptied (validation rejects it).
-    fn payload_into(payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
-        let decoded = in_place::fill_exact(place, payload)
+    fn payload_into(version: u16, payload: &[u8], place: &mut Self) -> Result<(), BlobError> {
+        let decoded = legacy::payload(version, payload)
+            .and_then(|payload| in_place::fill_exact(place, payload))
             .map_err(BlobError::Malformed)
             .and_then(|()| place.validate().map_err(BlobError::Invalid));
         if decoded.is_err() {
@@ -179,9 +181,16 @@ fn needs_of<'a, const R: usize, const A: usize, const C: usize>(
 /// through `decode`'s frame (firmware decodes ~12-KB tables on a stack it must budget,
 /// docs/embedded.md).
 #[inline(never)]
-fn from_payload<M: Image>(payload: &[u8]) -> Result<M, BlobError> {
-    let (model, rest) = postcard::take_from_bytes::<M>(payload).map_err(BlobError::Malformed)?;
-    if !rest.is_empty() {
+fn from_payload<M: Image>(version: u16, payload: &[u8]) -> Result<M, BlobError> {
+    let mut deserializer = postcard::Deserializer::from_flavor(
+        legacy::payload(version, payload).map_err(BlobError::Malformed)?,
+    );
+    let model = M::deserialize(&mut deserializer).map_err(BlobError::Malformed)?;
+    if !deserializer
+        .finalize()
+        .map_err(BlobError::Malformed)?
+        .is_empty()
+    {
         return Err(BlobError::Malformed(
             postcard::Error::DeserializeBadEncoding,
         ));
@@ -205,7 +214,7 @@ pub fn encode<M: Image>(model: &M, buffer: &mut [u8]) -> Result<usize, BlobError
     encode_for(model, &Provenance::default(), buffer)
 }
 
-/// Encodes `model` into `buffer` as a version-2 image whose header carries the capacities it
+/// Encodes `model` into `buffer` as a [`FORMAT_VERSION`] image whose header carries the capacities it
 /// needs and `provenance`; returns the image's length. The model is validated first, so an image
 /// is never written from tables the firmware would reject.
 pub fn encode_for<M: Image>(
@@ -230,7 +239,7 @@ pub fn encode_for<M: Image>(
     let header = buffer
         .get_mut(..HEADER_LEN)
         .ok_or(BlobError::BufferTooSmall)?;
-    header::write_v2(header, M::KIND as u8, declared, &model.needs(), provenance);
+    header::write(header, M::KIND as u8, declared, &model.needs(), provenance);
     let crc = CRC32.checksum(buffer.get(..body_len).ok_or(BlobError::BufferTooSmall)?);
     let trailer = buffer
         .get_mut(body_len..total)
@@ -241,7 +250,7 @@ pub fn encode_for<M: Image>(
     Ok(total)
 }
 
-/// The header at the start of `bytes` (version 1 or 2), without checking the payload or the CRC:
+/// The header at the start of `bytes` (version 1, 2 or 3), without checking the payload or the CRC:
 /// which unit an image calibrates and what it needs, before decoding it.
 pub fn header(bytes: &[u8]) -> Result<Header, BlobError> {
     header::read(bytes)
@@ -278,7 +287,8 @@ pub fn image_len(bytes: &[u8]) -> Result<usize, BlobError> {
 /// Building the paper's tables by value takes several times their size in stack (serde's nested
 /// decoders): firmware decodes with [`decode_into`] instead, into a `static`.
 pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
-    from_payload(payload::<M>(bytes)?)
+    let (version, payload) = payload::<M>(bytes)?;
+    from_payload(version, payload)
 }
 
 /// Decodes and validates an image of model type `M` into `place`, the firmware way: the paper's
@@ -307,12 +317,13 @@ pub fn decode<M: Image>(bytes: &[u8]) -> Result<M, BlobError> {
 /// # Ok::<(), drift_core::blob::BlobError>(())
 /// ```
 pub fn decode_into<M: Image>(bytes: &[u8], place: &mut M) -> Result<(), BlobError> {
-    M::payload_into(payload::<M>(bytes)?, place)
+    let (version, payload) = payload::<M>(bytes)?;
+    M::payload_into(version, payload, place)
 }
 
-/// The payload of an image of model type `M`, after checking the header (its capacities against
-/// `M`'s), the length and the CRC.
-fn payload<M: Image>(bytes: &[u8]) -> Result<&[u8], BlobError> {
+/// The format version and payload of an image of model type `M`, after checking the header (its
+/// capacities against `M`'s), the length and the CRC.
+fn payload<M: Image>(bytes: &[u8]) -> Result<(u16, &[u8]), BlobError> {
     let header = match header::read_fixed(bytes) {
         // A header cut short is an image cut short: say how long the shortest image is.
         Err(BlobError::Truncated { .. }) if bytes.len() < HEADER_LEN_V1 + TRAILER_LEN => {
@@ -351,5 +362,5 @@ fn payload<M: Image>(bytes: &[u8]) -> Result<&[u8], BlobError> {
     if stored != computed {
         return Err(BlobError::CrcMismatch { stored, computed });
     }
-    Ok(body.get(header.len()..).unwrap_or_default())
+    Ok((header.version, body.get(header.len()..).unwrap_or_default()))
 }

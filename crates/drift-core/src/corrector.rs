@@ -21,6 +21,40 @@ pub struct Sample {
     pub temperature_raw: [f32; AXES],
 }
 
+impl Sample {
+    /// A sample from integer temperature counts, as a 16-bit sensor reports them;
+    /// [`MISSING_TEMPERATURE`](crate::MISSING_TEMPERATURE) on an axis means no reading this sample
+    /// (NaN: flagged `TEMPERATURE_INVALID`, the last good drift held). Every other count converts
+    /// exactly (`f32` holds every `i16`), so a count gives the same output as its float.
+    ///
+    /// ```
+    /// use drift_core::{Sample, MISSING_TEMPERATURE};
+    /// let sample = Sample::from_counts(250, [0.1, -0.2, 0.0], [6123, MISSING_TEMPERATURE, -40]);
+    /// assert_eq!(sample.temperature_raw[0], 6123.0);
+    /// assert!(sample.temperature_raw[1].is_nan());
+    /// ```
+    pub const fn from_counts(
+        since_power_on_ms: u32,
+        rate_dps: [f32; AXES],
+        temperature_counts: [i16; AXES],
+    ) -> Self {
+        let [x, y, z] = temperature_counts;
+        Self {
+            since_power_on_ms,
+            rate_dps,
+            temperature_raw: [count(x), count(y), count(z)],
+        }
+    }
+}
+
+const fn count(raw: i16) -> f32 {
+    if raw == crate::settings::MISSING_TEMPERATURE {
+        f32::NAN
+    } else {
+        raw as f32
+    }
+}
+
 /// The corrector's answer for one sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -102,6 +102,11 @@ pub enum Problem {
         /// The largest plausible magnitude, in the field's unit.
         limit: u16,
     },
+    /// A duration longer, at the stated sample rate, than the counter that holds it.
+    TooManySamples {
+        /// The most samples the counter holds.
+        limit: u16,
+    },
     /// A correlation beyond any gyro's, standing for a drift at its point (`k · rise`) larger
     /// than any gyro drifts.
     ImplausibleDrift {
@@ -161,6 +166,9 @@ impl fmt::Display for Error {
             Problem::Mismatch => f.write_str(": differs from the earlier entry it must equal"),
             Problem::Implausible { limit } => {
                 write!(f, ": magnitude beyond {limit}, implausible for a gyro")
+            }
+            Problem::TooManySamples { limit } => {
+                write!(f, ": more than {limit} samples at the sample rate given")
             }
             Problem::ImplausibleDrift { limit } => {
                 write!(

@@ -53,7 +53,7 @@ pub use polynomial::{
     RelativePolynomialTables, MAX_POLYNOMIAL_COEFFICIENTS,
 };
 pub use recommended::{RecommendedAxis, RecommendedTables, TurnOn};
-pub use settings::Settings;
+pub use settings::{SensorSettings, Settings, MISSING_TEMPERATURE};
 pub use stage::ambient::AmbientPosition;
 pub use stage::since_power_on::{Moment, Segment, SegmentKind};
 pub use stillness::{StillnessLearner, StillnessOutput, StillnessSettings};

@@ -9,6 +9,7 @@
 
 use drift_core::blob::{
     decode, decode_into, encode, header_len, Image, HEADER_LEN, HEADER_LEN_V1, TRAILER_LEN,
+    VERSION_3,
 };
 use drift_core::{Corrector, ModifiedTables, PolynomialTables, Sample};
 
@@ -57,8 +58,11 @@ fn check<M: Image + PartialEq + core::fmt::Debug + Default>(bytes: &[u8]) {
     // ignored, postcard accepts overlong varints), so several byte strings decode to one model.
     // The CRC still covers every byte. What must hold: the model survives encode → decode, and the
     // canonical image is never longer than the one decoded.
-    // A version-1 image is re-encoded behind the longer version-2 header.
-    let grown = HEADER_LEN - header_len(u16::from_le_bytes([bytes[4], bytes[5]]));
+    // A version-1 image is re-encoded behind the longer header, and a version-1 or -2 payload
+    // gains its settings' sample rate (an `f32`).
+    let version = u16::from_le_bytes([bytes[4], bytes[5]]);
+    let rate = if version < VERSION_3 { 4 } else { 0 };
+    let grown = HEADER_LEN - header_len(version) + rate;
     assert!(
         len <= bytes.len() + grown,
         "re-encoding is longer than the image"

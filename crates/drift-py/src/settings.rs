@@ -60,6 +60,7 @@ impl PySettings {
             stuck_after_samples: or_default(stuck_after_samples, d.stuck_after_samples, |v| {
                 args::count_u16("stuck_after_samples", v)
             })?,
+            ..d
         };
         settings.validate().map_err(Error::Table)?;
         Ok(Self(settings))

@@ -22,7 +22,7 @@ pub enum BlobError {
     },
     /// The first four bytes are `0xFF`: erased flash, no image was written there.
     Erased,
-    /// The format version is not one this build reads ([`VERSION_1`], [`VERSION_2`]).
+    /// The format version is not one this build reads ([`VERSION_1`], [`VERSION_2`], [`VERSION_3`](super::VERSION_3)).
     UnsupportedVersion {
         /// The version found.
         found: u16,

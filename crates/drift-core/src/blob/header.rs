@@ -1,13 +1,14 @@
-//! The image's fixed header, both versions: what it says (kind, payload length and, from version 2,
-//! the capacities the model needs and where the image comes from), read without the payload, and
-//! written. Layouts: the `blob` module's documentation.
+//! The image's fixed header, every version (2 and 3 share one layout): what it says (kind, payload
+//! length and, from version 2, the capacities the model needs and where the image comes from),
+//! read without the payload, and written. Layouts: the `blob` module's documentation.
 
 use heapless::String;
 
 use super::error::BlobError;
 use super::layout::{
-    array, header_len, le_u16, le_u32, CAPACITIES_AT, DATE_AT, HEADER_LEN_V1, KIND_AT, MAGIC,
-    PAYLOAD_LEN_AT, TOOL_AT, TOOL_VERSION_LEN, TRAILER_LEN, UNIT_AT, UNIT_ID_LEN, VERSION_2,
+    array, header_len, le_u16, le_u32, CAPACITIES_AT, DATE_AT, FORMAT_VERSION, HEADER_LEN_V1,
+    KIND_AT, MAGIC, PAYLOAD_LEN_AT, TOOL_AT, TOOL_VERSION_LEN, TRAILER_LEN, UNIT_AT, UNIT_ID_LEN,
+    VERSION_2,
 };
 
 /// How many entries of each table dimension a model holds: what a firmware's capacities (the
@@ -109,7 +110,8 @@ fn text<const N: usize>(value: &str, field: &'static str) -> Result<String<N>, B
 /// An image's header, read without its payload ([`header`](super::header)).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Header {
-    /// Format version, [`VERSION_1`](super::VERSION_1) or [`VERSION_2`].
+    /// Format version, [`VERSION_1`](super::VERSION_1), [`VERSION_2`] or
+    /// [`VERSION_3`](super::VERSION_3).
     pub version: u16,
     /// Model kind byte ([`Kind`](super::Kind)).
     pub kind: u8,
@@ -144,7 +146,7 @@ impl Header {
 /// provenance's text.
 pub(super) fn read(bytes: &[u8]) -> Result<Header, BlobError> {
     let mut header = read_fixed(bytes)?;
-    if header.version == VERSION_2 {
+    if header.version >= VERSION_2 {
         header.provenance = Provenance {
             unit_id: label(bytes, UNIT_AT, "unit ID")?,
             tool_version: label(bytes, TOOL_AT, "tool version")?,
@@ -186,7 +188,7 @@ pub(super) fn read_fixed(bytes: &[u8]) -> Result<Header, BlobError> {
         needs: None,
         provenance: Provenance::default(),
     };
-    if version == VERSION_2 {
+    if version >= VERSION_2 {
         header.needs = Some(Capacities {
             reference_times: le_u16(bytes, CAPACITIES_AT),
             ambients: le_u16(bytes, CAPACITIES_AT.saturating_add(2)),
@@ -210,8 +212,9 @@ fn label<const N: usize>(
         .ok_or(BlobError::BadHeader { field })
 }
 
-/// Writes a version-2 header into `out` (exactly [`HEADER_LEN_V2`] bytes).
-pub(super) fn write_v2(
+/// Writes the header of the version this build writes ([`FORMAT_VERSION`],
+/// version 2's layout) into `out` (exactly [`HEADER_LEN_V2`] bytes).
+pub(super) fn write(
     out: &mut [u8],
     kind: u8,
     payload_len: u32,
@@ -221,7 +224,7 @@ pub(super) fn write_v2(
     out.fill(0);
     let fields: [(usize, &[u8]); 10] = [
         (0, &MAGIC),
-        (4, &VERSION_2.to_le_bytes()),
+        (4, &FORMAT_VERSION.to_le_bytes()),
         (KIND_AT, &[kind]),
         (PAYLOAD_LEN_AT, &payload_len.to_le_bytes()),
         (CAPACITIES_AT, &needs.reference_times.to_le_bytes()),

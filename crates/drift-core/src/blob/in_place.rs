@@ -11,6 +11,7 @@ use heapless::Vec;
 use serde::de::{self, DeserializeSeed, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 
+use super::legacy::Spliced;
 use crate::recommended::{RecommendedAxis, RecommendedTables};
 use crate::table::{AmbientCurves, AxisTable, ModifiedTables};
 use crate::AXES;
@@ -200,7 +201,7 @@ impl<T: Fill + Default, const N: usize> Fill for Vec<T, N> {
 /// written; the caller empties it.
 pub(super) fn fill_modified<const R: usize, const A: usize, const C: usize>(
     place: &mut ModifiedTables<R, A, C>,
-    payload: &[u8],
+    payload: Spliced<'_>,
 ) -> Result<(), postcard::Error> {
     fill_exact(place, payload)
 }
@@ -208,8 +209,11 @@ pub(super) fn fill_modified<const R: usize, const A: usize, const C: usize>(
 /// Fills `place` from `payload`, which must hold exactly one value of its type. On error `place`
 /// is partly written; the caller empties it.
 #[allow(private_bounds)]
-pub(super) fn fill_exact<T: Fill>(place: &mut T, payload: &[u8]) -> Result<(), postcard::Error> {
-    let mut deserializer = postcard::Deserializer::from_bytes(payload);
+pub(super) fn fill_exact<T: Fill>(
+    place: &mut T,
+    payload: Spliced<'_>,
+) -> Result<(), postcard::Error> {
+    let mut deserializer = postcard::Deserializer::from_flavor(payload);
     place.fill(&mut deserializer)?;
     if deserializer.finalize()?.is_empty() {
         Ok(())

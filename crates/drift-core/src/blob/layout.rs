@@ -8,9 +8,16 @@ pub const VERSION_1: u16 = 1;
 /// Version 2 adds the capacities the model needs, the unit's ID, the tool's version and the date
 /// (64 bytes).
 pub const VERSION_2: u16 = 2;
+/// Version 3 has version 2's header; its payload's settings end with `sample_rate_hz`
+/// (versions 1 and 2 read as 0, not stated).
+pub const VERSION_3: u16 = 3;
+/// The image format version this build writes. It reads it, [`VERSION_2`] and [`VERSION_1`]. Any
+/// change to the header or to the payload's shape (a model type's fields, in order) is a new
+/// version.
+pub const FORMAT_VERSION: u16 = VERSION_3;
 /// Header length of a version-1 image.
 pub const HEADER_LEN_V1: usize = 12;
-/// Header length of a version-2 image.
+/// Header length of a version-2 or -3 image.
 pub const HEADER_LEN_V2: usize = 64;
 /// Bytes after the payload (the CRC).
 pub const TRAILER_LEN: usize = 4;
@@ -30,7 +37,7 @@ pub(super) const UNIT_AT: usize = 40;
 pub fn header_len(version: u16) -> usize {
     match version {
         VERSION_1 => HEADER_LEN_V1,
-        VERSION_2 => HEADER_LEN_V2,
+        VERSION_2 | VERSION_3 => HEADER_LEN_V2,
         _ => 0,
     }
 }

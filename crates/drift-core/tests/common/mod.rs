@@ -21,3 +21,5 @@ pub mod cases;
 pub mod fixture;
 #[cfg(feature = "serde")]
 pub mod format;
+#[cfg(feature = "serde")]
+pub mod legacy;
