@@ -79,7 +79,7 @@ impl Envelope {
 #[inline]
 pub fn heat_beyond(most: f32, switch_on: &SwitchOn) -> Option<f32> {
     let heat = switch_on.residual_heat_celsius;
-    (switch_on.known && heat > 0.0 && heat > most).then(|| heat - most)
+    (switch_on.known && heat > 0.0 && heat > most).then_some(heat - most)
 }
 
 impl TurnOn {
