@@ -58,11 +58,12 @@ pub fn section(units: &[UnitUncertainty]) -> String {
     let _ = writeln!(
         md,
         "\nσ at the knots, m°/s (linear between them, held after the last; plus the growth per °C \
-         of switch-on ambient outside the envelope):\n"
+         of switch-on ambient outside the envelope and per °C of residual heat beyond the \
+         calibration's most, per axis X / Y / Z):\n"
     );
     let _ = writeln!(
         md,
-        "| unit | class | {} | envelope | outside, m°/s per °C |\n|---|---|{}---|---:|",
+        "| unit | class | {} | envelope | outside, m°/s per °C | most residual heat | beyond, m°/s per °C |\n|---|---|{}---|---:|---|---:|",
         header.join(" | "),
         "---:|".repeat(header.len())
     );
@@ -75,13 +76,17 @@ pub fn section(units: &[UnitUncertainty]) -> String {
                 .collect();
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {}–{} °C | {:.3} |",
+                "| {} | {} | {} | {}–{} °C | {:.3} | {} °C | {:.3} |",
                 unit.unit_id,
                 class.name(),
                 values.join(" | "),
                 s.ambient_min_celsius,
                 s.ambient_max_celsius,
-                s.per_celsius_outside_dps * 1000.0
+                s.per_celsius_outside_dps * 1000.0,
+                s.most_residual_heat_celsius
+                    .map(|h| format!("{h:.2}"))
+                    .join(" / "),
+                s.per_residual_celsius_beyond_dps * 1000.0
             );
         }
     }

@@ -576,6 +576,12 @@ class Uncertainty:
     @property
     def per_celsius_outside_dps(self) -> float:
         """Growth of σ per °C of switch-on ambient outside the envelope, °/s."""
+    @property
+    def most_residual_heat_celsius(self) -> list[float]:
+        """The most residual heat a calibration activation switched on with, per axis, °C."""
+    @property
+    def per_residual_celsius_beyond_dps(self) -> float:
+        """Growth of σ per °C of residual heat beyond the most, °/s."""
     def sigma(
         self,
         since_power_on_ms: NDArray[np.uint32],
