@@ -206,12 +206,27 @@ pub struct Coverage {
     pub samples: usize,
     /// Of them, within ±2σ(t).
     pub inside: usize,
+    /// Of the samples, those of activation × axis pairs outside the calibrated envelope, where σ
+    /// widens (ambient outside the set points, residual heat beyond the calibration's most).
+    pub widened_samples: usize,
+    /// Of them, within ±2σ(t).
+    pub widened_inside: usize,
 }
 
 impl Coverage {
     /// The share within ±2σ (NaN for no samples).
     pub fn share(&self) -> f64 {
         self.inside as f64 / self.samples as f64
+    }
+
+    /// The share within ±2σ where σ widens (NaN for no samples).
+    pub fn widened_share(&self) -> f64 {
+        self.widened_inside as f64 / self.widened_samples as f64
+    }
+
+    /// The share within ±2σ inside the envelope (NaN for no samples).
+    pub fn unwidened_share(&self) -> f64 {
+        (self.inside - self.widened_inside) as f64 / (self.samples - self.widened_samples) as f64
     }
 }
 
@@ -226,6 +241,8 @@ pub fn coverage(
         axis_activations: 0,
         samples: 0,
         inside: 0,
+        widened_samples: 0,
+        widened_inside: 0,
     });
     for r in held_out {
         let state: SigmaState = uncertainty.start(&r.switch_on);
@@ -234,10 +251,21 @@ pub fn coverage(
         }
         for &(ms, residual) in &r.samples {
             let sigma = uncertainty.sigma_dps(&state, ms);
-            for ((class, value), sigma) in state.class.iter().zip(residual).zip(sigma) {
+            for (((class, value), sigma), widening) in state
+                .class
+                .iter()
+                .zip(residual)
+                .zip(sigma)
+                .zip(state.widening_dps)
+            {
                 let cell = &mut out[*class as usize];
+                let within = usize::from(value.abs() <= 2.0 * sigma);
                 cell.samples += 1;
-                cell.inside += usize::from(value.abs() <= 2.0 * sigma);
+                cell.inside += within;
+                if widening > 0.0 {
+                    cell.widened_samples += 1;
+                    cell.widened_inside += within;
+                }
             }
         }
     }
@@ -387,6 +415,7 @@ mod tests {
         for cell in coverage(&u, &held_out) {
             assert_eq!(cell.axis_activations, 30, "{cell:?}");
             assert!((0.93..=0.97).contains(&cell.share()), "{cell:?}");
+            assert_eq!(cell.widened_samples, 0, "inside the envelope: {cell:?}");
         }
     }
 
