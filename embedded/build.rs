@@ -12,6 +12,10 @@ mod format;
 #[allow(dead_code)]
 mod sigma_format;
 
+#[path = "../crates/drift-core/tests/common/stillness_format.rs"]
+#[allow(dead_code)]
+mod stillness_format;
+
 fn unhex(hex: &str) -> Vec<u8> {
     (0..hex.len())
         .step_by(2)
@@ -79,6 +83,30 @@ fn main() {
             code,
             "SigmaCase {{ name: {:?}, switch_on_celsius: {:?}, previous: {:?}, times_ms: &{:?}, expected: &{:?} }},",
             case.name, case.switch_on_celsius, case.previous, case.times_ms, case.expected
+        )
+        .unwrap();
+    }
+    writeln!(code, "];").unwrap();
+
+    println!("cargo:rerun-if-changed=../testdata/stillness-vectors.json");
+    let text = std::fs::read_to_string("../testdata/stillness-vectors.json")
+        .expect("testdata/stillness-vectors.json");
+    let stillness: stillness_format::StillnessVectors =
+        serde_json::from_str(&text).expect("stillness vector file");
+    writeln!(code, "pub static STILLNESS_CASES: &[StillnessCase] = &[").unwrap();
+    for case in &stillness.cases {
+        writeln!(
+            code,
+            "StillnessCase {{ name: {:?}, settings: {:?}, start_offset: {:?}, accel_every: {}, accel: &{:?}, rate: &{:?}, expected: &{:?}, states: &{:?}, final_offset: {:?} }},",
+            case.name,
+            case.settings,
+            case.start_offset,
+            case.accel_every,
+            case.accel,
+            case.rate,
+            case.expected,
+            case.states,
+            case.final_offset
         )
         .unwrap();
     }

@@ -80,6 +80,11 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     let (out, text) = check(&campaign, &tables, &report, &[]);
     assert!(out.status.success(), "{text}");
     assert!(text.contains("| GIU-02 | Z | 40 |"), "{text}");
+    // The share outside the calibrated envelope, per unit, over activations × axes and samples.
+    assert!(
+        text.contains("GIU-02: outside the calibrated envelope: ") && text.contains(" of 120), "),
+        "{text}"
+    );
     let own = verdicts(&report.join("check.json"));
     assert_eq!(own.len(), 6);
     assert!(own.iter().all(|(_, passed)| *passed), "{own:?}");

@@ -105,6 +105,26 @@ fn simulate_fit_and_report_from_the_command_line() {
     )
     .unwrap();
     assert_eq!(drift_core::blob::decode_section(&section).unwrap(), json);
+    // The coverage map: a figure per unit, every calibration activation in a cell, and the
+    // validation data's share outside the envelope.
+    assert!(md.contains("## Coverage of the calibration"), "{md}");
+    assert!(report.join("fig-coverage-GIU-01.svg").exists());
+    let coverage: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report.join("coverage.json")).unwrap()).unwrap();
+    let unit = &coverage[0];
+    let in_cells: u64 = unit["cells"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["calibration_activations"].as_u64().unwrap())
+        .sum();
+    assert_eq!(
+        in_cells,
+        unit["calibration_activations"].as_u64().unwrap(),
+        "{unit}"
+    );
+    assert!(in_cells > 0, "{unit}");
+    assert_eq!(unit["outside"][0]["split"], "validation", "{unit}");
     // The headline names the best baseline; the absolute error stands beside the drift, its
     // flags on the first page, before the paper's table.
     assert!(md.contains("best baseline / modified"), "{md}");

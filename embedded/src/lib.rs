@@ -2,7 +2,10 @@
 //! a stack-use probe.
 #![no_std]
 
-use drift_core::{ModifiedTables, Previous, RecommendedTables, SwitchOn, Uncertainty};
+use drift_core::{
+    ModifiedTables, Previous, RecommendedTables, StillnessLearner, StillnessSettings, SwitchOn,
+    Uncertainty,
+};
 
 pub mod stack;
 
@@ -82,6 +85,71 @@ impl SigmaCase {
         for (i, &ms) in self.times_ms.iter().enumerate() {
             each(i, uncertainty.sigma_dps(&state, ms).map(f32::to_bits));
         }
+    }
+}
+
+/// One stillness-learner test-vector case (see `testdata/stillness-vectors.json`).
+pub struct StillnessCase {
+    /// Case name.
+    pub name: &'static str,
+    /// `StillnessSettings` in field order, f32 bits.
+    pub settings: [u32; 8],
+    /// The offset the learner starts from, °/s (f32 bits).
+    pub start_offset: [u32; 3],
+    /// An accelerometer reading before every `accel_every`-th gyro sample; 0: none.
+    pub accel_every: u32,
+    /// Accelerometer readings, g (f32 bits).
+    pub accel: &'static [[u32; 3]],
+    /// Gyro samples, °/s (f32 bits).
+    pub rate: &'static [[u32; 3]],
+    /// Per gyro sample, the rate less the learned offset (f32 bits).
+    pub expected: &'static [[u32; 3]],
+    /// Per gyro sample: bit 0 still, bit 1 learning.
+    pub states: &'static [u8],
+    /// The offset learned after the last sample (f32 bits).
+    pub final_offset: [u32; 3],
+}
+
+impl StillnessCase {
+    /// The learner's settings.
+    pub fn settings(&self) -> StillnessSettings {
+        let [sample_rate_hz, accel_rate_hz, rate_threshold_dps, rate_sd_threshold_dps, accel_sd_threshold_g, variance_time_constant_s, still_for_s, time_constant_s] =
+            self.settings.map(f32::from_bits);
+        StillnessSettings {
+            sample_rate_hz,
+            accel_rate_hz,
+            rate_threshold_dps,
+            rate_sd_threshold_dps,
+            accel_sd_threshold_g,
+            variance_time_constant_s,
+            still_for_s,
+            time_constant_s,
+        }
+    }
+
+    /// Runs the learner over the case's inputs as firmware would: `each(i, rate bits, states)`
+    /// per gyro sample; returns the final offset's bits, or `None` if the settings or the start
+    /// offset are refused.
+    pub fn run(&self, mut each: impl FnMut(usize, [u32; 3], u8)) -> Option<[u32; 3]> {
+        let mut learner = StillnessLearner::new(&self.settings()).ok()?;
+        learner
+            .set_offset(self.start_offset.map(f32::from_bits))
+            .ok()?;
+        let mut accel = self.accel.iter();
+        for (i, rate) in self.rate.iter().enumerate() {
+            if self.accel_every > 0 && (i as u32) % self.accel_every == 0 {
+                if let Some(a) = accel.next() {
+                    learner.accelerometer(a.map(f32::from_bits));
+                }
+            }
+            let out = learner.update(rate.map(f32::from_bits));
+            each(
+                i,
+                out.rate_dps.map(f32::to_bits),
+                u8::from(out.still) | (u8::from(out.learning) << 1),
+            );
+        }
+        Some(learner.offset_dps().map(f32::to_bits))
     }
 }
 

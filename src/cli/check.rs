@@ -217,6 +217,38 @@ fn table(results: &[UnitResult]) -> String {
     md
 }
 
+/// Per unit, the share of the checked data outside the calibrated envelope (switch-on
+/// temperature or residual heat beyond the calibration's, as the corrector flags it), over
+/// activations × axes and over samples: there the check measures the envelope as much as the
+/// tables.
+fn outside_envelope(results: &[UnitResult]) -> String {
+    let mut out = String::new();
+    for unit in results {
+        let (mut pairs, mut pairs_out, mut samples, mut samples_out) = (0, 0, 0, 0);
+        for v in &unit.axes {
+            pairs += v.activations;
+            pairs_out += v.outside_envelope;
+            samples += v.samples;
+            samples_out += v.outside_envelope_samples;
+        }
+        let share = |part: usize, whole: usize| {
+            if whole == 0 {
+                "–".to_owned()
+            } else {
+                format!("{:.1} %", 100.0 * part as f64 / whole as f64)
+            }
+        };
+        let _ = writeln!(
+            out,
+            "{}: outside the calibrated envelope: {} of activations × axes ({pairs_out} of {pairs}), {} of samples",
+            unit.unit_id,
+            share(pairs_out, pairs),
+            share(samples_out, samples)
+        );
+    }
+    out
+}
+
 /// `check.md`: what was checked against which limits, the table, what its columns mean.
 fn markdown(results: &[UnitResult], limits: &Limits) -> String {
     let mut md = format!(
@@ -226,7 +258,8 @@ fn markdown(results: &[UnitResult], limits: &Limits) -> String {
         100.0 * limits.min_removed
     );
     md.push_str(&table(results));
-    md.push_str("\nThe flag columns count activations: switched on outside the calibrated ambients, rise outside the stored curves (both clamped), running past the last reference time (`k` held), as the corrector documents; \"faults\" counts activations with a sensor or table fault flag. An activation outside the envelope measures the envelope as much as the tables.\n");
+    md.push_str("\nThe flag columns count activations: switched on outside the calibrated ambients, rise outside the stored curves (both clamped), running past the last reference time (`k` held), as the corrector documents; \"faults\" counts activations with a sensor or table fault flag. An activation outside the envelope measures the envelope as much as the tables.\n\n");
+    md.push_str(&outside_envelope(results));
     md
 }
 
@@ -291,6 +324,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     write_atomic(&staged.path().join("check.md"), md.as_bytes())?;
     staged.commit()?;
     print!("{}", table(&results));
+    print!("{}", outside_envelope(&results));
     if let Some(note) = &note {
         println!("in-sample: {note}");
     }

@@ -20,6 +20,7 @@ extern crate std;
 #[cfg(feature = "serde")]
 pub mod blob;
 mod corrector;
+mod envelope;
 mod error;
 mod extension;
 mod flags;
@@ -39,6 +40,7 @@ mod warm_start;
 pub use corrector::{
     AxisState, Corrector, CorrectorState, Output, Sample, MAX_PLAUSIBLE_DRIFT_DPS,
 };
+pub use envelope::Envelope;
 pub use error::{Error, Location, Problem};
 pub use extension::{
     Extension, ExtensionState, ExtraTerm, SwitchOnRate, Term, TermInputs, TermValues, AUX_INPUTS,

@@ -45,18 +45,16 @@ impl TurnOn {
     /// history is unknown (taken as fully cooled, flagged where the heat would have mattered).
     #[inline]
     pub fn bias(&self, settings: &Settings, switch_on: &SwitchOn) -> (f32, Flags) {
-        let (q, outside) = self
+        let (q, _) = self
             .polynomial
             .continued(switch_on.switch_on_celsius, settings.ambient_margin_celsius);
-        let mut flags = if outside {
-            Flags::TEMPERATURE_OUT_OF_RANGE
-        } else {
-            Flags::NONE
-        };
+        // The envelope's flags; the heat beyond its most is held there.
+        let mut flags = self
+            .envelope(settings.ambient_margin_celsius)
+            .flags(switch_on);
         let heat = switch_on.residual_heat_celsius;
         let warm = if switch_on.known && heat > 0.0 {
             let held = if heat > self.most_residual_heat_celsius {
-                flags |= Flags::HISTORY_OUT_OF_SPAN;
                 self.most_residual_heat_celsius
             } else {
                 heat

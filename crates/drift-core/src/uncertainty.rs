@@ -18,6 +18,8 @@
 //!     ambient_min_celsius: 30.0,
 //!     ambient_max_celsius: 40.0,
 //!     per_celsius_outside_dps: 0.0005,
+//!     most_residual_heat_celsius: [6.0; 3],
+//!     per_residual_celsius_beyond_dps: 0.001,
 //! };
 //! sigma.validate()?;
 //! // At switch-on, before `power_on_after` overwrites what was kept: 34 °C after an activation
@@ -29,6 +31,7 @@
 //! # Ok::<(), drift_core::Error>(())
 //! ```
 
+use crate::envelope::heat_beyond;
 use crate::error::{Error, Location, Problem};
 use crate::history::SwitchOn;
 use crate::AXES;
@@ -66,11 +69,13 @@ impl ActivationClass {
     }
 }
 
-/// The fitted σ(t) of one unit (every axis): 8 knots × 2 classes plus the envelope, 92 bytes.
+/// The fitted σ(t) of one unit (every axis): 8 knots × 2 classes plus the envelope, 108 bytes.
 ///
 /// σ(t) = the class's piecewise-linear curve through (`knots_ms`, `sigma_dps[class]`) at the time
 /// since switch-on (held after the last knot) + `per_celsius_outside_dps` × how far the switch-on
-/// ambient lies outside `ambient_min_celsius ..= ambient_max_celsius`, °C.
+/// ambient lies outside `ambient_min_celsius ..= ambient_max_celsius`, °C +
+/// `per_residual_celsius_beyond_dps` × how far the residual heat at switch-on lies beyond the
+/// axis's `most_residual_heat_celsius`, °C.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
@@ -88,9 +93,17 @@ pub struct Uncertainty {
     pub ambient_max_celsius: f32,
     /// What σ grows by per °C of ambient outside the envelope, °/s per °C.
     pub per_celsius_outside_dps: f32,
+    /// Per axis, the most residual heat a calibration activation switched on with, °C: the
+    /// tables' envelope ([`crate::Envelope::most_residual_heat_celsius`]); the corrector holds a
+    /// larger heat there and flags it `HISTORY_OUT_OF_SPAN`.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub most_residual_heat_celsius: [f32; AXES],
+    /// What σ grows by per °C of residual heat beyond the most, °/s per °C.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub per_residual_celsius_beyond_dps: f32,
 }
 
-/// What [`Uncertainty::start`] decided at switch-on, per axis: plain data, 24 bytes.
+/// What [`Uncertainty::start`] decided at switch-on, per axis: plain data, 28 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SigmaState {
@@ -98,6 +111,9 @@ pub struct SigmaState {
     pub class: [ActivationClass; AXES],
     /// How far the switch-on ambient lies outside the envelope per axis, °C (0 inside).
     pub outside_celsius: [f32; AXES],
+    /// What σ grows by for the whole activation per axis, °/s: outside the ambients and beyond
+    /// the residual heats of the calibration.
+    pub widening_dps: [f32; AXES],
 }
 
 impl Uncertainty {
@@ -133,6 +149,14 @@ impl Uncertainty {
             Location::default(),
             self.per_celsius_outside_dps,
         )?;
+        non_negative(
+            "per_residual_celsius_beyond_dps",
+            Location::default(),
+            self.per_residual_celsius_beyond_dps,
+        )?;
+        for (axis, &most) in self.most_residual_heat_celsius.iter().enumerate() {
+            non_negative("most_residual_heat_celsius", Location::axis(axis), most)?;
+        }
         for (field, value) in [
             ("ambient_min_celsius", self.ambient_min_celsius),
             ("ambient_max_celsius", self.ambient_max_celsius),
@@ -174,15 +198,20 @@ impl Uncertainty {
     /// The state for an activation from each axis's switch-on: call it at switch-on with the
     /// estimates `power_on_after` makes (`SwitchOn::estimate` of the switch-on temperature and
     /// what was kept, before `power_on_after` overwrites it).
+    #[allow(clippy::arithmetic_side_effects)] // f32 arithmetic: no overflow panic.
     pub fn start(&self, switch_on: &[SwitchOn; AXES]) -> SigmaState {
         let mut state = SigmaState::default();
-        for ((class, outside), switch_on) in state
+        for (((class, outside), widening), (switch_on, &most)) in state
             .class
             .iter_mut()
             .zip(&mut state.outside_celsius)
-            .zip(switch_on)
+            .zip(&mut state.widening_dps)
+            .zip(switch_on.iter().zip(&self.most_residual_heat_celsius))
         {
             (*class, *outside) = self.classify(switch_on);
+            let beyond = heat_beyond(most, switch_on).unwrap_or(0.0);
+            *widening = self.per_celsius_outside_dps * *outside
+                + self.per_residual_celsius_beyond_dps * beyond;
         }
         state
     }
@@ -194,8 +223,7 @@ impl Uncertainty {
     pub fn sigma_dps(&self, state: &SigmaState, since_power_on_ms: u32) -> [f32; AXES] {
         let (k, fraction) = position(&self.knots_ms, since_power_on_ms);
         let mut out = [0.0; AXES];
-        for ((sigma, class), outside) in out.iter_mut().zip(state.class).zip(state.outside_celsius)
-        {
+        for ((sigma, class), widening) in out.iter_mut().zip(state.class).zip(state.widening_dps) {
             let curve = match class {
                 ActivationClass::Cold => &self.sigma_dps[0],
                 ActivationClass::WarmRestart => &self.sigma_dps[1],
@@ -208,7 +236,7 @@ impl Uncertainty {
                 }
                 None => v0,
             };
-            *sigma = along + self.per_celsius_outside_dps * outside;
+            *sigma = along + widening;
         }
         out
     }
@@ -259,6 +287,8 @@ mod tests {
             ambient_min_celsius: 30.0,
             ambient_max_celsius: 40.0,
             per_celsius_outside_dps: 0.001,
+            most_residual_heat_celsius: [3.0, 3.0, 1.0],
+            per_residual_celsius_beyond_dps: 0.002,
         }
     }
 
@@ -312,6 +342,29 @@ mod tests {
     }
 
     #[test]
+    fn sigma_grows_beyond_the_calibrated_residual_heat_only() {
+        let u = example();
+        // Heats 2, 5 and 1.5 °C against the most 3, 3 and 1 °C: inside, 2 °C and 0.5 °C beyond.
+        let state = u.start(&[
+            switch_on(33.0, 2.0),
+            switch_on(33.0, 5.0),
+            switch_on(33.0, 1.5),
+        ]);
+        let sigma = u.sigma_dps(&state, 200_000);
+        assert_eq!(sigma[0], 0.001);
+        assert!((sigma[1] - 0.005).abs() < 1e-7, "{sigma:?}");
+        assert!((sigma[2] - 0.002).abs() < 1e-7, "{sigma:?}");
+        let mut unknown = switch_on(33.0, 5.0);
+        unknown.known = false;
+        let state = u.start(&[unknown; 3]);
+        assert_eq!(
+            u.sigma_dps(&state, 200_000),
+            [0.001; 3],
+            "nothing kept: no heat"
+        );
+    }
+
+    #[test]
     fn invalid_values_are_named() {
         let mut u = example();
         u.knots_ms[3] = u.knots_ms[2];
@@ -325,6 +378,18 @@ mod tests {
         let mut u = example();
         u.ambient_max_celsius = 20.0;
         assert_eq!(u.validate().unwrap_err().field, "ambient_max_celsius");
+        let mut u = example();
+        u.most_residual_heat_celsius[2] = -1.0;
+        assert_eq!(
+            u.validate().unwrap_err().field,
+            "most_residual_heat_celsius"
+        );
+        let mut u = example();
+        u.per_residual_celsius_beyond_dps = f32::INFINITY;
+        assert_eq!(
+            u.validate().unwrap_err().field,
+            "per_residual_celsius_beyond_dps"
+        );
     }
 
     #[test]

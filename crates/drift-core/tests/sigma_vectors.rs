@@ -36,6 +36,8 @@ fn uncertainty() -> Uncertainty {
         ambient_min_celsius: 30.0,
         ambient_max_celsius: 40.0,
         per_celsius_outside_dps: 0.000_37,
+        most_residual_heat_celsius: [4.5, 5.0, 4.25],
+        per_residual_celsius_beyond_dps: 0.001_23,
     }
 }
 
@@ -104,7 +106,7 @@ fn build() -> SigmaVectors {
     section.truncate(n);
     let bits = |v: [f32; 3]| v.map(f32::to_bits);
     let previous = |ambient: f32, off: f32| Some([[ambient.to_bits(), off.to_bits()]; 3]);
-    let cases: [(&str, [u32; 3], Kept); 6] = [
+    let cases: [(&str, [u32; 3], Kept); 7] = [
         ("cold inside the envelope", bits([33.0, 33.25, 32.9]), None),
         (
             "warm restart, 4 °C residual heat",
@@ -125,6 +127,11 @@ fn build() -> SigmaVectors {
             "warm restart outside the envelope",
             bits([45.0, 45.0, 45.0]),
             previous(42.0, 48.0),
+        ),
+        (
+            "warm restart beyond the calibrated residual heat",
+            bits([40.0, 41.3, 39.2]),
+            previous(30.0, 45.0),
         ),
         (
             "no temperature at switch-on",

@@ -8,10 +8,10 @@
 //! One pass, recording by recording: [`UnitCheck::add`] corrects one activation and keeps only its
 //! figures, so a long campaign is checked in the memory of one recording.
 
-use drift_core::{Flags, Model, Previous, Term};
+use drift_core::{Envelope, Flags, Model, Previous, Term};
 use drift_recording::{Segment, SegmentLabels};
 
-use crate::evaluate::{cooled_before, correct_segment_after, kept_after, metric, switch_on_raw};
+use crate::evaluate::{cooled_before, correct_segment_counting, kept_after, metric, switch_on_raw};
 use drift_fit::settings::FitSettings;
 
 /// What a calibration must still achieve on the recordings checked. Every figure is a mean over
@@ -89,6 +89,11 @@ pub struct CheckedActivation {
     pub residual_rms_dps: [f64; 3],
     /// Union of the corrector's flags over the activation, per axis.
     pub flags: [u16; 3],
+    /// Samples in the activation.
+    pub samples: usize,
+    /// Per axis, samples the corrector flagged outside the calibrated envelope
+    /// ([`Envelope::FLAGS`]).
+    pub outside_envelope_samples: [usize; 3],
 }
 
 /// The verdict for one axis of one unit.
@@ -118,6 +123,13 @@ pub struct AxisVerdict {
     /// Tables keyed by history: activations that started with nothing kept of the previous one
     /// or with a residual heat beyond the stored histories (a cold start was taken).
     pub history_unknown_or_out_of_span: usize,
+    /// Activations the corrector flagged outside the calibrated envelope ([`Envelope::FLAGS`]:
+    /// the switch-on temperature or residual heat beyond the calibration's) on some sample.
+    pub outside_envelope: usize,
+    /// Samples checked.
+    pub samples: usize,
+    /// Of them, flagged outside the calibrated envelope.
+    pub outside_envelope_samples: usize,
     /// Activations with a fault flag (sensor or tables).
     pub faulty: usize,
     /// Why the axis fails the limits; empty when it passes.
@@ -188,8 +200,13 @@ impl<M: Model> UnitCheck<M> {
         if cooled_before(segment, &self.settings) {
             self.previous = Previous::COOLED;
         }
-        let (corrected, flags) =
-            correct_segment_after(&self.model, segment, switch_on, Some(&self.previous));
+        let (corrected, flags, outside_envelope_samples) = correct_segment_counting(
+            &self.model,
+            segment,
+            switch_on,
+            Some(&self.previous),
+            Envelope::FLAGS,
+        );
         let core = self.model.settings();
         self.previous = kept_after(&self.previous, segment, &self.settings, core);
         let (corrected_drift_dps, residual_rms_dps) = metric(&corrected, window);
@@ -199,6 +216,8 @@ impl<M: Model> UnitCheck<M> {
             corrected_drift_dps,
             residual_rms_dps,
             flags,
+            samples: segment.len(),
+            outside_envelope_samples,
         });
     }
 
@@ -284,6 +303,12 @@ fn verdict(activations: &[CheckedActivation], axis: usize, limits: &Limits) -> A
         rise_out_of_span: count(Flags::RISE_OUT_OF_SPAN),
         past_last_reference: count(Flags::PAST_LAST_REFERENCE),
         history_unknown_or_out_of_span: count(Flags::HISTORY_UNKNOWN | Flags::HISTORY_OUT_OF_SPAN),
+        outside_envelope: count(Envelope::FLAGS),
+        samples: activations.iter().map(|a| a.samples).sum(),
+        outside_envelope_samples: activations
+            .iter()
+            .map(|a| a.outside_envelope_samples[axis])
+            .sum(),
         faulty: count(FAULT_FLAGS),
         failures,
     }
@@ -310,6 +335,12 @@ mod tests {
             corrected_drift_dps: [corrected; 3],
             residual_rms_dps: [rms; 3],
             flags: [flags; 3],
+            samples: 100,
+            outside_envelope_samples: [if Flags(flags).intersects(Envelope::FLAGS) {
+                100
+            } else {
+                0
+            }; 3],
         }
     }
 
@@ -369,11 +400,17 @@ mod tests {
             activation(0.03, 0.002, 0.003, Flags::AMBIENT_OUT_OF_RANGE.0),
             activation(0.03, 0.002, 0.003, Flags::TEMPERATURE_STUCK.0),
             activation(0.03, 0.002, 0.003, 0),
+            activation(0.03, 0.002, 0.003, Flags::HISTORY_OUT_OF_SPAN.0),
         ];
         let v = verdict(&acts, 2, &limits);
         assert_eq!(
             (v.ambient_out_of_range, v.rise_out_of_span, v.faulty),
             (1, 0, 1)
+        );
+        assert_eq!(
+            (v.outside_envelope, v.samples, v.outside_envelope_samples),
+            (1, 400, 100),
+            "the turn-on envelope: switch-on temperature and residual heat"
         );
         assert!(v.passed(), "flags are reported, not failed: {v:?}");
     }

@@ -274,6 +274,19 @@ pub fn correct_segment_after<M: Model>(
     switch_on: [f32; 3],
     previous: Option<&[Previous; 3]>,
 ) -> ([Vec<f32>; 3], [u16; 3]) {
+    let (corrected, flags, _) =
+        correct_segment_counting(model, segment, switch_on, previous, drift_core::Flags::NONE);
+    (corrected, flags)
+}
+
+/// [`correct_segment_after`] that also counts, per axis, the samples any of `counted` flags.
+pub fn correct_segment_counting<M: Model>(
+    model: &M,
+    segment: &Segment,
+    switch_on: [f32; 3],
+    previous: Option<&[Previous; 3]>,
+    counted: drift_core::Flags,
+) -> ([Vec<f32>; 3], [u16; 3], [usize; 3]) {
     let n = segment.len();
     let mut corrected: [Vec<f32>; 3] = [
         Vec::with_capacity(n),
@@ -281,10 +294,12 @@ pub fn correct_segment_after<M: Model>(
         Vec::with_capacity(n),
     ];
     let mut flags = [0u16; 3];
+    let mut count = [0usize; 3];
     let Ok(mut corrector) = Corrector::new(model) else {
         return (
             segment.rate_dps.clone(),
             [drift_core::Flags::MODEL_INVALID.0; 3],
+            count,
         );
     };
     let started = match previous {
@@ -295,6 +310,7 @@ pub fn correct_segment_after<M: Model>(
         return (
             segment.rate_dps.clone(),
             [drift_core::Flags::NOT_POWERED_ON.0; 3],
+            count,
         );
     }
     for i in 0..n {
@@ -303,9 +319,10 @@ pub fn correct_segment_after<M: Model>(
         for axis in 0..3 {
             corrected[axis].push(out.corrected_dps[axis]);
             flags[axis] |= out.flags[axis].0;
+            count[axis] += usize::from(out.flags[axis].intersects(counted));
         }
     }
-    (corrected, flags)
+    (corrected, flags, count)
 }
 
 /// Whether firmware with a clock would know the unit cooled fully before `segment`: off at least

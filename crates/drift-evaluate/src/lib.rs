@@ -6,6 +6,8 @@
 //! - [`evaluate`] corrects one activation and measures the paper's drift metric and the residual
 //!   bias; [`summary`] averages the results into the report's records; [`excess`] says how many
 //!   times a model cuts the error in excess of the noise floor, with its interval;
+//! - [`coverage`] maps the calibration's switch-on temperatures × residual heats and says how much
+//!   held-out data fell outside the envelope;
 //! - [`check`] answers "is a stored calibration still valid?";
 //! - [`noise_floor`] measures a zero-drift twin's floor per group of activations;
 //! - [`measured`] says what measured data the paper's method cannot be fitted on still tells;
@@ -14,6 +16,7 @@
 //! - [`tables_folder`] writes and reads a fit's tables folder (JSON and firmware images).
 
 pub mod check;
+pub mod coverage;
 pub mod evaluate;
 pub mod excess;
 pub mod measured;

@@ -19,6 +19,7 @@ use drift_recording::{
 };
 use rayon::prelude::*;
 
+use crate::coverage::{self, UnitCoverage};
 use crate::evaluate::{evaluate_after, kept_before, ActivationResult};
 use crate::summary::Split;
 use crate::uncertainty::{self, Residuals, UnitUncertainty};
@@ -193,6 +194,9 @@ pub struct Outcome {
     /// σ(t) of the recommended model per unit, fitted on the held-out repeats, with how often
     /// validation and field residuals fell within ±2σ.
     pub uncertainty: Vec<UnitUncertainty>,
+    /// The coverage map per unit: the calibration's switch-on temperatures × residual heats and
+    /// the held-out data outside the envelope.
+    pub coverage: Vec<UnitCoverage>,
 }
 
 /// Reports progress: (step, done, total).
@@ -924,6 +928,8 @@ pub fn run(
     outcome.uncertainty = uncertainty::per_unit(&outcome.fitted, &residuals);
     let evaluate_seconds = started.elapsed().as_secs_f64();
     outcome.calibration = by_unit.into_values().flatten().collect();
+    outcome.coverage =
+        coverage::per_unit(&outcome.fitted, &outcome.calibration, &residuals, settings);
     outcome.timings = vec![
         ("read recordings (pass 1)".into(), read_seconds),
         ("analyse calibration activations".into(), analyse_seconds),

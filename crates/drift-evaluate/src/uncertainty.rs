@@ -10,7 +10,7 @@
 
 pub use drift_core::ActivationClass;
 use drift_core::{
-    Model, Previous, SigmaState, SwitchOn, Uncertainty, ACTIVATION_CLASSES, SIGMA_KNOTS,
+    Model, Previous, SigmaState, SwitchOn, TurnOn, Uncertainty, ACTIVATION_CLASSES, SIGMA_KNOTS,
 };
 use drift_fit::lowpass::centred_moving_average;
 use drift_fit::settings::FitSettings;
@@ -92,10 +92,14 @@ pub fn residuals<M: Model>(
 }
 
 /// σ(t) without its curves: the calibrated envelope, the class threshold and the growth outside.
-/// The envelope is the calibration's set points; the growth per °C outside it is how far the
-/// mean uncorrected rate moves per °C of ambient between the lowest and the highest of them (the
-/// largest over axes): the error a table clamped at its envelope's edge makes per °C beyond it.
-pub fn envelope(calibration: &[Residuals]) -> Uncertainty {
+/// The ambient envelope is the calibration's set points; the growth per °C outside it is how far
+/// the mean uncorrected rate moves per °C of ambient between the lowest and the highest of them
+/// (the largest over axes): the error a table clamped at its envelope's edge makes per °C beyond
+/// it. The residual heat's envelope is the tables' (`turn_on`, per axis: the most residual heat
+/// the turn-on bias was fitted on, beyond which the corrector holds it); the growth per °C beyond
+/// it is the fitted turn-on bias's slope in residual heat (the largest over axes): the error of a
+/// turn-on bias held at the most heat per °C beyond it.
+pub fn envelope(calibration: &[Residuals], turn_on: &[TurnOn; 3]) -> Uncertainty {
     let lo = calibration
         .iter()
         .map(|r| r.set_point_celsius)
@@ -127,6 +131,13 @@ pub fn envelope(calibration: &[Residuals]) -> Uncertainty {
         ambient_min_celsius: finite(lo),
         ambient_max_celsius: finite(hi.max(lo)),
         per_celsius_outside_dps: finite(per_celsius),
+        most_residual_heat_celsius: turn_on
+            .each_ref()
+            .map(|t| finite(f64::from(t.most_residual_heat_celsius)).max(0.0)),
+        per_residual_celsius_beyond_dps: turn_on
+            .iter()
+            .map(|t| finite(f64::from(t.dps_per_residual_celsius)).abs())
+            .fold(0.0, f32::max),
     }
 }
 
@@ -154,11 +165,11 @@ fn quantile(values: &mut [f32], q: f64) -> Option<f32> {
     Some((low + (high - low) * frac) as f32)
 }
 
-/// σ(t) fitted on `calibration` (one unit's residuals on activations the tables did not see).
-/// A class or knot without residuals takes the pooled classes' value at that knot, then the
-/// previous knot's.
-pub fn fit(calibration: &[Residuals]) -> Uncertainty {
-    let mut u = envelope(calibration);
+/// σ(t) fitted on `calibration` (one unit's residuals on activations the tables did not see), for
+/// tables whose turn-on bias is `turn_on`. A class or knot without residuals takes the pooled
+/// classes' value at that knot, then the previous knot's.
+pub fn fit(calibration: &[Residuals], turn_on: &[TurnOn; 3]) -> Uncertainty {
+    let mut u = envelope(calibration, turn_on);
     let mut by = vec![vec![Vec::new(); SIGMA_KNOTS]; ACTIVATION_CLASSES + 1];
     for r in calibration {
         let state = u.start(&r.switch_on);
@@ -195,12 +206,27 @@ pub struct Coverage {
     pub samples: usize,
     /// Of them, within ±2σ(t).
     pub inside: usize,
+    /// Of the samples, those of activation × axis pairs outside the calibrated envelope, where σ
+    /// widens (ambient outside the set points, residual heat beyond the calibration's most).
+    pub widened_samples: usize,
+    /// Of them, within ±2σ(t).
+    pub widened_inside: usize,
 }
 
 impl Coverage {
     /// The share within ±2σ (NaN for no samples).
     pub fn share(&self) -> f64 {
         self.inside as f64 / self.samples as f64
+    }
+
+    /// The share within ±2σ where σ widens (NaN for no samples).
+    pub fn widened_share(&self) -> f64 {
+        self.widened_inside as f64 / self.widened_samples as f64
+    }
+
+    /// The share within ±2σ inside the envelope (NaN for no samples).
+    pub fn unwidened_share(&self) -> f64 {
+        (self.inside - self.widened_inside) as f64 / (self.samples - self.widened_samples) as f64
     }
 }
 
@@ -215,6 +241,8 @@ pub fn coverage(
         axis_activations: 0,
         samples: 0,
         inside: 0,
+        widened_samples: 0,
+        widened_inside: 0,
     });
     for r in held_out {
         let state: SigmaState = uncertainty.start(&r.switch_on);
@@ -223,10 +251,21 @@ pub fn coverage(
         }
         for &(ms, residual) in &r.samples {
             let sigma = uncertainty.sigma_dps(&state, ms);
-            for ((class, value), sigma) in state.class.iter().zip(residual).zip(sigma) {
+            for (((class, value), sigma), widening) in state
+                .class
+                .iter()
+                .zip(residual)
+                .zip(sigma)
+                .zip(state.widening_dps)
+            {
                 let cell = &mut out[*class as usize];
+                let within = usize::from(value.abs() <= 2.0 * sigma);
                 cell.samples += 1;
-                cell.inside += usize::from(value.abs() <= 2.0 * sigma);
+                cell.inside += within;
+                if widening > 0.0 {
+                    cell.widened_samples += 1;
+                    cell.widened_inside += within;
+                }
             }
         }
     }
@@ -272,7 +311,8 @@ pub fn per_unit(fitted: &[FittedUnit], residuals: &[(Split, Residuals)]) -> Vec<
         if calibration.is_empty() {
             continue;
         }
-        let sigma = fit(&calibration);
+        let turn_on = unit.recommended.axes.each_ref().map(|a| a.turn_on.clone());
+        let sigma = fit(&calibration, &turn_on);
         let coverage = [Split::Validation, Split::Field]
             .into_iter()
             .filter_map(|split| {
@@ -314,6 +354,15 @@ mod tests {
         }
     }
 
+    /// Turn-on biases whose slope in residual heat is largest (in magnitude) on Y.
+    fn turn_on() -> [TurnOn; 3] {
+        [(2.0, 0.001), (2.5, -0.003), (2.0, 0.002)].map(|(most, slope)| TurnOn {
+            most_residual_heat_celsius: most,
+            dps_per_residual_celsius: slope,
+            ..TurnOn::default()
+        })
+    }
+
     /// Residuals drawn from a normal distribution whose σ falls after switch-on and is twice as
     /// large for warm restarts: the fit finds each class's σ at the knots, and held-out draws
     /// from the same distribution fall within ±2σ about 95 % of the time.
@@ -351,9 +400,11 @@ mod tests {
         let calibration: Vec<Residuals> = (0..40)
             .map(|i| draw(if i % 2 == 0 { 30.0 } else { 40.0 }, i % 4 < 2))
             .collect();
-        let u = fit(&calibration);
+        let u = fit(&calibration, &turn_on());
         u.validate().unwrap();
         assert_eq!((u.ambient_min_celsius, u.ambient_max_celsius), (30.0, 40.0));
+        assert_eq!(u.most_residual_heat_celsius, [2.0, 2.5, 2.0]);
+        assert_eq!(u.per_residual_celsius_beyond_dps, 0.003);
         assert!((u.per_celsius_outside_dps - 0.001).abs() < 1e-6);
         let late_cold = u.sigma_dps[0][6];
         let late_warm = u.sigma_dps[1][6];
@@ -364,13 +415,14 @@ mod tests {
         for cell in coverage(&u, &held_out) {
             assert_eq!(cell.axis_activations, 30, "{cell:?}");
             assert!((0.93..=0.97).contains(&cell.share()), "{cell:?}");
+            assert_eq!(cell.widened_samples, 0, "inside the envelope: {cell:?}");
         }
     }
 
     #[test]
     fn an_empty_class_takes_the_pooled_value() {
         let calibration = [residual(30.0, 0.0, &[(0, 0.01), (100_000, 0.002)])];
-        let u = fit(&calibration);
+        let u = fit(&calibration, &turn_on());
         assert_eq!(u.sigma_dps[1], u.sigma_dps[0]);
         assert!(u.sigma_dps[0][0] > 0.0);
         u.validate().unwrap();

@@ -105,6 +105,9 @@ pub fn check<'py, M: Model + Clone + Send + Sync>(
                     "rise_out_of_span": v.rise_out_of_span,
                     "past_last_reference": v.past_last_reference,
                     "history_unknown_or_out_of_span": v.history_unknown_or_out_of_span,
+                    "outside_envelope": v.outside_envelope,
+                    "samples": v.samples,
+                    "outside_envelope_samples": v.outside_envelope_samples,
                     "faulty": v.faulty,
                     "failures": v.failures,
                 })

@@ -81,6 +81,18 @@ impl PyUncertainty {
         self.inner.per_celsius_outside_dps
     }
 
+    /// The most residual heat a calibration activation switched on with, per axis, °C.
+    #[getter]
+    fn most_residual_heat_celsius(&self) -> [f32; 3] {
+        self.inner.most_residual_heat_celsius
+    }
+
+    /// Growth of σ per °C of residual heat beyond the most, °/s.
+    #[getter]
+    fn per_residual_celsius_beyond_dps(&self) -> f32 {
+        self.inner.per_residual_celsius_beyond_dps
+    }
+
     /// σ per sample and axis, °/s `(n, 3)` float32, for an activation switched on at
     /// `switch_on_celsius` (per axis) after what was kept of the previous one (`previous`,
     /// `(3, 2)` as `Corrector.power_on_after` takes it; None: nothing kept, a cold start), at

@@ -27,6 +27,9 @@ FIELDS = {
     "rise_out_of_span",
     "past_last_reference",
     "history_unknown_or_out_of_span",
+    "outside_envelope",
+    "samples",
+    "outside_envelope_samples",
     "faulty",
     "failures",
 }
@@ -45,6 +48,8 @@ def test_the_fitted_tables_pass_on_data_they_did_not_see(
         assert 0 < r["corrected_drift_dps"] < r["uncorrected_drift_dps"]
         assert r["worst_drift_dps"] >= r["corrected_drift_dps"]
         assert r["removed"] == pytest.approx(1 - r["corrected_drift_dps"] / r["uncorrected_drift_dps"])
+        assert r["samples"] > 0 and 0 <= r["outside_envelope_samples"] <= r["samples"]
+        assert 0 <= r["outside_envelope"] <= r["activations"]
     # Segments in memory give the same records as the file.
     recording = gyrodrift.Recording.load(recording_path(campaign_dir, "+33.0"))
     assert unit.modified.check(recording) == records

@@ -62,6 +62,10 @@ def test_sigma_is_piecewise_linear_per_class_as_a_float32_restatement(section: P
     # Outside the envelope σ grows by the stored amount per °C.
     below = sigma.sigma(times[-1:], (lo - 2.0,) * 3)
     assert np.isclose(below[0, 0], table[0, -1] + 2.0 * sigma.per_celsius_outside_dps, rtol=1e-6)
+    # Beyond the calibration's most residual heat σ grows too (10 °C of heat, 30 °C ambient).
+    assert len(sigma.most_residual_heat_celsius) == 3 and sigma.per_residual_celsius_beyond_dps > 0
+    hot = sigma.sigma(times[-1:], (40.0,) * 3, np.array([[30.0, 45.0]] * 3, dtype=np.float32))
+    assert (hot[0] > table[1, -1]).all()
 
 
 def test_json_and_section_load_the_same_and_pickle(tmp_path: Path, section: Path) -> None:

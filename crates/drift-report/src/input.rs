@@ -1,5 +1,6 @@
 //! Everything a report is made from.
 
+use drift_evaluate::coverage::UnitCoverage;
 use drift_evaluate::evaluate::ActivationResult;
 use drift_evaluate::summary::Split;
 use drift_evaluate::uncertainty::UnitUncertainty;
@@ -26,4 +27,6 @@ pub struct ReportInput<'a> {
     pub timings: Vec<(String, f64)>,
     /// σ(t) per unit with its coverage on held-out activations (empty if not fitted).
     pub uncertainty: &'a [UnitUncertainty],
+    /// The calibration's coverage map per unit (empty without a fit).
+    pub coverage: &'a [UnitCoverage],
 }

@@ -3,6 +3,7 @@
 //! tables folder. `gyrodrift report`, `gyrodrift demo` and Python's `gyrodrift.report` all make it
 //! through [`make`], so the same inputs give the same bytes.
 
+mod coverage;
 mod figures;
 mod input;
 pub mod measured;
@@ -84,6 +85,7 @@ fn write_outcome(
         independent_after_min: options.fit.independent_after_min,
         timings: outcome.timings.clone(),
         uncertainty: &outcome.uncertainty,
+        coverage: &outcome.coverage,
     };
     let path = write_report(out, &input)?;
     Ok((path, outcome))
@@ -113,7 +115,7 @@ pub fn headline_of(outcome: &Outcome) -> String {
 }
 
 /// Writes `report.md`, `report.json` (the table as data), `uncertainty.json` (σ(t) and its
-/// coverage, when fitted), the figures and `timings.json` (how
+/// coverage, when fitted), `coverage.json` (the calibration's coverage map), the figures and `timings.json` (how
 /// long each step took) into `dir`; returns the report's path.
 pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathBuf> {
     let records = summarise(input.results);
@@ -138,6 +140,7 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
     md.push_str(&tables::residual_rms(&records, input.fitted));
     md.push_str(&tables::absolute_error(&cells));
     md.push_str(&uncertainty::section(input.uncertainty));
+    md.push_str(&coverage::section(dir, input.coverage)?);
     if !figures.is_empty() {
         writeln!(md, "## Figures\n")?;
         for (file, caption) in &figures {
@@ -182,6 +185,12 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
         write_atomic(
             &dir.join("uncertainty.json"),
             serde_json::to_string_pretty(input.uncertainty)?.as_bytes(),
+        )?;
+    }
+    if !input.coverage.is_empty() {
+        write_atomic(
+            &dir.join("coverage.json"),
+            serde_json::to_string_pretty(input.coverage)?.as_bytes(),
         )?;
     }
     // Durations differ from run to run; kept apart so the report itself is the same bytes for

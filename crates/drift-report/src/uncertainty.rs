@@ -6,10 +6,14 @@ use std::fmt::Write as _;
 use drift_evaluate::uncertainty::{ActivationClass, Coverage, UnitUncertainty, EVERY_MS, KNOTS_MS};
 
 fn percent(cell: &Coverage) -> String {
-    if cell.samples == 0 {
+    share(cell.inside, cell.samples)
+}
+
+fn share(part: usize, whole: usize) -> String {
+    if whole == 0 {
         "–".into()
     } else {
-        format!("{:.1} %", 100.0 * cell.share())
+        format!("{:.1} %", 100.0 * part as f64 / whole as f64)
     }
 }
 
@@ -27,26 +31,34 @@ pub fn section(units: &[UnitUncertainty]) -> String {
          the 95th percentile of the 1-s residual's magnitude per knot and class, every axis), \
          checked on validation and field activations neither saw. Warm restart: residual heat at \
          switch-on above {} °C (what firmware estimates from what it kept). Residuals every {} ms; \
-         the goal is 93–97 % within ±2σ.\n",
+         the goal is 93–97 % within ±2σ. Outside the envelope (switch-on ambient outside the \
+         calibration's set points, or residual heat beyond the calibration's most) σ widens; the \
+         last three columns split the samples there from those inside.\n",
         drift_evaluate::uncertainty::WARM_ABOVE_CELSIUS,
         EVERY_MS
     );
     let _ = writeln!(
         md,
-        "| unit | data | class | activations × axes | samples | within ±2σ |\n|---|---|---|---:|---:|---:|"
+        "| unit | data | class | activations × axes | samples | within ±2σ | samples outside the envelope | within ±2σ there | within ±2σ inside |\n|---|---|---|---:|---:|---:|---:|---:|---:|"
     );
     for unit in units {
         for split in &unit.coverage {
             for cell in &split.classes {
                 let _ = writeln!(
                     md,
-                    "| {} | {} | {} | {} | {} | {} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                     unit.unit_id,
                     split.split,
                     cell.class,
                     cell.axis_activations,
                     cell.samples,
-                    percent(cell)
+                    percent(cell),
+                    share(cell.widened_samples, cell.samples),
+                    share(cell.widened_inside, cell.widened_samples),
+                    share(
+                        cell.inside - cell.widened_inside,
+                        cell.samples - cell.widened_samples
+                    )
                 );
             }
         }
@@ -58,11 +70,12 @@ pub fn section(units: &[UnitUncertainty]) -> String {
     let _ = writeln!(
         md,
         "\nσ at the knots, m°/s (linear between them, held after the last; plus the growth per °C \
-         of switch-on ambient outside the envelope):\n"
+         of switch-on ambient outside the envelope and per °C of residual heat beyond the \
+         calibration's most, per axis X / Y / Z):\n"
     );
     let _ = writeln!(
         md,
-        "| unit | class | {} | envelope | outside, m°/s per °C |\n|---|---|{}---|---:|",
+        "| unit | class | {} | envelope | outside, m°/s per °C | most residual heat | beyond, m°/s per °C |\n|---|---|{}---|---:|---|---:|",
         header.join(" | "),
         "---:|".repeat(header.len())
     );
@@ -75,13 +88,17 @@ pub fn section(units: &[UnitUncertainty]) -> String {
                 .collect();
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {}–{} °C | {:.3} |",
+                "| {} | {} | {} | {}–{} °C | {:.3} | {} °C | {:.3} |",
                 unit.unit_id,
                 class.name(),
                 values.join(" | "),
                 s.ambient_min_celsius,
                 s.ambient_max_celsius,
-                s.per_celsius_outside_dps * 1000.0
+                s.per_celsius_outside_dps * 1000.0,
+                s.most_residual_heat_celsius
+                    .map(|h| format!("{h:.2}"))
+                    .join(" / "),
+                s.per_residual_celsius_beyond_dps * 1000.0
             );
         }
     }

@@ -11,7 +11,8 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use drift_core::blob::{decode, decode_into, decode_section};
 use drift_core::{
-    AxisModel, Corrector, Model, PolynomialTables, Previous, Sample, SwitchOn, Uncertainty,
+    AxisModel, Corrector, Model, PolynomialTables, Previous, Sample, StillnessLearner,
+    StillnessSettings, SwitchOn, Uncertainty,
 };
 use gyrodrift_embedded::{
     FirmwareRecommended, FirmwareTables, BY_HISTORY, EXTENDED, MODIFIED, RECOMMENDED,
@@ -140,6 +141,30 @@ fn measure_sigma(uncertainty: &Uncertainty, samples: &[Sample], id: u32) {
     gyrodrift_marker(id + 1);
 }
 
+/// The stillness learner per gyro sample on its longest path: every sample still and learning
+/// (no wait), with an accelerometer seen (its variance joins the test), alone: what a firmware
+/// adds after the corrector.
+fn measure_stillness(samples: &[Sample], id: u32) {
+    let settings = StillnessSettings {
+        sample_rate_hz: 1000.0,
+        still_for_s: 0.0,
+        ..StillnessSettings::default()
+    };
+    let Ok(mut learner) = StillnessLearner::new(black_box(&settings)) else {
+        hprintln!("FAIL: stillness settings refused");
+        debug::exit(debug::EXIT_FAILURE);
+        #[allow(clippy::empty_loop)]
+        loop {}
+    };
+    learner.accelerometer(black_box([0.0, 0.0, 1.0]));
+    learner.accelerometer(black_box([0.0, 0.0, 1.0]));
+    gyrodrift_marker(id);
+    for sample in samples {
+        black_box(learner.update(black_box(sample).rate_dps));
+    }
+    gyrodrift_marker(id + 1);
+}
+
 #[entry]
 fn main() -> ! {
     // The tables live in `static`s (cortex-m-rt makes these `&'static mut`), decoded in place.
@@ -201,6 +226,10 @@ fn main() -> ! {
             measure_sigma(&uncertainty, &samples, 21);
             hprintln!("interval 23: σ(t) beside each sample (sigma), 1000 Hz windows");
             measure_sigma(&uncertainty, &at_1khz, 23);
+            hprintln!(
+                "interval 25: stillness learner after the tables (stillness), still and learning, 1000 Hz gyro samples"
+            );
+            measure_stillness(&at_1khz, 25);
             debug::exit(debug::EXIT_SUCCESS);
         }
         _ => {

@@ -15,7 +15,8 @@ use drift_core::{
 };
 use gyrodrift_embedded::{
     stack, Case, FirmwareRecommended, FirmwareTables, ModelName, BY_HISTORY, CASES, EXTENDED,
-    MODIFIED, RECOMMENDED, SIGMA_CASES, SIGMA_SECTION, STANDARD, THIRD_ORDER, WARM_STARTED,
+    MODIFIED, RECOMMENDED, SIGMA_CASES, SIGMA_SECTION, STANDARD, STILLNESS_CASES, THIRD_ORDER,
+    WARM_STARTED,
 };
 use panic_semihosting as _;
 
@@ -176,6 +177,36 @@ fn main() -> ! {
         });
     }
 
+    // The stillness learner after the tables: every case's output, states and offset bit for bit.
+    let mut stillness_outputs = 0;
+    for case in STILLNESS_CASES {
+        let offset = case.run(|i, got, states| {
+            stillness_outputs += 1;
+            let rates_differ = case.expected[i]
+                .iter()
+                .zip(&got)
+                .any(|(&e, &g)| !same(e, g));
+            if rates_differ || case.states[i] != states {
+                mismatches += 1;
+                hprintln!(
+                    "stillness {} sample {}: differs from the host",
+                    case.name,
+                    i
+                );
+            }
+        });
+        match offset {
+            Some(offset) if offset == case.final_offset => {}
+            _ => {
+                mismatches += 1;
+                hprintln!(
+                    "stillness {}: final offset differs from the host",
+                    case.name
+                );
+            }
+        }
+    }
+
     // Stack of one power-on plus one corrected sample, measured on a fresh painting.
     let Ok(mut corrector) = Corrector::new(extended) else {
         fail("model rejected")
@@ -212,6 +243,8 @@ fn main() -> ! {
     hprintln!("outputs compared: {}", samples * 9);
     hprintln!("σ(t) cases: {}", SIGMA_CASES.len());
     hprintln!("σ(t) outputs compared: {}", sigma_outputs);
+    hprintln!("stillness cases: {}", STILLNESS_CASES.len());
+    hprintln!("stillness samples compared: {}", stillness_outputs);
     hprintln!("mismatches: {}", mismatches);
     hprintln!("σ(t) section bytes: {}", SIGMA_SECTION.len());
     hprintln!("modified image bytes: {}", MODIFIED.len());

@@ -21,8 +21,37 @@ use crate::uncertainty::Uncertainty;
 
 /// First four bytes of every σ(t) section.
 pub const SECTION_MAGIC: [u8; 4] = *b"GYSG";
-/// The section's version: any change to [`Uncertainty`]'s fields is a new one.
-pub const SECTION_VERSION: u16 = 1;
+/// The section's version: any change to [`Uncertainty`]'s fields is a new one. Version 1 (without
+/// the residual heat's widening) is still read, as σ(t) with no widening beyond any heat.
+pub const SECTION_VERSION: u16 = 2;
+/// The first version, without `most_residual_heat_celsius` and `per_residual_celsius_beyond_dps`.
+const VERSION_1: u16 = 1;
+
+/// [`Uncertainty`] as version 1 stored it.
+#[derive(serde::Deserialize)]
+struct UncertaintyV1 {
+    knots_ms: [u32; crate::SIGMA_KNOTS],
+    sigma_dps: [[f32; crate::SIGMA_KNOTS]; crate::ACTIVATION_CLASSES],
+    warm_above_celsius: f32,
+    ambient_min_celsius: f32,
+    ambient_max_celsius: f32,
+    per_celsius_outside_dps: f32,
+}
+
+impl From<UncertaintyV1> for Uncertainty {
+    fn from(v1: UncertaintyV1) -> Self {
+        Self {
+            knots_ms: v1.knots_ms,
+            sigma_dps: v1.sigma_dps,
+            warm_above_celsius: v1.warm_above_celsius,
+            ambient_min_celsius: v1.ambient_min_celsius,
+            ambient_max_celsius: v1.ambient_max_celsius,
+            per_celsius_outside_dps: v1.per_celsius_outside_dps,
+            most_residual_heat_celsius: [0.0; crate::AXES],
+            per_residual_celsius_beyond_dps: 0.0,
+        }
+    }
+}
 const HEAD: usize = 12;
 const TAIL: usize = 4;
 
@@ -80,7 +109,7 @@ impl fmt::Display for SectionError {
             ),
             Self::UnsupportedVersion { found } => write!(
                 f,
-                "σ(t) section version {found} is not supported (this build reads {SECTION_VERSION})"
+                "σ(t) section version {found} is not supported (this build reads {VERSION_1} and {SECTION_VERSION})"
             ),
             Self::TrailingBytes { count } => {
                 write!(f, "{count} unexpected bytes after the σ(t) section's CRC")
@@ -164,7 +193,7 @@ pub fn decode_section(bytes: &[u8]) -> Result<Uncertainty, SectionError> {
         head.get(4).copied().unwrap_or(0),
         head.get(5).copied().unwrap_or(0),
     ]);
-    if version != SECTION_VERSION {
+    if version != SECTION_VERSION && version != VERSION_1 {
         return Err(SectionError::UnsupportedVersion { found: version });
     }
     let declared = usize::try_from(le_u32(bytes, 8)).unwrap_or(usize::MAX);
@@ -184,8 +213,13 @@ pub fn decode_section(bytes: &[u8]) -> Result<Uncertainty, SectionError> {
         return Err(SectionError::CrcMismatch { stored, computed });
     }
     let payload = bytes.get(HEAD..body).ok_or(truncated(total))?;
-    let (uncertainty, rest) =
-        postcard::take_from_bytes::<Uncertainty>(payload).map_err(SectionError::Malformed)?;
+    let (uncertainty, rest) = if version == VERSION_1 {
+        postcard::take_from_bytes::<UncertaintyV1>(payload)
+            .map(|(v1, rest)| (Uncertainty::from(v1), rest))
+            .map_err(SectionError::Malformed)?
+    } else {
+        postcard::take_from_bytes::<Uncertainty>(payload).map_err(SectionError::Malformed)?
+    };
     if !rest.is_empty() {
         return Err(SectionError::Malformed(
             postcard::Error::DeserializeBadEncoding,
@@ -207,7 +241,34 @@ mod tests {
             ambient_min_celsius: 30.0,
             ambient_max_celsius: 40.0,
             per_celsius_outside_dps: 0.0005,
+            most_residual_heat_celsius: [2.5, 2.6, 2.4],
+            per_residual_celsius_beyond_dps: 0.0012,
         }
+    }
+
+    /// A version-1 section as the previous release wrote it (testdata/sigma-vectors.json then).
+    const V1_HEX: &str = "47595347010000006300000000d00f8827904ea09c01c0b80280f10480e2097923733b3e05403b8f360e3b9cdcef3a31ebc53ada03ad3ac6f99b3a3e3f8c3a2bdec83ba94d9c3bc32a5e3b890c2b3bc009053b1422e03ad66ebb3a3815a93a0000003f0000f041000020428ffcc13933641e72";
+
+    #[test]
+    fn a_version_1_section_reads_without_widening_beyond_any_heat() {
+        let bytes: std::vec::Vec<u8> = (0..V1_HEX.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&V1_HEX[i..i + 2], 16).unwrap())
+            .collect();
+        assert_eq!(u16::from_le_bytes([bytes[4], bytes[5]]), 1);
+        let u = decode_section(&bytes).unwrap();
+        assert_eq!(u.most_residual_heat_celsius, [0.0; 3]);
+        assert_eq!(u.per_residual_celsius_beyond_dps, 0.0);
+        assert_eq!((u.ambient_min_celsius, u.ambient_max_celsius), (30.0, 40.0));
+        assert_eq!(u.knots_ms[7], 160_000);
+        let mut buffer = [0u8; 256];
+        let n = encode_section(&u, &mut buffer).unwrap();
+        assert_eq!(u16::from_le_bytes([buffer[4], buffer[5]]), SECTION_VERSION);
+        assert_eq!(
+            decode_section(&buffer[..n]).unwrap(),
+            u,
+            "rewritten as the current version"
+        );
     }
 
     #[test]

@@ -236,9 +236,10 @@ class ModifiedTables:
         `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
         `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
-        `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the
-        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤
-        `max_rms` °/s, share removed ≥ `min_removed`.
+        `history_unknown_or_out_of_span`, `outside_envelope`, `faulty` (activation counts),
+        `samples`, `outside_envelope_samples` (samples flagged outside the calibrated envelope)
+        and `failures` (why the axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s,
+        residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
     @property
@@ -362,9 +363,10 @@ class PolynomialTables:
         `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
         `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
-        `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the
-        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤
-        `max_rms` °/s, share removed ≥ `min_removed`.
+        `history_unknown_or_out_of_span`, `outside_envelope`, `faulty` (activation counts),
+        `samples`, `outside_envelope_samples` (samples flagged outside the calibrated envelope)
+        and `failures` (why the axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s,
+        residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
     def __eq__(self, other: object, /) -> bool: ...
@@ -417,9 +419,10 @@ class RelativePolynomialTables:
         `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
         `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
-        `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the
-        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤
-        `max_rms` °/s, share removed ≥ `min_removed`.
+        `history_unknown_or_out_of_span`, `outside_envelope`, `faulty` (activation counts),
+        `samples`, `outside_envelope_samples` (samples flagged outside the calibrated envelope)
+        and `failures` (why the axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s,
+        residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
     def __eq__(self, other: object, /) -> bool: ...
@@ -473,9 +476,10 @@ class RecommendedTables:
         `passed`, `activations`, `uncorrected_drift_dps`, `corrected_drift_dps` (mean drift left),
         `worst_drift_dps`, `removed` (share of the uncorrected drift), `residual_rms_dps`,
         `ambient_out_of_range`, `rise_out_of_span`, `past_last_reference`,
-        `history_unknown_or_out_of_span`, `faulty` (activation counts) and `failures` (why the
-        axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s, residual RMS ≤
-        `max_rms` °/s, share removed ≥ `min_removed`.
+        `history_unknown_or_out_of_span`, `outside_envelope`, `faulty` (activation counts),
+        `samples`, `outside_envelope_samples` (samples flagged outside the calibrated envelope)
+        and `failures` (why the axis misses a limit). Limits: mean drift left ≤ `max_drift` °/s,
+        residual RMS ≤ `max_rms` °/s, share removed ≥ `min_removed`.
         Raises `InputError` (several units in `source`, none at all, a negative limit, an extended
         model that reads an auxiliary input), `FileError` or `RecordingError`."""
     def __eq__(self, other: object, /) -> bool: ...
@@ -572,6 +576,12 @@ class Uncertainty:
     @property
     def per_celsius_outside_dps(self) -> float:
         """Growth of σ per °C of switch-on ambient outside the envelope, °/s."""
+    @property
+    def most_residual_heat_celsius(self) -> list[float]:
+        """The most residual heat a calibration activation switched on with, per axis, °C."""
+    @property
+    def per_residual_celsius_beyond_dps(self) -> float:
+        """Growth of σ per °C of residual heat beyond the most, °/s."""
     def sigma(
         self,
         since_power_on_ms: NDArray[np.uint32],
