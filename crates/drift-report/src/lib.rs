@@ -98,8 +98,10 @@ pub fn provenance(source: &str, options: &Options) -> Vec<String> {
     )]
 }
 
-/// The headline table of an outcome (Markdown), for printing.
-pub fn headline_of(outcome: &Outcome) -> String {
+/// What a finished report says first, for printing: the headline table (Markdown), the
+/// absolute-error verdict and the field-like results' means, as `report.md` has them.
+/// `independent_after_min` is the fit's cool-down (what counts as a cold start).
+pub fn headline_of(outcome: &Outcome, independent_after_min: f64) -> String {
     let records = summarise(&outcome.results);
     let mut noise: Vec<String> = outcome
         .results
@@ -109,7 +111,19 @@ pub fn headline_of(outcome: &Outcome) -> String {
         .collect();
     noise.sort();
     noise.dedup();
-    tables::headline(&records, &outcome.fitted, &noise)
+    let mut text = tables::headline(&records, &outcome.fitted, &noise);
+    let cells = absolute_error(&outcome.results, independent_after_min);
+    if !cells.is_empty() {
+        let _ = writeln!(
+            text,
+            "{} (report.md: *Absolute error*).",
+            tables::absolute_error_verdict(&cells)
+        );
+    }
+    if let Some(field) = tables::field_headline(&records, &outcome.fitted) {
+        let _ = writeln!(text, "{field} (report.md: *Field-like use*).");
+    }
+    text
 }
 
 /// Writes `report.md`, `report.json` (the table as data), `uncertainty.json` (σ(t) and its
