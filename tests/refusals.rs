@@ -888,6 +888,78 @@ fn import_refuses_an_implausible_rate_naming_row_and_column() {
     assert!(!out.exists());
 }
 
+/// A sheet of four activations of unit U1 at +30 °C, at 10 Hz with a gyro's white noise; the
+/// third file's rates are divided by `third_rate_divisor` (57.3: logged in rad/s).
+fn noisy_bench(dir: &Path, third_rate_divisor: f64) -> PathBuf {
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut noise = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut sheet = String::from(
+        "file,unit,set_point_celsius,series,repeat,activation,off_before_s,series_kind,switch_on_s\n",
+    );
+    for k in 0..4 {
+        let divisor = if k == 2 { third_rate_divisor } else { 1.0 };
+        let mut text = String::from("t_s,gx_dps,gy_dps,gz_dps,temp_c\n");
+        for i in 0..50 {
+            let rate = |bias: f64, n: f64| (bias + 0.05 * n) / divisor;
+            text.push_str(&format!(
+                "{},{},{},{},{}\n",
+                f64::from(i) / 10.0,
+                rate(0.1, noise()),
+                rate(-0.2, noise()),
+                rate(0.05, noise()),
+                30.0 + 0.02 * f64::from(i)
+            ));
+        }
+        std::fs::write(dir.join(format!("a{k}.csv")), text).unwrap();
+        let off = if k == 0 { String::new() } else { "60".into() };
+        sheet.push_str(&format!(
+            "a{k}.csv,U1,30,1,1,{},{off},protocol,{}\n",
+            k + 1,
+            65 * k
+        ));
+    }
+    let path = dir.join("sheet.csv");
+    std::fs::write(&path, sheet).unwrap();
+    path
+}
+
+#[test]
+fn import_campaign_refuses_a_file_in_rad_s_among_files_in_deg_s() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("imported");
+    let import = |sheet: &Path| {
+        vec![
+            "import".to_owned(),
+            "campaign".into(),
+            s(sheet).into(),
+            "-o".into(),
+            s(&out).into(),
+            "--rate-hz".into(),
+            "10".into(),
+        ]
+    };
+    let args = import(&noisy_bench(dir.path(), 1.0));
+    common::ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    std::fs::remove_dir_all(&out).unwrap();
+    let args = import(&noisy_bench(dir.path(), 180.0 / std::f64::consts::PI));
+    refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[
+            "sheet.csv: row 3 (line 4), column `file`: the rate of `",
+            "a2.csv` changes from sample to sample by",
+            "57× less than the median of unit U1's 3 other files",
+            "it looks like rad/s among files in °/s",
+            "convert this file to the others' unit",
+        ],
+    );
+    assert!(!out.exists());
+}
+
 #[test]
 fn simulate_refuses_a_set_point_range_too_large_before_making_it() {
     let dir = tempfile::tempdir().unwrap();
