@@ -220,10 +220,13 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
         &|s, d, t| steps.update(s, d, t),
     );
     steps.finish();
-    let (path, outcome) = made?;
+    let (path, outcome, warnings) = made?;
     super::in_sample::write(&staged.path().join("tables"), &calibration, options)?;
     staged.commit()?;
-    print_headline(&outcome, &options);
+    for warning in &warnings {
+        eprintln!("warning: {warning}");
+    }
+    print_headline(&outcome, options);
     println!("report: {}", in_target(&args.out, &path).display());
     Ok(())
 }

@@ -3,6 +3,7 @@
 //! tables folder. `gyrodrift report`, `gyrodrift demo` and Python's `gyrodrift.report` all make it
 //! through [`make`], so the same inputs give the same bytes.
 
+mod evaluation_units;
 mod figures;
 mod input;
 pub mod measured;
@@ -50,19 +51,26 @@ pub fn make(
 }
 
 /// [`make`] with the data split by source: fits on the calibration activations of `calibration`
-/// and judges on every activation of `evaluation` ([`pipeline::run_separate`]).
+/// and judges on every activation of `evaluation` ([`pipeline::run_separate`]). Also returns
+/// warnings, each on top of the report too: evaluation recordings whose uncorrected drift is
+/// tens of times the calibration's (another rate unit).
 pub fn make_separate(
     calibration: &[PathBuf],
     evaluation: &[PathBuf],
     noise_floor: Option<&[PathBuf]>,
     options: &Options,
     out: &Path,
-    provenance: Vec<String>,
+    mut provenance: Vec<String>,
     progress: Progress<'_>,
-) -> anyhow::Result<(PathBuf, Outcome)> {
+) -> anyhow::Result<(PathBuf, Outcome, Vec<String>)> {
     let (outcome, noise_units) =
         pipeline::run_separate(calibration, evaluation, noise_floor, options, progress)?;
-    write_outcome(outcome, &noise_units, options, out, provenance)
+    let warnings = evaluation_units::warnings(&outcome, evaluation);
+    for warning in &warnings {
+        provenance.push(format!("\n**Warning:** {warning}."));
+    }
+    let (path, outcome) = write_outcome(outcome, &noise_units, options, out, provenance)?;
+    Ok((path, outcome, warnings))
 }
 
 fn write_outcome(
