@@ -1100,3 +1100,61 @@ fn diagnose_refuses_diagnosis_data_at_a_calibration_set_point() {
     );
     assert!(!dir.path().join("diagnosis").exists());
 }
+
+#[test]
+fn gzip_data_in_a_file_named_csv_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    gz.write_all(CSV.as_bytes()).unwrap();
+    std::fs::write(&csv, gz.finish().unwrap()).unwrap();
+    let out = dir.path().join("measured");
+    let text = refused(
+        &csv_args(s(&csv), s(&out), &[]),
+        &[
+            "bench.csv: the file holds gzip-compressed data (it starts with bytes 1f 8b), but its name does not end in `.gz`",
+            "bench.csv.gz`, or decompress it",
+        ],
+    );
+    assert!(!text.contains("utf-8") && !out.exists(), "{text}");
+}
+
+#[test]
+fn a_ulog_with_a_damaged_header_says_the_file_is_corrupt() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("flight.ulg");
+    let mut bytes = b"ULog\x01\x12\x35\x01".to_vec();
+    bytes.extend(0u64.to_le_bytes());
+    bytes[2] = 0;
+    std::fs::write(&log, &bytes).unwrap();
+    let out = dir.path().join("px4");
+    refused(
+        &["import", "ulog", s(&log), "-o", s(&out)],
+        &["flight.ulg: byte 0: the ULog header is corrupt: its magic reads 55 4c 00 67 01 12 35, not `ULog` 01 12 35: the file is corrupt"],
+    );
+    // A message the header's definitions do not allow is damage too, named as such.
+    bytes[2] = b'o';
+    bytes.extend([4u8, 0, b'D', 7, 0, 1, 2]);
+    std::fs::write(&log, &bytes).unwrap();
+    refused(
+        &["import", "ulog", s(&log), "-o", s(&out)],
+        &["flight.ulg: byte 16: data for msg_id 7, which no subscription defines: the file is corrupt"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_timing_hint_names_the_options_not_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("jitter.csv");
+    std::fs::write(
+        &csv,
+        "segment_id,t_s,gx,gy,gz,temp\n0,0.000,0.1,0.2,0.3,30.0\n0,0.001,0.1,0.2,0.3,30.0\n0,0.0026,0.1,0.2,0.3,30.0\n",
+    )
+    .unwrap();
+    let text = refused(
+        &csv_args(s(&csv), s(&dir.path().join("out")), &[]),
+        &["on the command line `--timing resample --rate-hz <the logging rate>`"],
+    );
+    assert!(!text.contains("::"), "{text}");
+}
