@@ -1158,3 +1158,42 @@ fn a_timing_hint_names_the_options_not_the_library() {
     );
     assert!(!text.contains("::"), "{text}");
 }
+
+#[test]
+fn diagnose_refuses_a_folder_of_another_run_and_force_replaces_its_own_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = s(campaign());
+    let out = dir.path().join("diagnosis");
+    let diagnose = |force: bool| {
+        let mut args = vec!["diagnose", c, "-q", "-o", s(&out)];
+        if force {
+            args.push("--force");
+        }
+        args
+    };
+    let mine = dir.path().join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    refused(
+        &["diagnose", c, "-q", "-o", s(&mine), "--force"],
+        &["holds files", "does not write (notes.txt)"],
+    );
+    assert_eq!(names(&mine), ["notes.txt"]);
+    common::ok(&diagnose(false));
+    std::fs::write(out.join("stale.svg"), "an earlier run's").unwrap();
+    refused(
+        &diagnose(false),
+        &["pass --force to replace the diagnosis there, or choose a new folder"],
+    );
+    assert!(
+        out.join("stale.svg").exists(),
+        "nothing removed without --force"
+    );
+    common::ok(&diagnose(true));
+    assert!(!out.join("stale.svg").exists() && out.join("diagnosis.md").is_file());
+    assert_eq!(
+        names(dir.path()),
+        ["diagnosis", "mine"],
+        "no staging folder left"
+    );
+}
