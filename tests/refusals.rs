@@ -1197,3 +1197,34 @@ fn diagnose_refuses_a_folder_of_another_run_and_force_replaces_its_own_whole() {
         "no staging folder left"
     );
 }
+
+#[test]
+fn export_to_an_existing_mcap_file_is_refused_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let recording = first_recording(campaign());
+    let bag = dir.path().join("bag.mcap");
+    std::fs::write(&bag, "the user's").unwrap();
+    let export = |force: bool| {
+        let mut args = vec!["export", "ros2", s(&recording), "-o", s(&bag)];
+        if force {
+            args.push("--force");
+        }
+        args
+    };
+    refused(
+        &export(false),
+        &["bag.mcap: the file exists; pass --force to replace it, or choose a new file"],
+    );
+    assert_eq!(std::fs::read_to_string(&bag).unwrap(), "the user's");
+    common::ok(&export(true));
+    assert!(std::fs::metadata(&bag).unwrap().len() > 1000);
+    // Never onto the recording it is made from.
+    let copy = dir.path().join("copy.mcap");
+    std::fs::copy(&recording, &copy).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    refused(
+        &["export", "ros2", s(&copy), "-o", s(&copy), "--force"],
+        &["copy.mcap: the recording being exported; give another output file"],
+    );
+    assert_eq!(std::fs::read(&copy).unwrap(), before);
+}
