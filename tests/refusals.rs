@@ -292,7 +292,11 @@ fn an_interrupted_simulate_removes_its_partial_files_and_exits_130() {
             })
             .unwrap_or_default()
     };
-    let recordings = out.join("recordings");
+    // Written into a staging folder beside the output, put in place once whole.
+    let recordings = dir
+        .path()
+        .join(format!(".campaign.writing-{pid}"))
+        .join("recordings");
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
     while partial(&recordings).is_empty() {
         assert!(
@@ -309,15 +313,79 @@ fn an_interrupted_simulate_removes_its_partial_files_and_exits_130() {
     let finished = child.wait_with_output().unwrap();
     let text = String::from_utf8_lossy(&finished.stderr);
     assert_eq!(finished.status.code(), Some(130), "{text}");
-    assert!(text.contains("interrupted: removed"), "{text}");
-    assert_eq!(partial(&recordings), Vec::<String>::new());
-    assert_eq!(partial(&out.join("truth")), Vec::<String>::new());
-    assert!(!out.join("summary.json").exists());
-    // What is left is refused by the readers, by name.
-    refused(
-        &["fit", s(&out), "-q", "-o", s(&dir.path().join("tables"))],
-        &["is an incomplete simulated campaign (no summary.json"],
+    assert!(
+        text.contains("interrupted: removed the unfinished output"),
+        "{text}"
     );
+    // Nothing is left: no staging folder, no half campaign.
+    assert_eq!(names(dir.path()), Vec::<String>::new());
+}
+
+#[test]
+fn simulate_force_keeps_the_earlier_campaign_until_the_new_one_is_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    copy_tree(campaign(), &out);
+    let before = names(&out.join("recordings"));
+    // Interrupted while the new campaign is being written: the earlier one is all there.
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
+        .args(["simulate", "-q", "-o", s(&out), "--force", "--units", "10"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stage = dir
+        .path()
+        .join(format!(".campaign.writing-{}", child.id()))
+        .join("recordings");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while std::fs::read_dir(&stage).map_or(true, |mut e| e.next().is_none()) {
+        assert!(std::time::Instant::now() < deadline, "no file written");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert_eq!(
+        names(&out.join("recordings")),
+        before,
+        "replaced while writing"
+    );
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let finished = child.wait_with_output().unwrap();
+    assert_eq!(finished.status.code(), Some(130));
+    assert_eq!(names(&out.join("recordings")), before);
+    assert!(out.join("summary.json").is_file());
+    // Replaced whole once the new campaign is written; its summary names the files in place.
+    common::ok(&[
+        "simulate",
+        "-q",
+        "-o",
+        s(&out),
+        "--force",
+        "--units",
+        "1",
+        "--set-points",
+        "30",
+        "--intervals",
+        "1",
+        "--repeats",
+        "1",
+    ]);
+    assert_eq!(
+        names(&out.join("recordings")),
+        ["GIU-01_sp+30.0C_protocol.mcap"]
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(
+        summary.contains(&format!(
+            "\"{}\"",
+            out.join("recordings/GIU-01_sp+30.0C_protocol.mcap")
+                .display()
+        )) && !summary.contains("writing"),
+        "{summary}"
+    );
+    assert_eq!(names(dir.path()), ["campaign"], "no staging folder left");
 }
 
 #[test]

@@ -104,7 +104,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let total = size::within(&campaign, args.max_gb, "--max-gb")?;
     let estimate_gb = size::estimate_bytes(&campaign, total) / 1e9;
-    drift_sim::output_folder::prepare(&args.out, args.force, "--force")?;
+    // Written into a staging folder put in place at the end: `--force` replaces an earlier
+    // campaign only once the new one is whole, and a failed or interrupted run leaves it as it was.
+    let staged =
+        super::interrupt::stage(&args.out, args.force, &drift_sim::output_folder::SIMULATE)?;
     if !args.quiet {
         eprintln!(
             "simulating `{}`: {} samples, about {} → {}",
@@ -132,8 +135,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             },
         ),
     );
-    super::interrupt::watch(&args.out);
-    let summary = drift_sim::simulate_campaign(&campaign, &args.out, |p| {
+    let summary = drift_sim::simulate_campaign(&campaign, staged.path(), |p| {
         bar.set_position(p.samples_done);
         bar.set_message(format!(
             "file {}/{}",
@@ -149,6 +151,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         )
     })?;
     bar.finish_and_clear();
+    summary_in_place(staged.path(), &args.out)?;
+    staged.commit()?;
     let hours = summary.samples as f64 / f64::from(campaign.sample_rate_hz) / 3600.0;
     println!(
         "{} files, {} samples ({hours:.2} h at {} Hz), {:.1} MB recordings + {:.1} MB truth in {:.1} s → {}",
@@ -161,4 +165,31 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Rewrites the paths `summary.json` gives for the files written into `stage` as they are once the
+/// folder is in place as `out`.
+fn summary_in_place(stage: &std::path::Path, out: &std::path::Path) -> anyhow::Result<()> {
+    let path = stage.join("summary.json");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let mut summary: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("reading {}", path.display()))?;
+    let files = summary
+        .get_mut("files")
+        .and_then(serde_json::Value::as_array_mut)
+        .into_iter()
+        .flatten();
+    for file in files {
+        for key in ["recording", "truth"] {
+            if let Some(serde_json::Value::String(p)) = file.get_mut(key) {
+                if let Ok(rest) = std::path::Path::new(p.as_str()).strip_prefix(stage) {
+                    *p = out.join(rest).display().to_string();
+                }
+            }
+        }
+    }
+    let text = serde_json::to_string_pretty(&summary)?;
+    drift_recording::write_atomic(&path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))
 }

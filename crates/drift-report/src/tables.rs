@@ -286,8 +286,7 @@ pub fn field_headline(records: &[Record], fitted: &[FittedUnit]) -> Option<Strin
     let units = fitted_units(fitted);
     let mean = |model: &str| field_means(records, &units, model).1;
     let fmt = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.4}"));
-    let best = best_baseline(|name| mean(name))
-        .map_or("–".into(), |(name, d)| format!("{d:.4} ({name})"));
+    let best = best_baseline(mean).map_or("–".into(), |(name, d)| format!("{d:.4} ({name})"));
     Some(format!(
         "Field-like use (never fitted), mean drift, °/s: uncorrected {}, best baseline {best}, modified {}, recommended {}",
         fmt(mean("uncorrected")),
