@@ -1296,3 +1296,18 @@ fn export_to_an_existing_mcap_file_is_refused_unless_forced() {
     );
     assert_eq!(std::fs::read(&copy).unwrap(), before);
 }
+
+#[test]
+fn an_image_of_another_model_is_named_by_model_not_by_number() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = s(campaign());
+    let tables = dir.path().join("tables");
+    common::ok(&["fit", c, "-q", "-o", s(&tables)]);
+    let unit = tables.join("GIU-01");
+    std::fs::copy(unit.join("standard.bin"), unit.join("modified.bin")).unwrap();
+    let text = refused(
+        &["check", c, "--tables", s(&tables), "-q", "-o", s(&dir.path().join("check"))],
+        &["modified.bin: the image holds a polynomial baseline (standard.bin, third_order.bin), where the paper's modified tables (modified.bin, by_history.bin) is expected"],
+    );
+    assert!(!text.contains("kind 2"), "{text}");
+}
