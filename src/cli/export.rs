@@ -102,6 +102,9 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
     };
     if args.out.extension().is_some_and(|e| e == "mcap") {
         refuse_existing_file(args)?;
+        // The bag is written to a temporary beside it: an interruption removes that.
+        let parent = args.out.parent().filter(|p| !p.as_os_str().is_empty());
+        super::interrupt::watch(parent.unwrap_or(Path::new(".")));
         let segments: Vec<_> = recording.segments.iter().collect();
         let bytes = write_ros2_bag(&args.out, &segments, source, &topics)?.bytes;
         println!(
