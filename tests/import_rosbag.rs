@@ -545,8 +545,10 @@ fn bags_that_are_not_what_the_options_say_are_refused_by_file_topic_and_message(
     // A gap in the gyro messages beyond --max-gap, named by bag, topic and message.
     let text = import_fails(&good, &out, &["--max-gap", "0.001"]);
     assert!(
-        text.contains("good.mcap (/imu/data from message #0, row = message; temperature from /imu/temperature)")
-            && text.contains("gap"),
+        text.contains("good.mcap: topic /imu/data (temperature from /imu/temperature), message ")
+            && text.contains(", field `header.stamp`: gap: ")
+            && text.contains("since the previous message (at most 0.001 s); `--max-gap <s>`")
+            && !text.contains("row"),
         "{text}"
     );
 }

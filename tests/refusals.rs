@@ -292,7 +292,11 @@ fn an_interrupted_simulate_removes_its_partial_files_and_exits_130() {
             })
             .unwrap_or_default()
     };
-    let recordings = out.join("recordings");
+    // Written into a staging folder beside the output, put in place once whole.
+    let recordings = dir
+        .path()
+        .join(format!(".campaign.writing-{pid}"))
+        .join("recordings");
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
     while partial(&recordings).is_empty() {
         assert!(
@@ -309,15 +313,79 @@ fn an_interrupted_simulate_removes_its_partial_files_and_exits_130() {
     let finished = child.wait_with_output().unwrap();
     let text = String::from_utf8_lossy(&finished.stderr);
     assert_eq!(finished.status.code(), Some(130), "{text}");
-    assert!(text.contains("interrupted: removed"), "{text}");
-    assert_eq!(partial(&recordings), Vec::<String>::new());
-    assert_eq!(partial(&out.join("truth")), Vec::<String>::new());
-    assert!(!out.join("summary.json").exists());
-    // What is left is refused by the readers, by name.
-    refused(
-        &["fit", s(&out), "-q", "-o", s(&dir.path().join("tables"))],
-        &["is an incomplete simulated campaign (no summary.json"],
+    assert!(
+        text.contains("interrupted: removed the unfinished output"),
+        "{text}"
     );
+    // Nothing is left: no staging folder, no half campaign.
+    assert_eq!(names(dir.path()), Vec::<String>::new());
+}
+
+#[test]
+fn simulate_force_keeps_the_earlier_campaign_until_the_new_one_is_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("campaign");
+    copy_tree(campaign(), &out);
+    let before = names(&out.join("recordings"));
+    // Interrupted while the new campaign is being written: the earlier one is all there.
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_gyrodrift"))
+        .args(["simulate", "-q", "-o", s(&out), "--force", "--units", "10"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stage = dir
+        .path()
+        .join(format!(".campaign.writing-{}", child.id()))
+        .join("recordings");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while std::fs::read_dir(&stage).map_or(true, |mut e| e.next().is_none()) {
+        assert!(std::time::Instant::now() < deadline, "no file written");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert_eq!(
+        names(&out.join("recordings")),
+        before,
+        "replaced while writing"
+    );
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let finished = child.wait_with_output().unwrap();
+    assert_eq!(finished.status.code(), Some(130));
+    assert_eq!(names(&out.join("recordings")), before);
+    assert!(out.join("summary.json").is_file());
+    // Replaced whole once the new campaign is written; its summary names the files in place.
+    common::ok(&[
+        "simulate",
+        "-q",
+        "-o",
+        s(&out),
+        "--force",
+        "--units",
+        "1",
+        "--set-points",
+        "30",
+        "--intervals",
+        "1",
+        "--repeats",
+        "1",
+    ]);
+    assert_eq!(
+        names(&out.join("recordings")),
+        ["GIU-01_sp+30.0C_protocol.mcap"]
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(
+        summary.contains(&format!(
+            "\"{}\"",
+            out.join("recordings/GIU-01_sp+30.0C_protocol.mcap")
+                .display()
+        )) && !summary.contains("writing"),
+        "{summary}"
+    );
+    assert_eq!(names(dir.path()), ["campaign"], "no staging folder left");
 }
 
 #[test]
@@ -888,6 +956,78 @@ fn import_refuses_an_implausible_rate_naming_row_and_column() {
     assert!(!out.exists());
 }
 
+/// A sheet of four activations of unit U1 at +30 °C, at 10 Hz with a gyro's white noise; the
+/// third file's rates are divided by `third_rate_divisor` (57.3: logged in rad/s).
+fn noisy_bench(dir: &Path, third_rate_divisor: f64) -> PathBuf {
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut noise = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut sheet = String::from(
+        "file,unit,set_point_celsius,series,repeat,activation,off_before_s,series_kind,switch_on_s\n",
+    );
+    for k in 0..4 {
+        let divisor = if k == 2 { third_rate_divisor } else { 1.0 };
+        let mut text = String::from("t_s,gx_dps,gy_dps,gz_dps,temp_c\n");
+        for i in 0..50 {
+            let rate = |bias: f64, n: f64| (bias + 0.05 * n) / divisor;
+            text.push_str(&format!(
+                "{},{},{},{},{}\n",
+                f64::from(i) / 10.0,
+                rate(0.1, noise()),
+                rate(-0.2, noise()),
+                rate(0.05, noise()),
+                30.0 + 0.02 * f64::from(i)
+            ));
+        }
+        std::fs::write(dir.join(format!("a{k}.csv")), text).unwrap();
+        let off = if k == 0 { String::new() } else { "60".into() };
+        sheet.push_str(&format!(
+            "a{k}.csv,U1,30,1,1,{},{off},protocol,{}\n",
+            k + 1,
+            65 * k
+        ));
+    }
+    let path = dir.join("sheet.csv");
+    std::fs::write(&path, sheet).unwrap();
+    path
+}
+
+#[test]
+fn import_campaign_refuses_a_file_in_rad_s_among_files_in_deg_s() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("imported");
+    let import = |sheet: &Path| {
+        vec![
+            "import".to_owned(),
+            "campaign".into(),
+            s(sheet).into(),
+            "-o".into(),
+            s(&out).into(),
+            "--rate-hz".into(),
+            "10".into(),
+        ]
+    };
+    let args = import(&noisy_bench(dir.path(), 1.0));
+    common::ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    std::fs::remove_dir_all(&out).unwrap();
+    let args = import(&noisy_bench(dir.path(), 180.0 / std::f64::consts::PI));
+    refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[
+            "sheet.csv: row 3 (line 4), column `file`: the rate of `",
+            "a2.csv` changes from sample to sample by",
+            "57× less than the median of unit U1's 3 other files",
+            "it looks like rad/s among files in °/s",
+            "convert this file to the others' unit",
+        ],
+    );
+    assert!(!out.exists());
+}
+
 #[test]
 fn simulate_refuses_a_set_point_range_too_large_before_making_it() {
     let dir = tempfile::tempdir().unwrap();
@@ -1027,4 +1167,147 @@ fn diagnose_refuses_diagnosis_data_at_a_calibration_set_point() {
         ],
     );
     assert!(!dir.path().join("diagnosis").exists());
+}
+
+#[test]
+fn gzip_data_in_a_file_named_csv_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    gz.write_all(CSV.as_bytes()).unwrap();
+    std::fs::write(&csv, gz.finish().unwrap()).unwrap();
+    let out = dir.path().join("measured");
+    let text = refused(
+        &csv_args(s(&csv), s(&out), &[]),
+        &[
+            "bench.csv: the file holds gzip-compressed data (it starts with bytes 1f 8b), but its name does not end in `.gz`",
+            "bench.csv.gz`, or decompress it",
+        ],
+    );
+    assert!(!text.contains("utf-8") && !out.exists(), "{text}");
+}
+
+#[test]
+fn a_ulog_with_a_damaged_header_says_the_file_is_corrupt() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("flight.ulg");
+    let mut bytes = b"ULog\x01\x12\x35\x01".to_vec();
+    bytes.extend(0u64.to_le_bytes());
+    bytes[2] = 0;
+    std::fs::write(&log, &bytes).unwrap();
+    let out = dir.path().join("px4");
+    refused(
+        &["import", "ulog", s(&log), "-o", s(&out)],
+        &["flight.ulg: byte 0: the ULog header is corrupt: its magic reads 55 4c 00 67 01 12 35, not `ULog` 01 12 35: the file is corrupt"],
+    );
+    // A message the header's definitions do not allow is damage too, named as such.
+    bytes[2] = b'o';
+    bytes.extend([4u8, 0, b'D', 7, 0, 1, 2]);
+    std::fs::write(&log, &bytes).unwrap();
+    refused(
+        &["import", "ulog", s(&log), "-o", s(&out)],
+        &["flight.ulg: byte 16: data for msg_id 7, which no subscription defines: the file is corrupt"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_timing_hint_names_the_options_not_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("jitter.csv");
+    std::fs::write(
+        &csv,
+        "segment_id,t_s,gx,gy,gz,temp\n0,0.000,0.1,0.2,0.3,30.0\n0,0.001,0.1,0.2,0.3,30.0\n0,0.0026,0.1,0.2,0.3,30.0\n",
+    )
+    .unwrap();
+    let text = refused(
+        &csv_args(s(&csv), s(&dir.path().join("out")), &[]),
+        &["on the command line `--timing resample --rate-hz <the logging rate>`"],
+    );
+    assert!(!text.contains("::"), "{text}");
+}
+
+#[test]
+fn diagnose_refuses_a_folder_of_another_run_and_force_replaces_its_own_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = s(campaign());
+    let out = dir.path().join("diagnosis");
+    let diagnose = |force: bool| {
+        let mut args = vec!["diagnose", c, "-q", "-o", s(&out)];
+        if force {
+            args.push("--force");
+        }
+        args
+    };
+    let mine = dir.path().join("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    refused(
+        &["diagnose", c, "-q", "-o", s(&mine), "--force"],
+        &["holds files", "does not write (notes.txt)"],
+    );
+    assert_eq!(names(&mine), ["notes.txt"]);
+    common::ok(&diagnose(false));
+    std::fs::write(out.join("stale.svg"), "an earlier run's").unwrap();
+    refused(
+        &diagnose(false),
+        &["pass --force to replace the diagnosis there, or choose a new folder"],
+    );
+    assert!(
+        out.join("stale.svg").exists(),
+        "nothing removed without --force"
+    );
+    common::ok(&diagnose(true));
+    assert!(!out.join("stale.svg").exists() && out.join("diagnosis.md").is_file());
+    assert_eq!(
+        names(dir.path()),
+        ["diagnosis", "mine"],
+        "no staging folder left"
+    );
+}
+
+#[test]
+fn export_to_an_existing_mcap_file_is_refused_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let recording = first_recording(campaign());
+    let bag = dir.path().join("bag.mcap");
+    std::fs::write(&bag, "the user's").unwrap();
+    let export = |force: bool| {
+        let mut args = vec!["export", "ros2", s(&recording), "-o", s(&bag)];
+        if force {
+            args.push("--force");
+        }
+        args
+    };
+    refused(
+        &export(false),
+        &["bag.mcap: the file exists; pass --force to replace it, or choose a new file"],
+    );
+    assert_eq!(std::fs::read_to_string(&bag).unwrap(), "the user's");
+    common::ok(&export(true));
+    assert!(std::fs::metadata(&bag).unwrap().len() > 1000);
+    // Never onto the recording it is made from.
+    let copy = dir.path().join("copy.mcap");
+    std::fs::copy(&recording, &copy).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    refused(
+        &["export", "ros2", s(&copy), "-o", s(&copy), "--force"],
+        &["copy.mcap: the recording being exported; give another output file"],
+    );
+    assert_eq!(std::fs::read(&copy).unwrap(), before);
+}
+
+#[test]
+fn an_image_of_another_model_is_named_by_model_not_by_number() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = s(campaign());
+    let tables = dir.path().join("tables");
+    common::ok(&["fit", c, "-q", "-o", s(&tables)]);
+    let unit = tables.join("GIU-01");
+    std::fs::copy(unit.join("standard.bin"), unit.join("modified.bin")).unwrap();
+    let text = refused(
+        &["check", c, "--tables", s(&tables), "-q", "-o", s(&dir.path().join("check"))],
+        &["modified.bin: the image holds a polynomial baseline (standard.bin, third_order.bin), where the paper's modified tables (modified.bin, by_history.bin) is expected"],
+    );
+    assert!(!text.contains("kind 2"), "{text}");
 }

@@ -155,3 +155,49 @@ fn report_fits_on_one_source_and_judges_on_another_as_the_library_path_does() {
         "{text}"
     );
 }
+
+#[test]
+fn evaluation_data_in_another_rate_unit_is_named_in_a_warning_printed_and_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = simulate(d, "calibration", "30, 40", &[]);
+    let b = simulate(d, "evaluation", "33, 35", &[]);
+    // One recording of the evaluation data logged in another unit: every rate 57.3× larger.
+    let scaled = Path::new(&b).join("recordings/GIU-01_sp+35.0C_protocol.mcap");
+    let mut recording = drift_recording::read_recording(&scaled).unwrap();
+    for segment in &mut recording.segments {
+        for axis in &mut segment.rate_dps {
+            for v in axis.iter_mut() {
+                *v *= 57.3;
+            }
+        }
+    }
+    drift_recording::write_recording(&recording, &scaled).unwrap();
+    let out = d.join("report");
+    let (status, text) = gyrodrift(&[
+        "report",
+        "-q",
+        "--calibration-data",
+        &a,
+        "--evaluation-data",
+        &b,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(status.status.code(), Some(0), "{text}");
+    let stderr = String::from_utf8_lossy(&status.stderr);
+    let named = "GIU-01_sp+35.0C_protocol.mcap`: uncorrected drift";
+    assert!(
+        stderr.contains("warning: --evaluation-data: `")
+            && stderr.contains(named)
+            && stderr.contains("the calibration data's")
+            && stderr.contains("another unit or scale (rad/s against °/s is 57×)"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("sp+33.0C"), "{stderr}");
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("**Warning:** --evaluation-data: `") && md.contains(named),
+        "{md}"
+    );
+}

@@ -123,7 +123,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let report_dir = args.out.join("report");
     let path = report_dir.join("report.md");
     println!();
-    print_headline(&outcome);
+    print_headline(&outcome, &options);
     println!("tables:  {}", report_dir.join("tables").display());
     println!("report:  {}", path.display());
     println!("total:   {:.1} s", started.elapsed().as_secs_f64());

@@ -12,6 +12,7 @@ use drift_diagnose::diagnose::{ActivationSeries, AxisDiagnosis, CandidateScore};
 use drift_diagnose::warm_start::WarmStartChoice;
 use drift_evaluate::pipeline;
 use drift_fit::FittedUnit;
+use drift_recording::output_folder::{Owned, Writer};
 use drift_recording::{read_recording, Segment};
 
 use super::campaign_args::CampaignArgs;
@@ -29,6 +30,9 @@ pub struct Args {
     /// Output folder for `diagnosis.md` and `diagnosis.json`.
     #[arg(long, short = 'o', default_value = "out/diagnosis")]
     pub out: PathBuf,
+    /// Replace an earlier `gyrodrift diagnose` output in the output folder, whole.
+    #[arg(long)]
+    pub force: bool,
     /// How many candidates to print per axis.
     #[arg(long, default_value_t = 5)]
     pub top: usize,
@@ -512,6 +516,14 @@ Each half ranked, fitted and guarded on its own series and was judged on the oth
     md
 }
 
+/// `diagnose` as a writer of output folders.
+pub const WRITER: Writer = Writer {
+    command: "diagnose",
+    product: "diagnosis",
+    doing: "diagnosing",
+    owned: Owned::Marker,
+};
+
 /// Runs `gyrodrift diagnose`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
@@ -526,6 +538,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             options.calibration_set_points
         );
     }
+    // Everything is written into a staging folder put in place at the end: a failed or
+    // interrupted diagnosis leaves an earlier one as it was, and no stale file of it survives.
+    let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
+    let out = staged.path().to_path_buf();
     let files = pipeline::recording_files(input.source())?;
     let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
@@ -709,7 +725,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         md.push_str(&markdown(axes, args.top));
         // The plots show the ranking just above them (behind the loop's model), so they follow
         // it rather than the paper's ranking.
-        md.push_str(&residual_plots(&stem, activations, axes, &args.out)?);
+        md.push_str(&residual_plots(&stem, activations, axes, &out)?);
         if closed.keying.any() {
             md.push_str(&paper_markdown(&closed.paper_axes, args.top));
         }
@@ -814,7 +830,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 fitted,
                 &before_after,
                 floor.as_ref(),
-                &args.out,
+                &out,
             )?);
         }
         json.push(serde_json::json!({
@@ -837,11 +853,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }));
     }
     md.push_str(&agreement_markdown(&units));
-    write_atomic(&args.out.join("diagnosis.md"), md.as_bytes())?;
+    write_atomic(&out.join("diagnosis.md"), md.as_bytes())?;
     write_atomic(
-        &args.out.join("diagnosis.json"),
+        &out.join("diagnosis.json"),
         serde_json::to_string_pretty(&json)?.as_bytes(),
     )?;
+    staged.commit()?;
     println!("diagnosis: {}", args.out.join("diagnosis.md").display());
     Ok(())
 }

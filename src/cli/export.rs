@@ -45,7 +45,8 @@ pub struct Ros2Args {
     /// per activation (`activation-001/` with `metadata.yaml` and `activation-001_0.mcap`, ...).
     #[arg(long, short = 'o')]
     pub out: PathBuf,
-    /// Replace an earlier `gyrodrift export` output in the output folder, whole.
+    /// Replace an earlier `gyrodrift export` output in the output folder, whole; or the `.mcap`
+    /// file named by `--out`.
     #[arg(long)]
     pub force: bool,
     /// The `sensor_msgs/msg/Imu` topic.
@@ -100,6 +101,10 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
         metadata: &recording.metadata,
     };
     if args.out.extension().is_some_and(|e| e == "mcap") {
+        refuse_existing_file(args)?;
+        // The bag is written to a temporary beside it: an interruption removes that.
+        let parent = args.out.parent().filter(|p| !p.as_os_str().is_empty());
+        super::interrupt::watch(parent.unwrap_or(Path::new(".")));
         let segments: Vec<_> = recording.segments.iter().collect();
         let bytes = write_ros2_bag(&args.out, &segments, source, &topics)?.bytes;
         println!(
@@ -122,6 +127,32 @@ fn run_ros2(args: &Ros2Args) -> anyhow::Result<()> {
         recording.segments.len(),
         recording.segments.len(),
         args.out.display()
+    );
+    Ok(())
+}
+
+/// A single-file output replaces an existing file only with `--force`, and never the recording it
+/// is made from or a folder (a bag folder, say, whose name ends in `.mcap`).
+fn refuse_existing_file(args: &Ros2Args) -> anyhow::Result<()> {
+    let out = &args.out;
+    anyhow::ensure!(
+        !out.is_dir(),
+        "{}: a folder; give a new `.mcap` file name, or a folder name without `.mcap` for one bag folder per activation",
+        out.display()
+    );
+    if !out.exists() {
+        return Ok(());
+    }
+    let same = std::fs::canonicalize(out).ok() == std::fs::canonicalize(&args.recording).ok();
+    anyhow::ensure!(
+        !same,
+        "{}: the recording being exported; give another output file",
+        out.display()
+    );
+    anyhow::ensure!(
+        args.force,
+        "{}: the file exists; pass --force to replace it, or choose a new file",
+        out.display()
     );
     Ok(())
 }

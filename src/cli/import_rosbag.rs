@@ -16,6 +16,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+
+use super::log_terms::{in_log_terms, LogRows};
 use drift_recording::ros2::{bag_files, read_bag, Bag, BagClock, BagTopics, ExportedActivation};
 use drift_recording::{
     read_csv_bytes, CsvOptions, Recording, Segment, SeriesKind, RAW_PER_CELSIUS,
@@ -169,21 +171,34 @@ fn on_grid(
             );
         }
     }
-    let name = PathBuf::from(format!(
-        "{} ({} from message #{}, row = message; temperature from {})",
-        bag.display(),
-        topics.gyro,
-        rows.first_message,
-        topics.temperature
-    ));
+    let field = |column: &str| match column {
+        "gx" => "angular_velocity.x".to_owned(),
+        "gy" => "angular_velocity.y".to_owned(),
+        "gz" => "angular_velocity.z".to_owned(),
+        "temp_c" => format!("{} temperature", topics.temperature),
+        "temp_y" => format!("{}/y temperature", topics.temperature),
+        "temp_z" => format!("{}/z temperature", topics.temperature),
+        _ => "header.stamp".to_owned(),
+    };
+    let log_rows = LogRows {
+        describe: format!(
+            "{}: topic {} (temperature from {})",
+            bag.display(),
+            topics.gyro,
+            topics.temperature
+        ),
+        first_message: rows.first_message as u64,
+        field: &field,
+    };
     let mut options = options.clone();
     options.columns.temperature_celsius = ["temp_c".into(), "temp_y".into(), "temp_z".into()];
-    let recording = read_csv_bytes(&name, rows.csv.as_bytes(), &options)?;
+    let recording = read_csv_bytes(Path::new(&log_rows.describe), rows.csv.as_bytes(), &options)
+        .map_err(|e| in_log_terms(e, &log_rows))?;
     let segment = recording
         .segments
         .into_iter()
         .next()
-        .with_context(|| format!("{}: no samples", name.display()))?;
+        .with_context(|| format!("{}: no samples", log_rows.describe))?;
     Ok(Activation {
         bag: bag.to_path_buf(),
         files,

@@ -16,6 +16,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+
+use super::log_terms::{in_log_terms, LogRows};
 use drift_recording::ulog::{read_ulog, Ulog, UlogTopic};
 use drift_recording::{
     read_csv_bytes, CsvColumns, CsvOptions, CsvTiming, RateUnit, Recording, Segment, SeriesKind,
@@ -123,18 +125,31 @@ pub(super) fn activation(
             c[i]
         )?;
     }
-    let name = PathBuf::from(format!(
-        "{} ({} instance {}, row = message)",
+    let describe = format!(
+        "{}: topic `{}` instance {}",
         log.path.display(),
         topic.name,
         topic.instance
-    ));
-    let recording = read_csv_bytes(&name, text.as_bytes(), options)?;
+    );
+    let field = |column: &str| match column {
+        "gx" => rates[0].to_owned(),
+        "gy" => rates[1].to_owned(),
+        "gz" => rates[2].to_owned(),
+        "temp_c" => temperature.to_owned(),
+        _ => "timestamp".to_owned(),
+    };
+    let rows = LogRows {
+        describe,
+        first_message: 1,
+        field: &field,
+    };
+    let recording = read_csv_bytes(Path::new(&rows.describe), text.as_bytes(), options)
+        .map_err(|e| in_log_terms(e, &rows))?;
     recording
         .segments
         .into_iter()
         .next()
-        .with_context(|| format!("{}: no samples", name.display()))
+        .with_context(|| format!("{}: no samples", rows.describe))
 }
 
 fn logs(path: &Path) -> anyhow::Result<Vec<PathBuf>> {

@@ -18,6 +18,7 @@ pub mod import_rosbag;
 pub mod import_ulog;
 mod in_sample;
 pub mod interrupt;
+mod log_terms;
 mod measured;
 mod progress;
 mod reading;

@@ -98,9 +98,13 @@ pub fn in_target(out: &Path, path: &Path) -> PathBuf {
         .map_or_else(|| out.to_owned(), |name| out.join(name))
 }
 
-/// Prints the headline table of a finished report.
-pub fn print_headline(outcome: &Outcome) {
-    print!("{}", drift_report::headline_of(outcome));
+/// Prints the headline table of a finished report, its absolute-error verdict and its field-like
+/// results.
+pub fn print_headline(outcome: &Outcome, options: &Options) {
+    print!(
+        "{}",
+        drift_report::headline_of(outcome, options.fit.independent_after_min)
+    );
 }
 
 /// Runs `gyrodrift report`.
@@ -123,7 +127,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let error = match made {
         Ok((path, outcome)) => {
             staged.commit()?;
-            print_headline(&outcome);
+            print_headline(&outcome, &options);
             println!("report: {}", in_target(&args.out, &path).display());
             return Ok(());
         }
@@ -216,10 +220,13 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
         &|s, d, t| steps.update(s, d, t),
     );
     steps.finish();
-    let (path, outcome) = made?;
+    let (path, outcome, warnings) = made?;
     super::in_sample::write(&staged.path().join("tables"), &calibration, options)?;
     staged.commit()?;
-    print_headline(&outcome);
+    for warning in &warnings {
+        eprintln!("warning: {warning}");
+    }
+    print_headline(&outcome, options);
     println!("report: {}", in_target(&args.out, &path).display());
     Ok(())
 }

@@ -104,7 +104,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let total = size::within(&campaign, args.max_gb, "--max-gb")?;
     let estimate_gb = size::estimate_bytes(&campaign, total) / 1e9;
-    drift_sim::output_folder::prepare(&args.out, args.force, "--force")?;
+    // Written into a staging folder put in place at the end: `--force` replaces an earlier
+    // campaign only once the new one is whole, and a failed or interrupted run leaves it as it was.
+    let staged =
+        super::interrupt::stage(&args.out, args.force, &drift_sim::output_folder::SIMULATE)?;
     if !args.quiet {
         eprintln!(
             "simulating `{}`: {} samples, about {} → {}",
@@ -132,8 +135,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             },
         ),
     );
-    super::interrupt::watch(&args.out);
-    let summary = drift_sim::simulate_campaign(&campaign, &args.out, |p| {
+    let summary = drift_sim::simulate_campaign(&campaign, staged.path(), |p| {
         bar.set_position(p.samples_done);
         bar.set_message(format!(
             "file {}/{}",
@@ -149,6 +151,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         )
     })?;
     bar.finish_and_clear();
+    summary_in_place(staged.path(), &args.out)?;
+    staged.commit()?;
     let hours = summary.samples as f64 / f64::from(campaign.sample_rate_hz) / 3600.0;
     println!(
         "{} files, {} samples ({hours:.2} h at {} Hz), {:.1} MB recordings + {:.1} MB truth in {:.1} s → {}",
@@ -161,4 +165,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.out.display()
     );
     Ok(())
+}
+
+/// Rewrites the paths `summary.json` gives for the files written into `stage` as they are once the
+/// folder is in place as `out`; the rest of the file keeps its bytes.
+fn summary_in_place(stage: &std::path::Path, out: &std::path::Path) -> anyhow::Result<()> {
+    let path = stage.join("summary.json");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    // As JSON string contents, with the separator that starts a file's path inside the folder.
+    let quoted = |folder: &std::path::Path| -> anyhow::Result<String> {
+        let json = serde_json::to_string(&folder.join("x").display().to_string())?;
+        Ok(format!("\"{}", &json[1..json.len() - 2]))
+    };
+    let text = text.replace(&quoted(stage)?, &quoted(out)?);
+    drift_recording::write_atomic(&path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))
 }

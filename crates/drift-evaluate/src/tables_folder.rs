@@ -51,13 +51,49 @@ pub enum TablesError {
         problem: std::io::Error,
     },
     /// A stored image is not a valid image of the expected model.
-    #[error("{path}: {problem}")]
+    #[error("{path}: {}", blob_message(problem))]
     Decode {
         /// The image.
         path: PathBuf,
         /// What the decoder refused.
         problem: BlobError,
     },
+}
+
+/// The model an image's kind byte stands for, by name (`modified.bin` and its kin hold these).
+pub fn kind_name(kind: u8) -> String {
+    use drift_core::blob::Kind;
+    let named = [
+        (
+            Kind::Modified,
+            "the paper's modified tables (modified.bin, by_history.bin)",
+        ),
+        (
+            Kind::Polynomial,
+            "a polynomial baseline (standard.bin, third_order.bin)",
+        ),
+        (
+            Kind::RelativePolynomial,
+            "the relative polynomial baseline (relative.bin)",
+        ),
+        (Kind::Recommended, "the recommended model (recommended.bin)"),
+    ];
+    named.iter().find(|(k, _)| *k as u8 == kind).map_or_else(
+        || format!("an unknown model kind ({kind})"),
+        |(_, name)| (*name).to_owned(),
+    )
+}
+
+/// What a decoder refused, for people: a wrong model kind is named, not numbered.
+pub fn blob_message(problem: &BlobError) -> String {
+    match problem {
+        BlobError::WrongKind { expected, found } => format!(
+            "the image holds {}, where {} is expected",
+            kind_name(*found),
+            kind_name(*expected)
+        ),
+        other => other.to_string(),
+    }
 }
 
 /// The models a tables folder holds for each unit.

@@ -266,7 +266,9 @@ impl From<Error> for PyErr {
             Error::Json { model, source } => {
                 TableError::new_err(format!("not a valid {model} JSON: {source}"))
             }
-            Error::Image(source) => ImageError::new_err(source.to_string()),
+            Error::Image(source) => {
+                ImageError::new_err(drift_evaluate::tables_folder::blob_message(&source))
+            }
             Error::File {
                 action,
                 path,

@@ -71,8 +71,9 @@ pub fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyRecording> {
 
 /// Checks what the writer needs beyond a valid in-memory recording, as `InputError`s naming segment
 /// and channel: the format's auxiliary channels, and any named ones (valid names, one unit per
-/// name across the recording), each at 100 Hz with one value per 10 ms of the activation. A
-/// channel then reads back exactly as it was built.
+/// name across the recording), each at 100 Hz with one value per 10 ms of the activation or none
+/// (a channel the source did not record, as the reader gives it). A channel then reads back
+/// exactly as it was built, so whatever a reader gives can be saved again.
 fn check_writable(recording: &Recording) -> Result<(), Error> {
     let mut units: BTreeMap<&str, (&str, usize)> = BTreeMap::new();
     for (i, segment) in recording.segments.iter().enumerate() {
@@ -108,10 +109,13 @@ fn check_writable(recording: &Recording) -> Result<(), Error> {
             }
         }
         for (name, channel) in &segment.aux {
-            if channel.sample_rate_hz != AUX_RATE_HZ || channel.values.len() != expected {
+            // No values: a channel the source did not record, as every reader gives the format's
+            // own channels of a file without them; it is written and read back empty.
+            let length_ok = channel.values.is_empty() || channel.values.len() == expected;
+            if channel.sample_rate_hz != AUX_RATE_HZ || !length_ok {
                 return Err(Error::Input(format!(
                     "segments[{i}]: channel {name:?} must hold {expected} values at {AUX_RATE_HZ} Hz \
-                     ({} samples at {} Hz), got {} values at {} Hz",
+                     ({} samples at {} Hz) or none (not recorded), got {} values at {} Hz",
                     segment.len(),
                     segment.sample_rate_hz,
                     channel.values.len(),

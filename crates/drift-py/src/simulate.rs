@@ -54,6 +54,29 @@ fn parse_text(text: &str) -> Result<Campaign, Error> {
     })
 }
 
+/// A campaign from the JSON text of the dict given as `campaign`. An error names the dict's key at
+/// fault (`campaign["units"]`), not a line and column of JSON text the caller never wrote.
+fn from_dict(json: &str) -> Result<Campaign, Error> {
+    let value: serde_json::Value = serde_json::from_str(json)
+        .map_err(|e| Error::Campaign(format!("not a valid campaign: {e}")))?;
+    serde_json::from_value(value.clone()).map_err(|error| {
+        // Every field has a default: the first key that fails on its own is the one at fault.
+        let key = value.as_object().and_then(|fields| {
+            fields.iter().find_map(|(key, v)| {
+                let alone =
+                    serde_json::Value::Object([(key.clone(), v.clone())].into_iter().collect());
+                serde_json::from_value::<Campaign>(alone)
+                    .is_err()
+                    .then(|| key.clone())
+            })
+        });
+        Error::Campaign(match key {
+            Some(key) => format!("not a valid campaign: `campaign[{key:?}]`: {error}"),
+            None => format!("not a valid campaign: `campaign`: {error}"),
+        })
+    })
+}
+
 /// The base campaign: the paper's, a dict, TOML/JSON text, or a file (`os.PathLike`).
 fn base(py: Python<'_>, campaign: Option<&Bound<'_, PyAny>>) -> Result<Campaign, Error> {
     let Some(value) = campaign.filter(|c| !c.is_none()) else {
@@ -67,8 +90,7 @@ fn base(py: Python<'_>, campaign: Option<&Bound<'_, PyAny>>) -> Result<Campaign,
             .and_then(|json| json.call_method1("dumps", (value,)))
             .and_then(|text| text.extract::<String>())
             .map_err(|e| Error::Campaign(format!("campaign dict is not JSON-serialisable: {e}")))?;
-        serde_json::from_str(&json)
-            .map_err(|e| Error::Campaign(format!("not a valid campaign: {e}")))?
+        from_dict(&json)?
     } else if let Ok(path) = value.extract::<PathBuf>() {
         // The command line's reader: JSON for `.json`, TOML otherwise; it also validates.
         return Ok(Campaign::from_file(&path)?);

@@ -418,7 +418,11 @@ def image(modified: ModifiedTables) -> bytes:
             lambda b: b[:4] + b"\x00\x00" + b[6:],
             "table image format version 0 is not supported (this build reads 1 and 2)",
         ),
-        (lambda b: b[:6] + b"\x02" + b[7:], "table image holds model kind 2, expected 1"),
+        (
+            lambda b: b[:6] + b"\x02" + b[7:],
+            "the image holds a polynomial baseline (standard.bin, third_order.bin), "
+            "where the paper's modified tables (modified.bin, by_history.bin) is expected",
+        ),
         (lambda b: b + b"\x00\x00", "2 unexpected bytes after the table image's CRC"),
         (lambda b: b[:20] + bytes([b[20] ^ 1]) + b[21:], "table image CRC mismatch"),
         (
@@ -452,7 +456,12 @@ def test_each_image_error(image: bytes, corrupt: Any, message: str) -> None:
 
 
 def test_image_of_the_other_kind(models: dict[str, Model]) -> None:
-    with pytest.raises(ImageError, match=re.escape("table image holds model kind 1, expected 2")):
+    with pytest.raises(
+        ImageError,
+        match=re.escape(
+            "the image holds the paper's modified tables (modified.bin, by_history.bin), where a"
+        ),
+    ):
         PolynomialTables.from_image(models["modified"].to_image())
 
 

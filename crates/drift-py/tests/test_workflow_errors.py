@@ -245,7 +245,18 @@ def test_validation_error_names_file_topic_and_message(campaign_dir: Path, tmp_p
             CampaignError,
             "invalid campaign: set_points_celsius[1]: must be in −60…+100 °C, got 200",
         ),
-        ({"colour": "blue"}, {}, CampaignError, "not a valid campaign: unknown field `colour`"),
+        (
+            {"colour": "blue"},
+            {},
+            CampaignError,
+            'not a valid campaign: `campaign["colour"]`: unknown field `colour`',
+        ),
+        (
+            {"seed": 3, "units": "two"},
+            {},
+            CampaignError,
+            'not a valid campaign: `campaign["units"]`: invalid type: string "two", expected u32',
+        ),
         ("units = ", {}, CampaignError, "not a valid campaign TOML"),
         (None, {"set_points": "30,abc"}, InputError, "`set_points` must be a sequence of floats"),
         (None, {"effects": ["sunspots"]}, InputError, "`effects`: unknown effect `sunspots`"),
@@ -276,6 +287,9 @@ def test_bad_campaigns(
     with pytest.raises(error) as raised:
         gyrodrift.resolve_campaign(campaign, **overrides)
     assert message in str(raised.value)
+    if not isinstance(campaign, str):
+        # The caller wrote a dict or keywords, no text: no line and column of one.
+        assert " at line " not in str(raised.value)
 
 
 def test_campaign_file_missing(tmp_path: Path) -> None:

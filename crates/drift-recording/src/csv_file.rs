@@ -220,6 +220,12 @@ pub enum CsvError {
         /// Bytes decompressed before it.
         decompressed: usize,
     },
+    /// Gzip-compressed data in a file whose name does not say so (no `.gz` ending).
+    #[error("{path}: the file holds gzip-compressed data (it starts with bytes 1f 8b), but its name does not end in `.gz`: name it `{}.gz`, or decompress it", path.display())]
+    GzipContent {
+        /// The file.
+        path: PathBuf,
+    },
     /// The options cannot be used.
     #[error("{path}: option `{field}`: {reason}")]
     Options {
@@ -284,8 +290,20 @@ pub fn read_csv(path: &Path, options: &CsvOptions) -> Result<Recording, CsvError
             })?;
         return read_csv_from(path, text.as_slice(), options);
     }
-    read_csv_from(path, std::io::BufReader::new(file), options)
+    let mut reader = std::io::BufReader::new(file);
+    if std::io::BufRead::fill_buf(&mut reader)
+        .map_err(io)?
+        .starts_with(&GZIP_MAGIC)
+    {
+        return Err(CsvError::GzipContent {
+            path: path.to_path_buf(),
+        });
+    }
+    read_csv_from(path, reader, options)
 }
+
+/// The first bytes of a gzip stream (RFC 1952).
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 
 /// Reads CSV text held in memory (not compressed); `name` stands for the file in errors. The same
 /// checks as [`read_csv`]; fuzzing drives it directly.
@@ -810,7 +828,7 @@ fn to_segment(
                     return Err(timing_error(
                         i,
                         format!(
-                            "{what}: time {t} s is sample {position:.2} of the activation at {} Hz, expected sample {i} (host timestamps with jitter or pauses: read them with resampled timing, `CsvTiming::Resample`, on the command line `--timing resample --rate-hz <the logging rate>`)",
+                            "{what}: time {t} s is sample {position:.2} of the activation at {} Hz, expected sample {i} (host timestamps with jitter or pauses: read them with resampled timing: on the command line `--timing resample --rate-hz <the logging rate>`, in Python `max_gap_s=`)",
                             options.sample_rate_hz
                         ),
                     ));

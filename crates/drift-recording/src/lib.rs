@@ -26,6 +26,7 @@ pub mod ros2;
 pub mod schema;
 mod segment;
 mod sheet;
+mod sheet_units;
 pub mod ulog;
 mod writable;
 mod write;

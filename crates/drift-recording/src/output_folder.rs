@@ -254,8 +254,12 @@ impl Staged {
             stage,
             committed: false,
         };
-        let marker = staged.stage.join(MARKER);
-        std::fs::write(&marker, format!("{}\n", writer.command)).map_err(io("writing", &marker))?;
+        // A writer known by the names it writes has no marker: one would be foreign to it.
+        if matches!(writer.owned, Owned::Marker) {
+            let marker = staged.stage.join(MARKER);
+            std::fs::write(&marker, format!("{}\n", writer.command))
+                .map_err(io("writing", &marker))?;
+        }
         Ok(staged)
     }
 

@@ -33,6 +33,7 @@ use crate::csv_file::{read_csv, CsvError, CsvOptions};
 use crate::layout::AUX_RATE_HZ;
 use crate::read::Recording;
 use crate::segment::{AuxChannel, Segment, SeriesKind, RAW_PER_CELSIUS};
+use crate::sheet_units;
 
 /// The format's own auxiliary channel of the chamber's set point, °C.
 const SET_POINT_CHANNEL: &str = "chamber_set_point";
@@ -430,6 +431,8 @@ pub fn read_sheet_campaign_with(
     let fs = options.sample_rate_hz;
     let period_ns = 1_000_000_000 / u64::from(fs.max(1));
     let mut recordings = Vec::new();
+    // Per unit: each activation file's noise level with its row, to find a file in another unit.
+    let mut levels: BTreeMap<String, Vec<(&SheetRow, Option<f64>)>> = BTreeMap::new();
     for (key, stem) in order.iter().zip(stems) {
         let (unit, kind, bits) = key;
         let set_point = f64::from_bits(*bits);
@@ -470,6 +473,10 @@ pub fn read_sheet_campaign_with(
                     reason: format!("{}: no samples", row.file.display()),
                 });
             };
+            levels
+                .entry(unit.clone())
+                .or_default()
+                .push((row, sheet_units::noise_level(&segment)));
             let end_of_previous = previous.map(|(end, _)| end);
             let power_on_ns = match (row.switch_on_ns, end_of_previous) {
                 (Some(on), _) => on,
@@ -604,6 +611,30 @@ pub fn read_sheet_campaign_with(
                 segments,
             },
         ));
+    }
+    for (unit, files) in &levels {
+        let found: Vec<Option<f64>> = files.iter().map(|(_, level)| *level).collect();
+        if let Some((i, ratio, median)) = sheet_units::odd_one_out(&found) {
+            let row = files[i].0;
+            return Err(SheetError::Row {
+                path: sheet.to_path_buf(),
+                row: row.at.0,
+                line: row.at.1,
+                column: "file".into(),
+                reason: format!(
+                    "the rate of `{}` changes from sample to sample by {:.3e} °/s on average, {} the median of unit {unit}'s {} other files ({median:.3e} °/s): {}. One `--rate-unit` reads every file of the sheet: convert this file to the others' unit",
+                    row.file.display(),
+                    ratio * median,
+                    if ratio < 1.0 {
+                        format!("{:.0}× less than", 1.0 / ratio)
+                    } else {
+                        format!("{ratio:.0}× more than")
+                    },
+                    files.len() - 1,
+                    sheet_units::likely_cause(ratio)
+                ),
+            });
+        }
     }
     Ok(recordings)
 }

@@ -241,18 +241,50 @@ pub fn read_ulog(path: &Path) -> Result<Ulog, UlogError> {
     read_ulog_bytes(path, &bytes)
 }
 
+/// What is wrong with the 16-byte file header (magic, version, timestamp), if anything: a file
+/// that starts like ULog but breaks the magic, or ends inside the header, is a damaged ULog file;
+/// anything else is not ULog at all.
+fn header_fault(bytes: &[u8]) -> Option<String> {
+    if bytes.len() >= 16 && bytes[..7] == MAGIC {
+        return None;
+    }
+    let shared = bytes.iter().zip(MAGIC).filter(|(a, b)| **a == *b).count();
+    Some(
+        if bytes.len() < 16 && MAGIC.starts_with(&bytes[..bytes.len().min(7)]) {
+            format!(
+            "the file ends inside the 16-byte ULog header ({} bytes): the file is corrupt (truncated)",
+            bytes.len()
+        )
+        } else if shared >= 4 {
+            format!(
+            "the ULog header is corrupt: its magic reads {}, not `ULog` 01 12 35: the file is corrupt",
+            bytes
+                .iter()
+                .take(7)
+                .map(|b| format!("{b:02x}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        )
+        } else {
+            "not a ULog file (magic `ULog` 01 12 35 missing)".into()
+        },
+    )
+}
+
 /// Reads ULog bytes held in memory; `path` names them in errors.
 pub fn read_ulog_bytes(path: &Path, bytes: &[u8]) -> Result<Ulog, UlogError> {
+    // Past a valid header every malformed message is damage to the file, and is named so.
     let bad = |offset: usize, reason: String| UlogError::Format {
         path: path.to_path_buf(),
         offset,
-        reason,
+        reason: format!("{reason}: the file is corrupt"),
     };
-    if bytes.len() < 16 || bytes[..7] != MAGIC {
-        return Err(bad(
-            0,
-            "not a ULog file (magic `ULog` 01 12 35 missing)".into(),
-        ));
+    if let Some(reason) = header_fault(bytes) {
+        return Err(UlogError::Format {
+            path: path.to_path_buf(),
+            offset: 0,
+            reason,
+        });
     }
     let start_us = u64::from_le_bytes(bytes[8..16].try_into().unwrap_or_default());
     let mut formats: BTreeMap<String, String> = BTreeMap::new();
@@ -301,10 +333,14 @@ pub fn read_ulog_bytes(path: &Path, bytes: &[u8]) -> Result<Ulog, UlogError> {
                 }
                 appended.sort_unstable();
                 if body[8] & !1 != 0 {
-                    return Err(bad(
-                        pos,
-                        format!("incompatible flags {:#04x}: a newer ULog version", body[8]),
-                    ));
+                    return Err(UlogError::Format {
+                        path: path.to_path_buf(),
+                        offset: pos,
+                        reason: format!(
+                            "incompatible flags {:#04x} (this reader knows bit 0, appended data): the file is corrupt, or from a newer ULog version",
+                            body[8]
+                        ),
+                    });
                 }
             }
             b'F' => {

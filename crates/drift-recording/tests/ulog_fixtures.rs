@@ -161,7 +161,7 @@ fn bad_input_is_named_by_file_and_byte_offset() {
     let e = read_ulog_bytes(name, &bytes).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "bad.ulg: byte 16: data for msg_id 7, which no subscription defines"
+        "bad.ulg: byte 16: data for msg_id 7, which no subscription defines: the file is corrupt"
     );
     // A subscription to a format never defined.
     let mut bytes = b"ULog\x01\x12\x35\x01".to_vec();
@@ -172,7 +172,33 @@ fn bad_input_is_named_by_file_and_byte_offset() {
     let e = read_ulog_bytes(name, &bytes).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "bad.ulg: byte 16: no format definition `sensor_gyro`"
+        "bad.ulg: byte 16: no format definition `sensor_gyro`: the file is corrupt"
+    );
+    // A header that starts as ULog's but is damaged, or cut short, is a corrupt ULog file.
+    let mut bytes = b"ULog\x01\x12\x35\x01".to_vec();
+    bytes.extend(0u64.to_le_bytes());
+    bytes[1] = b'X';
+    let e = read_ulog_bytes(name, &bytes).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "bad.ulg: byte 0: the ULog header is corrupt: its magic reads 55 58 6f 67 01 12 35, not `ULog` 01 12 35: the file is corrupt"
+    );
+    let e = read_ulog_bytes(name, b"ULog\x01\x12").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "bad.ulg: byte 0: the file ends inside the 16-byte ULog header (6 bytes): the file is corrupt (truncated)"
+    );
+    // Unknown incompatible flags: a newer version, or damage.
+    let mut bytes = b"ULog\x01\x12\x35\x01".to_vec();
+    bytes.extend(0u64.to_le_bytes());
+    let mut flags = vec![0u8; 40];
+    flags[8] = 0xff;
+    bytes.extend([40u8, 0, b'B']);
+    bytes.extend(&flags);
+    let e = read_ulog_bytes(name, &bytes).unwrap_err();
+    assert!(
+        e.to_string().ends_with("incompatible flags 0xff (this reader knows bit 0, appended data): the file is corrupt, or from a newer ULog version"),
+        "{e}"
     );
 }
 

@@ -181,6 +181,8 @@ pub fn write_all(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<Vec<(Str
         ModelKind::Uncorrected,
         ModelKind::Standard,
         ModelKind::ThirdOrder,
+        ModelKind::Relative,
+        ModelKind::RelativeCubic,
         ModelKind::Modified,
     ]
     .iter()
@@ -192,7 +194,7 @@ pub fn write_all(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<Vec<(Str
                 r.models
                     .iter()
                     .find(|m| m.model == model)
-                    .map(|m| (i as f64, m.drift_dps[AXIS]))
+                    .map(|m| ((i + 1) as f64, m.drift_dps[AXIS]))
             })
             .collect();
         Series::markers(model.name(), points)
@@ -206,7 +208,7 @@ pub fn write_all(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<Vec<(Str
         ),
         Chart {
             title: "Drift per validation activation",
-            x: "activation (in recording order)",
+            x: "validation activation (from 1, in recording order)",
             y: "drift (max − min within the activation), °/s",
         },
         series,

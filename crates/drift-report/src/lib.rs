@@ -4,6 +4,7 @@
 //! through [`make`], so the same inputs give the same bytes.
 
 mod coverage;
+mod evaluation_units;
 mod figures;
 mod input;
 pub mod measured;
@@ -51,19 +52,26 @@ pub fn make(
 }
 
 /// [`make`] with the data split by source: fits on the calibration activations of `calibration`
-/// and judges on every activation of `evaluation` ([`pipeline::run_separate`]).
+/// and judges on every activation of `evaluation` ([`pipeline::run_separate`]). Also returns
+/// warnings, each on top of the report too: evaluation recordings whose uncorrected drift is
+/// tens of times the calibration's (another rate unit).
 pub fn make_separate(
     calibration: &[PathBuf],
     evaluation: &[PathBuf],
     noise_floor: Option<&[PathBuf]>,
     options: &Options,
     out: &Path,
-    provenance: Vec<String>,
+    mut provenance: Vec<String>,
     progress: Progress<'_>,
-) -> anyhow::Result<(PathBuf, Outcome)> {
+) -> anyhow::Result<(PathBuf, Outcome, Vec<String>)> {
     let (outcome, noise_units) =
         pipeline::run_separate(calibration, evaluation, noise_floor, options, progress)?;
-    write_outcome(outcome, &noise_units, options, out, provenance)
+    let warnings = evaluation_units::warnings(&outcome, evaluation);
+    for warning in &warnings {
+        provenance.push(format!("\n**Warning:** {warning}."));
+    }
+    let (path, outcome) = write_outcome(outcome, &noise_units, options, out, provenance)?;
+    Ok((path, outcome, warnings))
 }
 
 fn write_outcome(
@@ -100,8 +108,10 @@ pub fn provenance(source: &str, options: &Options) -> Vec<String> {
     )]
 }
 
-/// The headline table of an outcome (Markdown), for printing.
-pub fn headline_of(outcome: &Outcome) -> String {
+/// What a finished report says first, for printing: the headline table (Markdown), the
+/// absolute-error verdict and the field-like results' means, as `report.md` has them.
+/// `independent_after_min` is the fit's cool-down (what counts as a cold start).
+pub fn headline_of(outcome: &Outcome, independent_after_min: f64) -> String {
     let records = summarise(&outcome.results);
     let mut noise: Vec<String> = outcome
         .results
@@ -111,7 +121,19 @@ pub fn headline_of(outcome: &Outcome) -> String {
         .collect();
     noise.sort();
     noise.dedup();
-    tables::headline(&records, &outcome.fitted, &noise)
+    let mut text = tables::headline(&records, &outcome.fitted, &noise);
+    let cells = absolute_error(&outcome.results, independent_after_min);
+    if !cells.is_empty() {
+        let _ = writeln!(
+            text,
+            "{} (report.md: *Absolute error*).",
+            tables::absolute_error_verdict(&cells)
+        );
+    }
+    if let Some(field) = tables::field_headline(&records, &outcome.fitted) {
+        let _ = writeln!(text, "{field} (report.md: *Field-like use*).");
+    }
+    text
 }
 
 /// Writes `report.md`, `report.json` (the table as data), `uncertainty.json` (σ(t) and its

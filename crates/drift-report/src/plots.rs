@@ -78,6 +78,20 @@ fn decimals(lo: f64, hi: f64) -> usize {
     digits.clamp(0.0, 9.0) as usize
 }
 
+/// A tick label with `decimals` decimals; a value that rounds to zero reads "0", never "-0.000".
+fn tick(value: f64, decimals: usize) -> String {
+    let text = format!("{value:.decimals$}");
+    if text
+        .trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        "0".to_owned()
+    } else {
+        text
+    }
+}
+
 /// Width of the plot; the legend gets a column to its right, off the data.
 const PLOT_WIDTH: u32 = 900;
 /// Width of the legend column.
@@ -104,8 +118,8 @@ fn draw_into(svg: &mut String, chart: &Chart<'_>, series: &[Series]) -> anyhow::
     plot.configure_mesh()
         .x_desc(chart.x)
         .y_desc(chart.y)
-        .x_label_formatter(&|v| format!("{v:.x_decimals$}"))
-        .y_label_formatter(&|v| format!("{v:.y_decimals$}"))
+        .x_label_formatter(&|v| tick(*v, x_decimals))
+        .y_label_formatter(&|v| tick(*v, y_decimals))
         .draw()
         .map_err(|e| fail(&e))?;
     let text = ("sans-serif", 14).into_font().color(&BLACK);
@@ -153,5 +167,15 @@ mod tests {
         assert_eq!(decimals(2.0, 6.4), 1);
         assert_eq!(decimals(0.0, 40.0), 0);
         assert_eq!(decimals(1.0, 1.0), 0);
+    }
+
+    #[test]
+    fn a_tick_at_zero_reads_0_whatever_its_sign_or_decimals() {
+        assert_eq!(tick(-0.00004, 3), "0");
+        assert_eq!(tick(0.0, 2), "0");
+        assert_eq!(tick(-0.0, 0), "0");
+        assert_eq!(tick(-0.0015, 3), "-0.002");
+        assert_eq!(tick(0.25, 2), "0.25");
+        assert_eq!(tick(10.0, 0), "10");
     }
 }

@@ -241,31 +241,58 @@ pub fn field_table(records: &[Record], fitted: &[FittedUnit]) -> String {
     md.push('\n');
     for model in MODELS {
         let _ = write!(md, "| {model} |");
-        let mut all = Vec::new();
-        for u in &units {
-            for axis in AXES {
-                let values: Vec<f64> = of_split(records, Split::Field)
-                    .filter(|r| r.unit == u.unit_id && r.model == model && r.axis == axis)
-                    .map(|r| r.drift_dps)
-                    .collect();
-                if values.is_empty() {
-                    md.push_str(" – |");
-                } else {
-                    let mean = values.iter().sum::<f64>() / values.len() as f64;
-                    all.push(mean);
-                    let _ = write!(md, " {mean:.4} |");
+        let (cells, mean) = field_means(records, &units, model);
+        for cell in cells {
+            match cell {
+                Some(v) => {
+                    let _ = write!(md, " {v:.4} |");
                 }
+                None => md.push_str(" – |"),
             }
         }
-        let mean = if all.is_empty() {
-            f64::NAN
-        } else {
-            all.iter().sum::<f64>() / all.len() as f64
-        };
-        let _ = writeln!(md, " {mean:.4} |");
+        let _ = writeln!(md, " {:.4} |", mean.unwrap_or(f64::NAN));
     }
     md.push('\n');
     md
+}
+
+/// A model's mean drift on the field-like activations per unit × axis (in column order), and
+/// the mean of those.
+fn field_means(
+    records: &[Record],
+    units: &[&FittedUnit],
+    model: &str,
+) -> (Vec<Option<f64>>, Option<f64>) {
+    let cells: Vec<Option<f64>> = units
+        .iter()
+        .flat_map(|u| AXES.iter().map(move |axis| (u, axis)))
+        .map(|(u, axis)| {
+            let values: Vec<f64> = of_split(records, Split::Field)
+                .filter(|r| r.unit == u.unit_id && r.model == model && r.axis == *axis)
+                .map(|r| r.drift_dps)
+                .collect();
+            (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+        })
+        .collect();
+    let present: Vec<f64> = cells.iter().flatten().copied().collect();
+    let mean = (!present.is_empty()).then(|| present.iter().sum::<f64>() / present.len() as f64);
+    (cells, mean)
+}
+
+/// The field-like results in one sentence (the means of *Field-like use*): uncorrected, the best
+/// standard baseline, the paper's model and the recommended one; `None` without field data.
+pub fn field_headline(records: &[Record], fitted: &[FittedUnit]) -> Option<String> {
+    of_split(records, Split::Field).next()?;
+    let units = fitted_units(fitted);
+    let mean = |model: &str| field_means(records, &units, model).1;
+    let fmt = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:.4}"));
+    let best = best_baseline(mean).map_or("–".into(), |(name, d)| format!("{d:.4} ({name})"));
+    Some(format!(
+        "Field-like use (never fitted), mean drift, °/s: uncorrected {}, best baseline {best}, modified {}, recommended {}",
+        fmt(mean("uncorrected")),
+        fmt(mean("modified")),
+        fmt(mean("recommended"))
+    ))
 }
 
 /// The noise-floor unit's figures.
@@ -337,29 +364,44 @@ pub fn residual_rms(records: &[Record], fitted: &[FittedUnit]) -> String {
     md
 }
 
+/// The absolute-error verdict in one sentence: in how many unit × axis × set point ×
+/// activation-class cells the paper's model leaves more than [`WORSE_THAN_BASELINE`] × the best
+/// standard baseline's residual bias RMS.
+pub fn absolute_error_verdict(cells: &[AbsoluteCell]) -> String {
+    let worse = cells.iter().filter(|c| c.worse).count();
+    if cells.is_empty() {
+        "No held-out activations: no absolute error to compare".to_owned()
+    } else if worse == 0 {
+        format!(
+            "In none of the {} unit × axis × set point × activation-class cells does the paper's model leave more than {WORSE_THAN_BASELINE}× the best standard baseline's residual bias RMS",
+            cells.len()
+        )
+    } else {
+        format!(
+            "In {worse} of {} unit × axis × set point × activation-class cells the paper's model leaves more than {WORSE_THAN_BASELINE}× the best standard baseline's residual bias RMS",
+            cells.len()
+        )
+    }
+}
+
 /// The cells where the paper's model leaves more than [`WORSE_THAN_BASELINE`] × the best
 /// baseline's residual bias RMS, for the report's first page: a sentence and a short table, or a
 /// sentence saying there are none.
 pub fn absolute_error_flags(cells: &[AbsoluteCell]) -> String {
     let mut md = String::from("## Absolute error: where the paper's model is worse\n\n");
-    let worse: Vec<&AbsoluteCell> = cells.iter().filter(|c| c.worse).collect();
     if cells.is_empty() {
         md.push_str("No held-out activations: nothing to compare.\n\n");
         return md;
     }
+    let verdict = absolute_error_verdict(cells);
+    let worse: Vec<&AbsoluteCell> = cells.iter().filter(|c| c.worse).collect();
     if worse.is_empty() {
-        let _ = writeln!(
-            md,
-            "In none of the {} unit × axis × set point × activation-class cells does the paper's model leave more than {WORSE_THAN_BASELINE}× the best standard baseline's residual bias RMS (table: *Absolute error*, below).\n",
-            cells.len()
-        );
+        let _ = writeln!(md, "{verdict} (table: *Absolute error*, below).\n");
         return md;
     }
     let _ = writeln!(
         md,
-        "**In {} of {} unit × axis × set point × activation-class cells the paper's model leaves more than {WORSE_THAN_BASELINE}× the best standard baseline's residual bias RMS** (the drift metric, max − min, does not see a wrong offset; this does). Residual bias RMS, mean over the cell's activations, °/s:\n",
-        worse.len(),
-        cells.len()
+        "**{verdict}** (the drift metric, max − min, does not see a wrong offset; this does). Residual bias RMS, mean over the cell's activations, °/s:\n"
     );
     md.push_str("| unit | axis | set point | activations | n | modified | best baseline | modified / best | why (when known) |\n|---|---|---|---|---:|---:|---|---:|---|\n");
     for c in worse {

@@ -882,7 +882,8 @@ class Recording:
         in "g", supply_voltage in "V", chamber_set_point in "degC" — and may have any other named
         channels, each written to its own topic `/aux/<name>` and read back by `load`: names of
         ASCII letters, digits, "_", "." and "-", starting with a letter or digit, one unit per
-        name across the recording. Every channel is at 100 Hz, one value per 10 ms. A channel
+        name across the recording. Every channel is at 100 Hz, one value per 10 ms, or empty (not
+        recorded: what `load` gives for a file without it, so a loaded recording saves again). A channel
         that breaks these raises `InputError` naming segment and channel; otherwise `FileError`
         or `RecordingError`."""
     @property
