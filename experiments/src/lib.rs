@@ -5,4 +5,5 @@
 pub mod closed_loop;
 pub mod memory;
 pub mod oracle;
+pub mod world_loop;
 pub mod worlds;

@@ -12,18 +12,13 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
-use drift_diagnose::closing::{close, close_both, LoopOptions};
-use drift_diagnose::roles::Roles;
-use drift_fit::analyse::analyse;
-use drift_fit::{fit_unit, FitSettings};
+use drift_fit::FitSettings;
 use drift_recording::{read_recording, AuxChannel, Segment, RECORDINGS_DIR, TRUTH_EXTENSION};
 use drift_sim::truth::read_truth;
 use serde::{Deserialize, Serialize};
 
 use crate::memory::peak_rss_mb;
-use drift_recording::paper::{
-    CALIBRATION_SET_POINTS_CELSIUS as CALIBRATION, VALIDATION_SET_POINT_CELSIUS as VALIDATION,
-};
+use crate::world_loop::fit_and_close;
 
 /// The recorded channel that carries the truth on axis `axis`.
 pub fn oracle_channel(axis: usize) -> String {
@@ -124,34 +119,12 @@ pub fn close_oracle(
 ) -> anyhow::Result<OracleOutcome> {
     let started = Instant::now();
     let all = segments_with_oracle(&dir.join(RECORDINGS_DIR), &oracle_dir.join("world"))?;
-    let analysed = Roles::split(&all, &CALIBRATION)
-        .calibration
-        .iter()
-        .map(|s| analyse(s, settings))
-        .collect::<Result<Vec<_>, _>>()?;
-    let base = fit_unit(&analysed, settings)?;
-    let options = LoopOptions {
-        extend: false,
-        select_on: if select_on_validation {
-            vec![VALIDATION]
-        } else {
-            Vec::new()
-        },
-        ..LoopOptions::new(&CALIBRATION)
-    };
     let diagnosis = match diagnosis_dir {
         Some(d) => segments_with_oracle(&d.join(RECORDINGS_DIR), &oracle_dir.join("diagnosis"))?,
         None => Vec::new(),
     };
     let diagnosis: Vec<&Segment> = diagnosis.iter().collect();
-    let closed = if diagnosis.is_empty() {
-        close(&base, &all, &[], &options, settings)?
-    } else {
-        close_both(&base, &all, &diagnosis, &options, settings)?
-            .into_iter()
-            .next()
-            .context("the cross-fitted loop closed no half")?
-    };
+    let (_, closed) = fit_and_close(&all, &diagnosis, false, select_on_validation, settings)?;
     let axes = (0..3)
         .map(|a| {
             let d = &closed.axes[a];

@@ -18,12 +18,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use drift_diagnose::closing::{close, close_both, LoopOptions};
-use drift_diagnose::roles::Roles;
 use drift_evaluate::evaluate;
 use drift_evaluate::excess::{excess_cut, ExcessCut};
-use drift_fit::analyse::analyse;
-use drift_fit::{fit_unit, FitSettings};
+use drift_fit::FitSettings;
 use drift_recording::{paper, Segment, SeriesKind, RECORDINGS_DIR, TRUTH_DIR};
 use drift_sim::world::effects::{EffectFamily, Source};
 use drift_sim::world::{World, WorldCampaign, WorldSpec, WorldTruth};
@@ -32,6 +29,7 @@ use serde::{Deserialize, Serialize};
 use crate::closed_loop::segments;
 pub use crate::memory::peak_rss_mb;
 use crate::oracle::{close_oracle, OracleAxis, OracleOutcome};
+use crate::world_loop::fit_and_close;
 
 /// The set point the loop is measured at (°C): the world campaign's validation one.
 pub const VALIDATION: f64 = paper::VALIDATION_SET_POINT_CELSIUS;
@@ -315,35 +313,12 @@ pub fn close_blind(
 ) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let all = segments(&dir.join(RECORDINGS_DIR))?;
-    let analysed = Roles::split(&all, &CALIBRATION)
-        .calibration
-        .iter()
-        .map(|s| analyse(s, settings))
-        .collect::<Result<Vec<_>, _>>()?;
-    let base = fit_unit(&analysed, settings)?;
-    let selection: &[f64] = if select_on_validation {
-        &[VALIDATION]
-    } else {
-        &[]
-    };
-    let options = LoopOptions {
-        extend: true,
-        select_on: selection.to_vec(),
-        ..LoopOptions::new(&CALIBRATION)
-    };
     let diagnosis = match diagnosis_dir {
         Some(d) => segments(&d.join(RECORDINGS_DIR))?,
         None => Vec::new(),
     };
     let diagnosis: Vec<&Segment> = diagnosis.iter().collect();
-    let closed = if diagnosis.is_empty() {
-        close(&base, &all, &[], &options, settings)?
-    } else {
-        close_both(&base, &all, &diagnosis, &options, settings)?
-            .into_iter()
-            .next()
-            .context("the cross-fitted loop closed no half")?
-    };
+    let (base, closed) = fit_and_close(&all, &diagnosis, true, select_on_validation, settings)?;
     let measured: Vec<_> = closed
         .before_after(&base, settings)
         .into_iter()
