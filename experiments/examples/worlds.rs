@@ -116,8 +116,8 @@ fn one_world(
         ]),
         Err(_) => Err(anyhow::anyhow!("not recorded")),
     };
-    let oracle: anyhow::Result<Option<OracleOutcome>> = match (&outcome, kind) {
-        (Ok(_), Kind::Effect(_)) => child(&[
+    let oracle: anyhow::Result<Option<OracleOutcome>> = match &outcome {
+        Ok(_) if kind.has_oracle() => child(&[
             "--child-oracle",
             &paths.dir.display().to_string(),
             &diagnosis_text,

@@ -2,9 +2,9 @@
 //! data. The world's undeclared effect alone (the simulator's `/truth/hidden_effect_bias`, per
 //! axis) joins every activation as a recorded channel (`oracle_x`, `oracle_y`, `oracle_z`), and
 //! the loop's own diagnosis — the same fit, baseline, folds, shuffles and size threshold as the
-//! blind run — scores it beside the candidates. Its gain on its own axis is the most any
-//! candidate could explain there: an axis where even the true regressor stays under the detectable
-//! share cannot be found by any regressor built from the recordings.
+//! blind run — scores it beside the candidates. Its gain on its own axis is what the effect itself
+//! explains beyond the baseline: an axis where even the true regressor stays under the detectable
+//! share cannot have the effect found by any regressor built from the recordings.
 //!
 //! Run after the blind loop, in a process of its own (it reads the truth).
 

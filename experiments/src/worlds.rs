@@ -80,6 +80,12 @@ impl Kind {
             })
     }
 
+    /// Whether the world's effect is an additive bias an oracle can regress on (every family but
+    /// self-heating, which changes the heating itself).
+    pub fn has_oracle(self) -> bool {
+        matches!(self, Self::Effect(f) if f != EffectFamily::SelfHeating)
+    }
+
     /// The world spec: only this family at `magnitude` × the realistic size, or a null world.
     pub fn spec(self, magnitude: f64) -> WorldSpec {
         match self {
@@ -616,8 +622,8 @@ pub fn run_world(
         .as_ref()
         .ok()
         .map(|_| close_blind(&paths.dir, &paths.floor_dir, &fit_settings(), false, None));
-    let oracle = match (&outcome, kind) {
-        (Some(Ok(_)), Kind::Effect(_)) => Some(close_oracle(
+    let oracle = match &outcome {
+        Some(Ok(_)) if kind.has_oracle() => Some(close_oracle(
             &paths.dir,
             None,
             &paths.oracle_dir,
