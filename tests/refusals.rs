@@ -1147,6 +1147,34 @@ fn long_numbers_are_shortened() {
 }
 
 #[test]
+fn diagnose_refuses_a_copy_of_the_campaign_as_evaluation_data_or_noise_floor() {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("copy");
+    copy_tree(campaign(), &copy);
+    for flag in ["--evaluation-data", "--noise-floor", "--diagnosis-data"] {
+        refused(
+            &[
+                "diagnose",
+                s(campaign()),
+                "-q",
+                // The noise floor is read for the extended model's figures.
+                "--extend",
+                flag,
+                s(&copy.join("recordings")),
+                "-o",
+                s(&dir.path().join("diagnosis")),
+            ],
+            &[
+                &format!("({flag}) holds the same recording as"),
+                "(the campaign)",
+                "other recordings than the campaign",
+            ],
+        );
+        assert!(!dir.path().join("diagnosis").exists());
+    }
+}
+
+#[test]
 fn diagnose_refuses_diagnosis_data_at_a_calibration_set_point() {
     let dir = tempfile::tempdir().unwrap();
     refused(

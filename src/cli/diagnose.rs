@@ -17,6 +17,7 @@ use drift_recording::{read_recording, Segment};
 
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
+use super::shared_data::refuse_shared;
 use drift_report::plots;
 use drift_report::tables::ten_thousandths;
 use drift_report::write_atomic;
@@ -540,9 +541,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     // Everything is written into a staging folder put in place at the end: a failed or
     // interrupted diagnosis leaves an earlier one as it was, and no stale file of it survives.
+    let files = pipeline::recording_files(input.source())?;
+    refuse_shared_inputs(&files, args)?;
     let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let out = staged.path().to_path_buf();
-    let files = pipeline::recording_files(input.source())?;
     let steps = Steps::new(input.quiet);
     let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
         .map_err(|e| super::measured::explain(e, &files))?;
@@ -861,4 +863,33 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     staged.commit()?;
     println!("diagnosis: {}", args.out.join("diagnosis.md").display());
     Ok(())
+}
+
+/// Refuses diagnosis data, evaluation data or a noise floor that hold a recording of the campaign
+/// (or of each other), compared by content: a copy of the campaign given as `--evaluation-data`
+/// would be counted as held out.
+fn refuse_shared_inputs(campaign: &[PathBuf], args: &Args) -> anyhow::Result<()> {
+    let listed = |dir: &Option<PathBuf>| {
+        dir.as_deref()
+            .map(pipeline::recording_files)
+            .transpose()
+            .map(Option::unwrap_or_default)
+    };
+    let diagnosis = listed(&args.diagnosis_data)?;
+    let evaluation = listed(&args.evaluation_data)?;
+    let floor = listed(&args.noise_floor)?;
+    let apart = "each must be other recordings than the campaign and than each other: give \
+                 recordings the campaign does not hold";
+    for (flag, files) in [
+        ("--diagnosis-data", &diagnosis),
+        ("--evaluation-data", &evaluation),
+        ("--noise-floor", &floor),
+    ] {
+        refuse_shared(("the campaign", campaign), (flag, files), apart)?;
+    }
+    refuse_shared(
+        ("--diagnosis-data", &diagnosis),
+        ("--evaluation-data", &evaluation),
+        apart,
+    )
 }
