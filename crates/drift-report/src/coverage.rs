@@ -96,6 +96,8 @@ pub fn draw_map(unit: &UnitCoverage) -> anyhow::Result<String> {
             .disable_mesh()
             .x_desc("switch-on temperature, °C (mean over axes)")
             .y_desc("residual heat at switch-on, °C")
+            .x_label_formatter(&|v| crate::plots::tick(*v, 1))
+            .y_label_formatter(&|v| crate::plots::tick(*v, 1))
             .draw()
             .map_err(|e| fail(&e))?;
         let text = ("sans-serif", 12).into_font().color(&BLACK);

@@ -79,7 +79,7 @@ fn decimals(lo: f64, hi: f64) -> usize {
 }
 
 /// A tick label with `decimals` decimals; a value that rounds to zero reads "0", never "-0.000".
-fn tick(value: f64, decimals: usize) -> String {
+pub(crate) fn tick(value: f64, decimals: usize) -> String {
     let text = format!("{value:.decimals$}");
     if text
         .trim_start_matches('-')
