@@ -686,6 +686,8 @@ def _default_settings() -> dict[str, Any]:
         "ambient_margin_celsius": s.ambient_margin_celsius,
         "rise_margin_celsius": s.rise_margin_celsius,
         "stuck_after_samples": s.stuck_after_samples,
+        # The fit does not state the rate the stuck timeout was converted at (drift-core: 0).
+        "sample_rate_hz": 0.0,
     }
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+import struct
 from pathlib import Path
 from typing import Any
 
@@ -291,8 +292,11 @@ def test_committed_image_still_loads(modified: ModifiedTables) -> None:
     fixture = VECTORS.parent / "image-v1-modified.bin"
     stored = ModifiedTables.load_image(fixture)
     assert stored == modified and stored.extension == ()
-    # Version 2 wrote a longer header (64 bytes, not 12) before the same payload.
-    assert fixture.read_bytes()[12:-4] == stored.to_image()[64:-4]
+    # Version 2 wrote a longer header (64 bytes, not 12); version 3's settings add the sample rate
+    # (f32, 0: not stated) after the stuck timeout's varint; every other payload byte is the same.
+    old, new = fixture.read_bytes()[12:-4], stored.to_image()[64:-4]
+    at = 16 + next(i for i, byte in enumerate(old[16:]) if byte & 0x80 == 0) + 1
+    assert new == old[:at] + struct.pack("<f", 0.0) + old[at:]
 
 
 def test_extension_changes_the_correction(modified: ModifiedTables, extended: ModifiedTables) -> None:
