@@ -113,18 +113,7 @@ pub struct StillnessCase {
 impl StillnessCase {
     /// The learner's settings.
     pub fn settings(&self) -> StillnessSettings {
-        let [sample_rate_hz, accel_rate_hz, rate_threshold_dps, rate_sd_threshold_dps, accel_sd_threshold_g, variance_time_constant_s, still_for_s, time_constant_s] =
-            self.settings.map(f32::from_bits);
-        StillnessSettings {
-            sample_rate_hz,
-            accel_rate_hz,
-            rate_threshold_dps,
-            rate_sd_threshold_dps,
-            accel_sd_threshold_g,
-            variance_time_constant_s,
-            still_for_s,
-            time_constant_s,
-        }
+        StillnessSettings::from_array(self.settings.map(f32::from_bits))
     }
 
     /// Runs the learner over the case's inputs as firmware would: `each(i, rate bits, states)`

@@ -56,6 +56,39 @@ impl Default for StillnessSettings {
     }
 }
 
+impl StillnessSettings {
+    /// The settings in field order, as the shared test vectors and firmware images keep them.
+    pub const fn to_array(&self) -> [f32; 8] {
+        [
+            self.sample_rate_hz,
+            self.accel_rate_hz,
+            self.rate_threshold_dps,
+            self.rate_sd_threshold_dps,
+            self.accel_sd_threshold_g,
+            self.variance_time_constant_s,
+            self.still_for_s,
+            self.time_constant_s,
+        ]
+    }
+
+    /// The settings from [`Self::to_array`]'s order (not validated: [`StillnessLearner::new`]
+    /// checks them).
+    pub const fn from_array(values: [f32; 8]) -> Self {
+        let [sample_rate_hz, accel_rate_hz, rate_threshold_dps, rate_sd_threshold_dps, accel_sd_threshold_g, variance_time_constant_s, still_for_s, time_constant_s] =
+            values;
+        Self {
+            sample_rate_hz,
+            accel_rate_hz,
+            rate_threshold_dps,
+            rate_sd_threshold_dps,
+            accel_sd_threshold_g,
+            variance_time_constant_s,
+            still_for_s,
+            time_constant_s,
+        }
+    }
+}
+
 /// A moving mean and variance of one signal (exponential weights): the mean moves by `alpha` of
 /// each deviation, the variance by the West/Finch update, which stays non-negative.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

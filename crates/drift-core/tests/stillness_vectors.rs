@@ -22,32 +22,11 @@ const PATH: &str = concat!(
 );
 
 fn settings_bits(s: &StillnessSettings) -> [u32; 8] {
-    [
-        s.sample_rate_hz,
-        s.accel_rate_hz,
-        s.rate_threshold_dps,
-        s.rate_sd_threshold_dps,
-        s.accel_sd_threshold_g,
-        s.variance_time_constant_s,
-        s.still_for_s,
-        s.time_constant_s,
-    ]
-    .map(f32::to_bits)
+    s.to_array().map(f32::to_bits)
 }
 
 fn settings_of(bits: [u32; 8]) -> StillnessSettings {
-    let [sample_rate_hz, accel_rate_hz, rate_threshold_dps, rate_sd_threshold_dps, accel_sd_threshold_g, variance_time_constant_s, still_for_s, time_constant_s] =
-        bits.map(f32::from_bits);
-    StillnessSettings {
-        sample_rate_hz,
-        accel_rate_hz,
-        rate_threshold_dps,
-        rate_sd_threshold_dps,
-        accel_sd_threshold_g,
-        variance_time_constant_s,
-        still_for_s,
-        time_constant_s,
-    }
+    StillnessSettings::from_array(bits.map(f32::from_bits))
 }
 
 /// What firmware computes: per gyro sample the output rate and states, then the final offset.
