@@ -13,6 +13,7 @@
 use std::path::Path;
 
 use anyhow::Context;
+use drift_diagnose::activations::{loop_settings, read_by_unit};
 use drift_diagnose::closing::{
     close, mean_profiles, profile_bin_labels, BeforeAfter, LoopOptions, Profile,
 };
@@ -21,7 +22,7 @@ use drift_evaluate::evaluate;
 use drift_evaluate::excess::{excess_cut, excess_ratio, ExcessCut};
 use drift_fit::analyse::analyse;
 use drift_fit::{fit_unit, FitSettings};
-use drift_recording::{paper, read_recording, Segment, SeriesKind};
+use drift_recording::{paper, Segment, SeriesKind};
 use drift_sim::{simulate_campaign, Campaign, Field, HiddenEffects, Protocol, UnitModel};
 
 use drift_report::tables::ten_thousandths;
@@ -130,13 +131,14 @@ pub fn campaign(
     })
 }
 
-/// Every activation of every recording in `dir`.
+/// Every activation of every recording in `dir`, by unit, at the loop's rate
+/// ([`drift_diagnose::activations`]).
 pub fn segments(dir: &Path) -> anyhow::Result<Vec<Segment>> {
-    let mut out = Vec::new();
-    for path in drift_evaluate::pipeline::recording_files(dir)? {
-        out.extend(read_recording(&path)?.segments);
-    }
-    Ok(out)
+    let files = drift_evaluate::pipeline::recording_files(dir)?;
+    Ok(read_by_unit(&files, |_, _| {})?
+        .into_values()
+        .flatten()
+        .collect())
 }
 
 fn is(set_point: f64, value: f64) -> bool {
@@ -384,6 +386,8 @@ pub fn run(
     plan_size: &Plan,
 ) -> anyhow::Result<Vec<Row>> {
     plan_size.check()?;
+    // The loop reads activations at its own rate, and fits with the grid that rate needs.
+    let settings = &loop_settings(settings);
     let calibration = &plan_size.calibration;
     let dir = work.join(format!("{effect}-{seed}"));
     let twin_dir = work.join(format!("{effect}-{seed}-floor"));

@@ -12,6 +12,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
+use drift_diagnose::activations::at_diagnosis_rate;
 use drift_fit::FitSettings;
 use drift_recording::{read_recording, AuxChannel, Segment, RECORDINGS_DIR, TRUTH_EXTENSION};
 use drift_sim::truth::read_truth;
@@ -26,7 +27,8 @@ pub fn oracle_channel(axis: usize) -> String {
 }
 
 /// Every activation of every recording in `recordings`, each with the world's effect alone as
-/// three channels, read from the sidecar of the same name in `truth`.
+/// three channels, read from the sidecar of the same name in `truth`; at the loop's rate
+/// ([`drift_diagnose::activations`]), as the blind run's.
 pub fn segments_with_oracle(recordings: &Path, truth: &Path) -> anyhow::Result<Vec<Segment>> {
     let mut out = Vec::new();
     for path in drift_evaluate::pipeline::recording_files(recordings)? {
@@ -63,7 +65,7 @@ pub fn segments_with_oracle(recordings: &Path, truth: &Path) -> anyhow::Result<V
                 );
             }
         }
-        out.extend(segments);
+        out.extend(segments.into_iter().map(at_diagnosis_rate));
     }
     Ok(out)
 }

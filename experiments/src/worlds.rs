@@ -116,10 +116,10 @@ pub fn world_campaign(small: bool) -> WorldCampaign {
     }
 }
 
-/// The fit's settings for [`world_campaign`]: the defaults (the 1-s low-pass is converted with
-/// each recording's own rate).
+/// The fit's settings for [`world_campaign`]: the defaults as the loop runs them on its block
+/// means ([`drift_diagnose::activations::loop_settings`]).
 pub fn fit_settings() -> FitSettings {
-    FitSettings::default()
+    drift_diagnose::activations::loop_settings(&FitSettings::default())
 }
 
 /// Where one world's files go.

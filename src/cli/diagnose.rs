@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use drift_diagnose::activations::{loop_settings, read_by_unit, DIAGNOSIS_RATE_HZ};
 use drift_diagnose::closing::{
     close_both, close_separate_both, mean_profiles, profile_bin_labels, BeforeAfter, Closed,
     LoopOptions, Profile, Stage3Choice,
@@ -13,7 +14,7 @@ use drift_diagnose::warm_start::WarmStartChoice;
 use drift_evaluate::pipeline;
 use drift_fit::FittedUnit;
 use drift_recording::output_folder::{Owned, Writer};
-use drift_recording::{read_recording, Segment};
+use drift_recording::Segment;
 
 use super::campaign_args::CampaignArgs;
 use super::progress::Steps;
@@ -93,23 +94,14 @@ fn evaluation_segments(
     fitted: &[FittedUnit],
 ) -> anyhow::Result<BTreeMap<String, Vec<Segment>>> {
     let files = pipeline::recording_files(dir)?;
-    let mut units: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
-    let mut seen = std::collections::BTreeSet::new();
-    for path in &files {
-        let recording = read_recording(path)?;
-        seen.insert(recording.unit_id.clone());
-        if fitted.iter().any(|f| f.unit_id == recording.unit_id) {
-            units
-                .entry(recording.unit_id.clone())
-                .or_default()
-                .extend(recording.segments);
-        }
-    }
+    let mut units = read_by_unit(&files, |_, _| {})?;
+    let seen: Vec<String> = units.keys().cloned().collect();
+    units.retain(|unit, _| fitted.iter().any(|f| &f.unit_id == unit));
     anyhow::ensure!(
         !units.is_empty(),
         "{}: the evaluation data's units ({}) are none of the units fitted on the calibration data ({}): give recordings of the same units",
         dir.display(),
-        seen.into_iter().collect::<Vec<_>>().join(", "),
+        seen.join(", "),
         fitted.iter().map(|f| f.unit_id.as_str()).collect::<Vec<_>>().join(", ")
     );
     for (unit, segments) in &mut units {
@@ -528,7 +520,9 @@ pub const WRITER: Writer = Writer {
 /// Runs `gyrodrift diagnose`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
-    let options = input.options(&[], false)?;
+    let mut options = input.options(&[], false)?;
+    // The loop works on 0.1-s block means: its analysis grid is a whole number of them.
+    options.fit = loop_settings(&options.fit);
     if let Some(shared) = args
         .diagnose_on
         .iter()
@@ -546,17 +540,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let out = staged.path().to_path_buf();
     let steps = Steps::new(input.quiet);
-    let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
-        .map_err(|e| super::measured::explain(e, &files))?;
-    let mut recorded: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
-    for (i, path) in files.iter().enumerate() {
-        steps.update("reading activations by role", i as u64, files.len() as u64);
-        let recording = read_recording(path)?;
-        recorded
-            .entry(recording.unit_id.clone())
-            .or_default()
-            .extend(recording.segments);
-    }
+    // The tables are fitted on the activations as the loop sees them: at its rate.
+    let outcome = pipeline::fit_at_rate(&files, &options, DIAGNOSIS_RATE_HZ, &|s, d, t| {
+        steps.update(s, d, t)
+    })
+    .map_err(|e| super::measured::explain(e, &files))?;
+    let recorded = read_by_unit(&files, |done, total| {
+        steps.update("reading activations by role", done, total)
+    })?;
     let diagnosis_data = args
         .diagnosis_data
         .as_deref()

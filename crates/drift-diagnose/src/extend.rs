@@ -679,6 +679,8 @@ struct HeldOutGain {
     drift: f64,
     /// The drift metric without the term, °/s.
     drift_before: f64,
+    /// The mean square without the term, (°/s)².
+    squared_before: f64,
 }
 
 /// Whether a term's kind changes the shape within an activation (judged by the drift) rather than
@@ -739,6 +741,7 @@ fn held_out_gains(
                     squared: before[axis].0 - after[axis].0,
                     drift: before[axis].1 - after[axis].1,
                     drift_before: before[axis].1,
+                    squared_before: before[axis].0,
                 });
             }
         }
@@ -872,6 +875,14 @@ pub fn extend(
                 } else {
                     (improvement, "squared residual")
                 };
+                // A found term must not make the guard's activations worse on either metric: a
+                // mean loss of more than 1 % of a metric refuses it, significant or not (a rate
+                // term with a long time constant cut the drift on a null unit while its start
+                // moved the offsets: the held-out RMS rose by a fifth).
+                let squared_before =
+                    gains.iter().map(|g| g.squared_before).sum::<f64>() / gains.len().max(1) as f64;
+                let squared_worse = squared_worse || improvement < -0.01 * squared_before;
+                let drift_worse = drift_worse || drift_gain < -0.01 * drift_before;
                 let admit = own_gain > 0.0 && !squared_worse && !drift_worse;
                 let reason = if admit {
                     format!("significant in the diagnosis on this axis, and lowers the held-out {own_metric}")

@@ -9,6 +9,7 @@
 //! the error before and after on held-out activations.
 
 pub mod absorb;
+pub mod activations;
 pub mod before_after;
 pub mod candidates;
 pub mod closing;

@@ -14,8 +14,8 @@ use std::sync::mpsc::{channel, sync_channel, Receiver};
 use std::time::Instant;
 
 use drift_recording::{
-    paper, read_metadata, read_recording, OpenRecording, ReadError, Recording, Segment, SeriesKind,
-    COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR,
+    block_means, paper, read_metadata, read_recording, OpenRecording, ReadError, Recording,
+    Segment, SeriesKind, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR,
 };
 use rayon::prelude::*;
 
@@ -596,6 +596,7 @@ struct PassOne {
 fn read_and_analyse(
     files: &[PathBuf],
     options: &Options,
+    fit_rate_hz: Option<u32>,
     progress: Progress<'_>,
 ) -> Result<PassOne, PipelineError> {
     let (sender, receiver) = sync_channel(ACTIVATIONS_IN_FLIGHT);
@@ -603,7 +604,9 @@ fn read_and_analyse(
         let reader = std::thread::Builder::new()
             .name("gyrodrift-read".into())
             .spawn_scoped(scope, move || {
-                read_calibration(files, options, progress, |d| sender.send(d).is_ok())
+                read_calibration(files, options, fit_rate_hz, progress, |d| {
+                    sender.send(d).is_ok()
+                })
             });
         let reader = match reader {
             Ok(reader) => reader,
@@ -611,8 +614,9 @@ fn read_and_analyse(
             // in the same order, all in memory at once), then analyse.
             Err(_) => {
                 let (sender, receiver) = channel();
-                let read_seconds =
-                    read_calibration(files, options, progress, |d| sender.send(d).is_ok());
+                let read_seconds = read_calibration(files, options, fit_rate_hz, progress, |d| {
+                    sender.send(d).is_ok()
+                });
                 drop(sender);
                 let mut pass = analyse_calibration(receiver, options, |_, _| {});
                 if let Ok(pass) = &mut pass {
@@ -662,6 +666,7 @@ fn read_and_analyse(
 fn read_calibration(
     files: &[PathBuf],
     options: &Options,
+    fit_rate_hz: Option<u32>,
     progress: Progress<'_>,
     mut send: impl FnMut(Decoded) -> bool,
 ) -> f64 {
@@ -685,7 +690,14 @@ fn read_calibration(
         let mut samples = 0;
         let read = file.for_each_activation(|segment| {
             samples += segment.len() as u64;
-            !calibration_segment(&segment, options) || send(Decoded::Activation(Box::new(segment)))
+            if !calibration_segment(&segment, options) {
+                return true;
+            }
+            let segment = match fit_rate_hz {
+                Some(rate_hz) => block_means(&segment, rate_hz).unwrap_or(segment),
+                None => segment,
+            };
+            send(Decoded::Activation(Box::new(segment)))
         });
         match read {
             Ok(true) if send(Decoded::End(samples)) => {}
@@ -771,6 +783,34 @@ pub fn run(
     noise_floor: bool,
     progress: Progress<'_>,
 ) -> Result<Outcome, PipelineError> {
+    run_at(files, options, noise_floor, None, progress)
+}
+
+/// Fits every unit found in `files` as [`run`] does without evaluating, on each calibration
+/// activation's block means at `rate_hz` ([`drift_recording::block_means`]; activations whose
+/// rate is not a multiple of it as recorded): the closed loop's rate, so that the tables it
+/// diagnoses are fitted on the activations as it sees them.
+pub fn fit_at_rate(
+    files: &[PathBuf],
+    options: &Options,
+    rate_hz: u32,
+    progress: Progress<'_>,
+) -> Result<Outcome, PipelineError> {
+    let fit_only = Options {
+        held_out_repeats: false,
+        evaluate: false,
+        ..options.clone()
+    };
+    run_at(files, &fit_only, false, Some(rate_hz), progress)
+}
+
+fn run_at(
+    files: &[PathBuf],
+    options: &Options,
+    noise_floor: bool,
+    fit_rate_hz: Option<u32>,
+    progress: Progress<'_>,
+) -> Result<Outcome, PipelineError> {
     let mut outcome = Outcome::default();
     let settings = &options.fit;
     if let Some(&set_point) = options
@@ -783,7 +823,7 @@ pub fn run(
 
     // Pass 1: read and analyse the calibration activations, fitting each unit whose files are
     // all read while the next unit's are decoded.
-    let pass = read_and_analyse(files, options, progress)?;
+    let pass = read_and_analyse(files, options, fit_rate_hz, progress)?;
     progress(READ_STEP, files.len() as u64, files.len() as u64);
     outcome.samples_read = pass.samples_read;
     let (read_seconds, analyse_seconds) = (pass.read_seconds, pass.analyse_seconds);

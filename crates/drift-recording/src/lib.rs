@@ -13,6 +13,7 @@
 
 pub mod atomic;
 mod aux;
+mod block_means;
 pub mod cdr;
 mod csv_aux;
 mod csv_file;
@@ -34,6 +35,7 @@ pub mod writer;
 
 pub use atomic::{write_atomic, write_atomic_creating_folder};
 pub use aux::{check_named_aux_channel, fixed_aux_unit, named_aux_topic, FIXED_AUX_CHANNELS};
+pub use block_means::block_means;
 pub use csv_aux::CsvAuxColumn;
 pub use csv_file::{
     read_csv, read_csv_bytes, CsvColumns, CsvError, CsvOptions, CsvTiming, RateUnit, TimeUnit,
