@@ -569,6 +569,30 @@ fn an_interrupted_demo_leaves_the_earlier_demo_as_it_was_and_no_temporaries() {
 }
 
 #[test]
+fn demo_names_an_older_demo_without_the_marker_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    // What a demo wrote before output folders were marked.
+    for folder in ["campaign", "noise-floor", "report"] {
+        std::fs::create_dir_all(out.join(folder)).unwrap();
+    }
+    std::fs::write(out.join("report/report.md"), "# earlier\n").unwrap();
+    refused(
+        &["demo", "-q", "-o", s(&out)],
+        &[
+            "holds campaign, noise-floor, report but no .gyrodrift-output file",
+            "the output of an older `gyrodrift demo`",
+            "pass --force to replace it, or delete the folder",
+        ],
+    );
+    assert_eq!(names(&out), ["campaign", "noise-floor", "report"]);
+    assert_eq!(
+        std::fs::read_to_string(out.join("report/report.md")).unwrap(),
+        "# earlier\n"
+    );
+}
+
+#[test]
 fn check_on_the_tables_own_calibration_data_says_it_is_in_sample() {
     let dir = tempfile::tempdir().unwrap();
     let tables = dir.path().join("tables");
