@@ -1052,6 +1052,74 @@ fn import_campaign_refuses_a_file_in_rad_s_among_files_in_deg_s() {
     assert!(!out.exists());
 }
 
+/// A sheet of two field activations of unit U1 at +25 °C, at 10 Hz; the second file's
+/// temperatures in °F when `second_in_fahrenheit`.
+fn field_bench(dir: &Path, second_in_fahrenheit: bool) -> PathBuf {
+    let mut sheet = String::from(
+        "file,unit,set_point_celsius,series,repeat,activation,off_before_s,series_kind,switch_on_s\n",
+    );
+    for k in 0..2 {
+        let mut text = String::from("t_s,gx_dps,gy_dps,gz_dps,temp_c\n");
+        for i in 0..50 {
+            let celsius = 25.5 + 0.02 * f64::from(i);
+            let temperature = if k == 1 && second_in_fahrenheit {
+                1.8 * celsius + 32.0
+            } else {
+                celsius
+            };
+            let wobble = 0.01 * f64::from(i % 7);
+            text.push_str(&format!(
+                "{},{},{},{},{temperature}\n",
+                f64::from(i) / 10.0,
+                0.1 + wobble,
+                -0.2 + wobble,
+                0.05 - wobble,
+            ));
+        }
+        std::fs::write(dir.join(format!("f{k}.csv")), text).unwrap();
+        let off = if k == 0 { String::new() } else { "60".into() };
+        sheet.push_str(&format!(
+            "f{k}.csv,U1,25,1,1,{},{off},field,{}\n",
+            k + 1,
+            65 * k
+        ));
+    }
+    let path = dir.join("sheet.csv");
+    std::fs::write(&path, sheet).unwrap();
+    path
+}
+
+#[test]
+fn import_campaign_refuses_a_field_file_in_fahrenheit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("imported");
+    let import = |sheet: &Path| {
+        vec![
+            "import".to_owned(),
+            "campaign".into(),
+            s(sheet).into(),
+            "-o".into(),
+            s(&out).into(),
+            "--rate-hz".into(),
+            "10".into(),
+        ]
+    };
+    let args = import(&field_bench(dir.path(), false));
+    common::ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    std::fs::remove_dir_all(&out).unwrap();
+    let args = import(&field_bench(dir.path(), true));
+    refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[
+            "sheet.csv: row 2 (line 3), column `set_point_celsius`: 25 °C, but the data of `",
+            "f1.csv` start at 77.90 °C",
+            "(field session) reads between 5 and 70 °C",
+            "the file's temperature is not in °C (°F or kelvin: convert the file to °C)",
+        ],
+    );
+    assert!(!out.exists());
+}
+
 #[test]
 fn simulate_refuses_a_set_point_range_too_large_before_making_it() {
     let dir = tempfile::tempdir().unwrap();
