@@ -164,6 +164,7 @@ class Settings:
         ambient_margin_celsius: float | None = None,
         rise_margin_celsius: float | None = None,
         stuck_after_samples: int | None = None,
+        sample_rate_hz: float | None = None,
     ) -> Settings: ...
     @property
     def raw_per_celsius(self) -> float:
@@ -180,6 +181,10 @@ class Settings:
     @property
     def stuck_after_samples(self) -> int:
         """Identical raw readings in a row that mean a stuck sensor; 0 disables (default 2000)."""
+    @property
+    def sample_rate_hz(self) -> float:
+        """The sample rate the tables were fitted at, Hz: `fit` states the recordings' rate, so
+        firmware can check its own against the image's; 0: not stated (default 0)."""
     def celsius(self, raw: float) -> float:
         """A raw temperature reading in °C, computed in f32 as the corrector does."""
     @overload
