@@ -23,7 +23,9 @@ def test_fit_a_campaign_folder(campaign_dir: Path) -> None:
     assert unit.settings == gyrodrift.FitSettings()
 
 
-def test_the_tables_and_their_images_state_the_recordings_sample_rate(campaign_dir: Path, tmp_path: Path) -> None:
+def test_the_tables_and_their_images_state_the_recordings_sample_rate(
+    campaign_dir: Path, tmp_path: Path
+) -> None:
     (unit,) = gyrodrift.fit(campaign_dir)
     for model in (unit.modified, unit.by_history, unit.standard, unit.third_order, unit.relative):
         assert model.settings.sample_rate_hz == 1000.0
