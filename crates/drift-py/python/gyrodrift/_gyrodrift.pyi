@@ -936,7 +936,8 @@ def simulate(
     """Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
     does: the same campaign and seed give the same bytes. A folder that is not empty is refused
     (`InputError`), as the command line refuses it; `force=True` replaces a campaign there (and
-    still refuses a folder holding other files). A campaign that would write more than `max_gb`
+    still refuses a folder holding other files), once the new one is whole: it is written into a
+    staging folder beside `out` and put in place at the end. A campaign that would write more than `max_gb`
     (GB) is refused (`InputError`, with its size) before it is planned or written. `campaign` is
     None (the paper's), a dict or TOML/JSON text (drift_sim::Campaign's fields), or a file path
     (os.PathLike; JSON if it ends in .json, else TOML). The keywords are the command line's flags
