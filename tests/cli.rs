@@ -72,6 +72,8 @@ fn simulate_fit_and_report_from_the_command_line() {
     )
     .unwrap();
     assert_eq!(decoded, json);
+    // The image states the recordings' sample rate, for firmware to check its own against.
+    assert_eq!(decoded.settings.sample_rate_hz, 1000.0);
     for name in ["standard", "third_order"] {
         let bytes = std::fs::read(tables.join(format!("GIU-01/{name}.bin"))).unwrap();
         assert!(decode::<PolynomialTables>(&bytes).is_ok(), "{name}");

@@ -569,6 +569,30 @@ fn an_interrupted_demo_leaves_the_earlier_demo_as_it_was_and_no_temporaries() {
 }
 
 #[test]
+fn demo_names_an_older_demo_without_the_marker_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    // What a demo wrote before output folders were marked.
+    for folder in ["campaign", "noise-floor", "report"] {
+        std::fs::create_dir_all(out.join(folder)).unwrap();
+    }
+    std::fs::write(out.join("report/report.md"), "# earlier\n").unwrap();
+    refused(
+        &["demo", "-q", "-o", s(&out)],
+        &[
+            "holds campaign, noise-floor, report but no .gyrodrift-output file",
+            "the output of an older `gyrodrift demo`",
+            "pass --force to replace it, or delete the folder",
+        ],
+    );
+    assert_eq!(names(&out), ["campaign", "noise-floor", "report"]);
+    assert_eq!(
+        std::fs::read_to_string(out.join("report/report.md")).unwrap(),
+        "# earlier\n"
+    );
+}
+
+#[test]
 fn check_on_the_tables_own_calibration_data_says_it_is_in_sample() {
     let dir = tempfile::tempdir().unwrap();
     let tables = dir.path().join("tables");
@@ -1023,6 +1047,74 @@ fn import_campaign_refuses_a_file_in_rad_s_among_files_in_deg_s() {
             "57× less than the median of unit U1's 3 other files",
             "it looks like rad/s among files in °/s",
             "convert this file to the others' unit",
+        ],
+    );
+    assert!(!out.exists());
+}
+
+/// A sheet of two field activations of unit U1 at +25 °C, at 10 Hz; the second file's
+/// temperatures in °F when `second_in_fahrenheit`.
+fn field_bench(dir: &Path, second_in_fahrenheit: bool) -> PathBuf {
+    let mut sheet = String::from(
+        "file,unit,set_point_celsius,series,repeat,activation,off_before_s,series_kind,switch_on_s\n",
+    );
+    for k in 0..2 {
+        let mut text = String::from("t_s,gx_dps,gy_dps,gz_dps,temp_c\n");
+        for i in 0..50 {
+            let celsius = 25.5 + 0.02 * f64::from(i);
+            let temperature = if k == 1 && second_in_fahrenheit {
+                1.8 * celsius + 32.0
+            } else {
+                celsius
+            };
+            let wobble = 0.01 * f64::from(i % 7);
+            text.push_str(&format!(
+                "{},{},{},{},{temperature}\n",
+                f64::from(i) / 10.0,
+                0.1 + wobble,
+                -0.2 + wobble,
+                0.05 - wobble,
+            ));
+        }
+        std::fs::write(dir.join(format!("f{k}.csv")), text).unwrap();
+        let off = if k == 0 { String::new() } else { "60".into() };
+        sheet.push_str(&format!(
+            "f{k}.csv,U1,25,1,1,{},{off},field,{}\n",
+            k + 1,
+            65 * k
+        ));
+    }
+    let path = dir.join("sheet.csv");
+    std::fs::write(&path, sheet).unwrap();
+    path
+}
+
+#[test]
+fn import_campaign_refuses_a_field_file_in_fahrenheit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("imported");
+    let import = |sheet: &Path| {
+        vec![
+            "import".to_owned(),
+            "campaign".into(),
+            s(sheet).into(),
+            "-o".into(),
+            s(&out).into(),
+            "--rate-hz".into(),
+            "10".into(),
+        ]
+    };
+    let args = import(&field_bench(dir.path(), false));
+    common::ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    std::fs::remove_dir_all(&out).unwrap();
+    let args = import(&field_bench(dir.path(), true));
+    refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[
+            "sheet.csv: row 2 (line 3), column `set_point_celsius`: 25 °C, but the data of `",
+            "f1.csv` start at 77.90 °C",
+            "(field session) reads between 5 and 70 °C",
+            "the file's temperature is not in °C (°F or kelvin: convert the file to °C)",
         ],
     );
     assert!(!out.exists());

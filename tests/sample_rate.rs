@@ -83,8 +83,9 @@ fn write_at(recordings: &[Recording], factor: usize, dir: &Path) {
     }
 }
 
-/// Mean drift of every model over every record (set point, split, axis) of the campaign in `dir`.
-fn drifts(dir: &Path) -> Vec<(ModelKind, f64)> {
+/// Mean drift of every model over every record (set point, split, axis) of the campaign in `dir`,
+/// whose recordings are at `rate` Hz: every fitted model states that rate for firmware.
+fn drifts(dir: &Path, rate: u32) -> Vec<(ModelKind, f64)> {
     let files = pipeline::recording_files(dir).unwrap();
     let options = Options {
         calibration_set_points: vec![30.0, 40.0],
@@ -94,6 +95,18 @@ fn drifts(dir: &Path) -> Vec<(ModelKind, f64)> {
         evaluate: true,
     };
     let outcome = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap();
+    for unit in &outcome.fitted {
+        let stated = [
+            unit.modified.settings,
+            unit.by_history.settings,
+            unit.standard.settings,
+            unit.third_order.settings,
+            unit.relative.settings,
+            unit.relative_cubic.settings,
+        ]
+        .map(|s| s.sample_rate_hz);
+        assert_eq!(stated, [rate as f32; 6], "{}", unit.unit_id);
+    }
     let records = summarise(&outcome.results);
     ModelKind::ALL
         .iter()
@@ -115,13 +128,13 @@ fn every_models_drift_is_the_same_at_1000_200_and_100_hz() {
     simulate_campaign(&campaign(), full.path(), |_| {}).unwrap();
     let recordings = read_campaign_dir(full.path()).unwrap();
     assert!(recordings.iter().all(|r| r.sample_rate_hz == 1000));
-    let at_1000 = drifts(full.path());
+    let at_1000 = drifts(full.path(), 1000);
     for factor in [5, 10] {
         let lower = tempfile::tempdir().unwrap();
         write_at(&recordings, factor, lower.path());
-        let at_lower = drifts(lower.path());
+        let rate = 1000 / factor as u32;
+        let at_lower = drifts(lower.path(), rate);
         for ((model, fast), (_, slow)) in at_1000.iter().zip(&at_lower) {
-            let rate = 1000 / factor;
             assert!(
                 (slow - fast).abs() <= 0.1 * fast,
                 "{model:?}: {fast:.5} °/s at 1000 Hz, {slow:.5} °/s at {rate} Hz"

@@ -32,12 +32,15 @@ pub struct Args {
     pub force: bool,
 }
 
-/// `demo` as a writer of output folders.
+/// What a demo writes into its output folder.
+const WRITTEN: [&str; 3] = ["campaign", "noise-floor", "report"];
+
+/// `demo` as a writer of output folders; a demo's folder without the marker is an older demo's.
 pub const WRITER: Writer = Writer {
     command: "demo",
     product: "demo",
     doing: "writing the demo",
-    owned: Owned::Marker,
+    owned: Owned::MarkerOrNames(&WRITTEN),
 };
 
 /// The demo's campaigns: the paper's, with field sessions; and a small zero-drift one.

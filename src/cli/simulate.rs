@@ -151,7 +151,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         )
     })?;
     bar.finish_and_clear();
-    summary_in_place(staged.path(), &args.out)?;
+    drift_sim::output_folder::summary_in_place(staged.path(), &args.out)?;
     staged.commit()?;
     let hours = summary.samples as f64 / f64::from(campaign.sample_rate_hz) / 3600.0;
     println!(
@@ -165,20 +165,4 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.out.display()
     );
     Ok(())
-}
-
-/// Rewrites the paths `summary.json` gives for the files written into `stage` as they are once the
-/// folder is in place as `out`; the rest of the file keeps its bytes.
-fn summary_in_place(stage: &std::path::Path, out: &std::path::Path) -> anyhow::Result<()> {
-    let path = stage.join("summary.json");
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    // As JSON string contents, with the separator that starts a file's path inside the folder.
-    let quoted = |folder: &std::path::Path| -> anyhow::Result<String> {
-        let json = serde_json::to_string(&folder.join("x").display().to_string())?;
-        Ok(format!("\"{}", &json[1..json.len() - 2]))
-    };
-    let text = text.replace(&quoted(stage)?, &quoted(out)?);
-    drift_recording::write_atomic(&path, text.as_bytes())
-        .with_context(|| format!("writing {}", path.display()))
 }

@@ -14,6 +14,8 @@ pub struct Analysed {
     pub labels: SegmentLabels,
     /// Spacing of the curves, ms.
     pub grid_ms: u32,
+    /// The activation's sample rate, Hz: the fitted tables state it for firmware to check.
+    pub sample_rate_hz: u32,
     /// Raw temperature at switch-on per axis, as firmware would pass it to `power_on` (the mean over
     /// the switch-on window).
     pub switch_on_raw: [f32; 3],
@@ -243,6 +245,7 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
     let mut out = Analysed {
         labels: segment.labels.clone(),
         grid_ms: settings.grid_ms,
+        sample_rate_hz: segment.sample_rate_hz,
         switch_on_raw: [0.0; 3],
         switch_on_celsius: [0.0; 3],
         initial_bias_dps: [0.0; 3],

@@ -501,6 +501,7 @@ mod tests {
                             off_before_s: Some(300.0),
                         },
                         grid_ms: 10,
+                        sample_rate_hz: 1000,
                         switch_on_raw: [(on * 200.0) as f32; 3],
                         switch_on_celsius: [on; 3],
                         initial_bias_dps: [0.01 * (on - 30.0) + jitter; 3],

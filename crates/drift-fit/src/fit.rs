@@ -492,10 +492,18 @@ pub fn fit_unit_at(
                 .collect()
         })
         .collect();
-    // The tables convert raw readings as the calibration recordings did.
+    // The tables convert raw readings as the calibration recordings did, and state their sample
+    // rate for firmware to check its own against (0, not stated, when the recordings differ).
+    let rate = activations.first().map_or(0, |a| a.sample_rate_hz);
+    let rate = if activations.iter().all(|a| a.sample_rate_hz == rate) {
+        rate
+    } else {
+        0
+    };
     let core_settings = Settings {
         raw_per_celsius: scale.raw_per_celsius as f32,
         raw_at_zero_celsius: scale.raw_at_zero_celsius as f32,
+        sample_rate_hz: rate as f32,
         ..Settings::default()
     };
     // The axes' tables and the baselines are independent: all on rayon's threads at once.

@@ -677,8 +677,9 @@ class FittedUnit:
     notes: list[str]
 
 
-def _default_settings() -> dict[str, Any]:
-    """drift-core's default `Settings` (what the fit stores with every table), from the Python API."""
+def _default_settings(sample_rate_hz: float) -> dict[str, Any]:
+    """drift-core's default `Settings` (what the fit stores with every table), from the Python API,
+    stating the recordings' sample rate."""
     s = gyrodrift.Settings()
     return {
         "raw_per_celsius": s.raw_per_celsius,
@@ -686,8 +687,7 @@ def _default_settings() -> dict[str, Any]:
         "ambient_margin_celsius": s.ambient_margin_celsius,
         "rise_margin_celsius": s.rise_margin_celsius,
         "stuck_after_samples": s.stuck_after_samples,
-        # The fit does not state the rate the stuck timeout was converted at (drift-core: 0).
-        "sample_rate_hz": 0.0,
+        "sample_rate_hz": sample_rate_hz,
     }
 
 
@@ -773,7 +773,9 @@ def fit_unit(activations: Sequence[Analysed], settings: FitSettings) -> FittedUn
                 }
             )
         axes.append({"reference_ms": [k * grid_ms for k in knots], "ambients": ambients})
-    settings_json = _default_settings()
+    # The activations' one sample rate (0, not stated, when they differ).
+    rates = {a.source.sample_rate_hz for a in activations}
+    settings_json = _default_settings(float(rates.pop()) if len(rates) == 1 else 0.0)
     protocol = [a for a in activations if _curve_key(a, settings) is not None]
     by_set_point = [
         [a for a in protocol if abs(a.source.set_point_celsius - sp.set_point_celsius) < 1e-6]

@@ -206,6 +206,7 @@ struct AnalysedDef {
     #[serde(with = "SegmentLabelsDef")]
     labels: SegmentLabels,
     grid_ms: u32,
+    sample_rate_hz: u32,
     switch_on_raw: [f32; 3],
     switch_on_celsius: [f64; 3],
     initial_bias_dps: [f64; 3],

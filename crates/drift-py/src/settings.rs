@@ -33,6 +33,7 @@ impl PySettings {
         ambient_margin_celsius = None,
         rise_margin_celsius = None,
         stuck_after_samples = None,
+        sample_rate_hz = None,
     ))]
     fn new(
         raw_per_celsius: Option<&Bound<'_, PyAny>>,
@@ -40,6 +41,7 @@ impl PySettings {
         ambient_margin_celsius: Option<&Bound<'_, PyAny>>,
         rise_margin_celsius: Option<&Bound<'_, PyAny>>,
         stuck_after_samples: Option<&Bound<'_, PyAny>>,
+        sample_rate_hz: Option<&Bound<'_, PyAny>>,
     ) -> Result<Self, Error> {
         let d = Settings::default();
         let settings = Settings {
@@ -60,7 +62,9 @@ impl PySettings {
             stuck_after_samples: or_default(stuck_after_samples, d.stuck_after_samples, |v| {
                 args::count_u16("stuck_after_samples", v)
             })?,
-            ..d
+            sample_rate_hz: or_default(sample_rate_hz, d.sample_rate_hz, |v| {
+                args::float("sample_rate_hz", v)
+            })?,
         };
         settings.validate().map_err(Error::Table)?;
         Ok(Self(settings))
@@ -94,6 +98,13 @@ impl PySettings {
     #[getter]
     fn stuck_after_samples(&self) -> u16 {
         self.0.stuck_after_samples
+    }
+
+    /// The sample rate the tables were fitted at (and `stuck_after_samples` counts at), Hz; 0: not
+    /// stated.
+    #[getter]
+    fn sample_rate_hz(&self) -> f32 {
+        self.0.sample_rate_hz
     }
 
     /// A raw temperature reading in °C (f32 arithmetic, as the corrector does it).
@@ -139,12 +150,13 @@ impl PySettings {
         let s = &self.0;
         format!(
             "Settings(raw_per_celsius={:?}, raw_at_zero_celsius={:?}, ambient_margin_celsius={:?}, \
-             rise_margin_celsius={:?}, stuck_after_samples={})",
+             rise_margin_celsius={:?}, stuck_after_samples={}, sample_rate_hz={:?})",
             s.raw_per_celsius,
             s.raw_at_zero_celsius,
             s.ambient_margin_celsius,
             s.rise_margin_celsius,
-            s.stuck_after_samples
+            s.stuck_after_samples,
+            s.sample_rate_hz
         )
     }
 }

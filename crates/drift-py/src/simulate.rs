@@ -4,7 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use drift_sim::output_folder::{prepare, FolderError};
+use drift_recording::output_folder::Staged;
+use drift_sim::output_folder::{summary_in_place, FolderError, SIMULATE};
 use drift_sim::overrides::{parse_set_points, OverrideError, Overrides, SetPointsError};
 use drift_sim::{Campaign, Protocol};
 use pyo3::prelude::*;
@@ -211,9 +212,31 @@ pub fn resolve_campaign<'py>(
     to_dict(py, &c)
 }
 
+/// A folder that cannot take the campaign: an I/O failure names the file, anything else is the
+/// caller's input.
+fn folder_error(error: FolderError) -> Error {
+    match error {
+        FolderError::Io {
+            action,
+            path,
+            source,
+        } => Error::File {
+            action: match action {
+                "reading" => "read",
+                "writing" => "write",
+                "renaming" => "rename",
+                _ => "remove",
+            },
+            path,
+            source,
+        },
+        other => Error::Input(other.to_string()),
+    }
+}
+
 /// Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
 /// does: a folder that is not empty is refused unless `force` (then an earlier campaign there is
-/// replaced, and anything else refused), and a campaign writing more than `max_gb` is refused
+/// replaced once the new one is whole, and anything else refused), and a campaign writing more than `max_gb` is refused
 /// before it is planned; returns the summary (files, samples, bytes, wall time) as a dict. The GIL is released.
 #[pyfunction]
 #[pyo3(signature = (
@@ -265,25 +288,13 @@ pub fn simulate<'py>(
     let summary = py.detach(|| -> Result<_, Error> {
         // Sized before anything is planned in full or written.
         drift_sim::size::within(&c, max_gb, "max_gb").map_err(|e| Error::Input(e.to_string()))?;
-        prepare(&out, force, "force=True").map_err(|e| match e {
-            FolderError::Io {
-                action,
-                path,
-                source,
-            } => Error::File {
-                action: if action == "reading" {
-                    "read"
-                } else {
-                    "remove"
-                },
-                path,
-                source,
-            },
-            other => Error::Input(other.to_string()),
-        })?;
-        Ok(drift_sim::simulate_campaign(&c, &out, |_| {})?)
+        // Written into a staging folder put in place at the end, as the command line does:
+        // `force=True` replaces an earlier campaign only once the new one is whole.
+        let staged = Staged::begin(&out, force, "force=True", &SIMULATE).map_err(folder_error)?;
+        drift_sim::simulate_campaign(&c, staged.path(), |_| {})?;
+        let text = summary_in_place(staged.path(), &out).map_err(folder_error)?;
+        staged.commit().map_err(folder_error)?;
+        Ok(text)
     })?;
-    let text = serde_json::to_string(&summary)
-        .map_err(|e| Error::Campaign(format!("internal: summary JSON: {e}")))?;
-    py.import("json")?.call_method1("loads", (text,))
+    py.import("json")?.call_method1("loads", (summary,))
 }

@@ -23,6 +23,18 @@ def test_fit_a_campaign_folder(campaign_dir: Path) -> None:
     assert unit.settings == gyrodrift.FitSettings()
 
 
+def test_the_tables_and_their_images_state_the_recordings_sample_rate(
+    campaign_dir: Path, tmp_path: Path
+) -> None:
+    (unit,) = gyrodrift.fit(campaign_dir)
+    for model in (unit.modified, unit.by_history, unit.standard, unit.third_order, unit.relative):
+        assert model.settings.sample_rate_hz == 1000.0
+        assert type(model).from_image(model.to_image()).settings.sample_rate_hz == 1000.0
+    unit.save(tmp_path / "tables")
+    stored = gyrodrift.ModifiedTables.load_image(tmp_path / "tables" / "GIU-01" / "modified.bin")
+    assert stored.settings.sample_rate_hz == 1000.0
+
+
 def test_files_and_memory_give_the_same_tables(campaign_dir: Path) -> None:
     (from_files,) = gyrodrift.fit(campaign_dir)
     (from_memory,) = gyrodrift.fit(gyrodrift.load_campaign(campaign_dir))

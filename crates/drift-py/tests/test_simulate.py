@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import time
@@ -104,6 +105,21 @@ def test_a_campaign_already_there_is_refused_unless_force(tmp_path: Path) -> Non
     ):
         gyrodrift.simulate(tmp_path, TINY_PROTOCOL, seed=13, force=True, **TINY)  # type: ignore[arg-type]
     assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
+def test_a_forced_campaign_is_written_beside_and_put_in_place_whole(tmp_path: Path) -> None:
+    """As the command line: the new campaign is written into a staging folder beside `out`, which
+    takes its place at the end; the summary (returned and stored) names the files in `out`."""
+    out = tmp_path / "campaign"
+    simulate_tiny(out, 11)
+    (out / "recordings" / "stale.mcap").write_bytes(b"old")
+    summary = gyrodrift.simulate(out, TINY_PROTOCOL, seed=12, force=True, **TINY)  # type: ignore[arg-type]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["campaign"], "no staging folder left"
+    assert not (out / "recordings" / "stale.mcap").exists(), "replaced whole"
+    stored = json.loads((out / "summary.json").read_text())
+    for files in (summary["files"], stored["files"]):
+        assert files and all(Path(f["recording"]).parent == out / "recordings" for f in files)
+        assert all(Path(f["recording"]).exists() for f in files)
 
 
 def test_a_campaign_too_large_is_refused_with_its_size_before_it_is_planned(tmp_path: Path) -> None:

@@ -19,6 +19,9 @@ pub enum Owned {
     Marker,
     /// The folder holds nothing but these names.
     Names(&'static [&'static str]),
+    /// The folder holds [`MARKER`] naming the writer's command or, written by a version that did
+    /// not mark its output, nothing but these names.
+    MarkerOrNames(&'static [&'static str]),
 }
 
 /// A command that writes an output folder.
@@ -64,6 +67,19 @@ pub enum FolderError {
         /// What the writer writes.
         product: &'static str,
         /// How replacing is asked for.
+        flag: &'static str,
+    },
+    /// The folder holds what the writer writes but no [`MARKER`]: its output from a version that
+    /// did not mark it, and replacing was not asked for.
+    #[error("{} holds {} but no {MARKER} file: it looks like the output of an older `gyrodrift {command}`, which did not mark its folders; pass {flag} to replace it, or delete the folder", path.display(), entries.join(", "))]
+    Unmarked {
+        /// The folder.
+        path: PathBuf,
+        /// Its entries, sorted.
+        entries: Vec<String>,
+        /// The writer's command.
+        command: &'static str,
+        /// How to ask for replacing.
         flag: &'static str,
     },
     /// The folder holds another command's output.
@@ -153,7 +169,7 @@ pub fn check(
                 });
             }
         }
-        Owned::Marker => {
+        Owned::Marker | Owned::MarkerOrNames(_) => {
             let marker = out.join(MARKER);
             let named = std::fs::read_to_string(&marker).ok();
             match named.as_deref().map(str::trim) {
@@ -167,15 +183,36 @@ pub fn check(
                         flag,
                     })
                 }
-                None => {
-                    return Err(FolderError::Foreign {
-                        path: out.to_owned(),
-                        names: entries,
-                        command: writer.command,
-                        product: writer.product,
-                        flag,
-                    })
-                }
+                None => match writer.owned {
+                    Owned::MarkerOrNames(names)
+                        if entries.iter().all(|e| names.contains(&e.as_str())) =>
+                    {
+                        if !force {
+                            return Err(FolderError::Unmarked {
+                                path: out.to_owned(),
+                                entries,
+                                command: writer.command,
+                                flag,
+                            });
+                        }
+                    }
+                    owned => {
+                        let names = match owned {
+                            Owned::MarkerOrNames(names) => entries
+                                .into_iter()
+                                .filter(|e| !names.contains(&e.as_str()))
+                                .collect(),
+                            _ => entries,
+                        };
+                        return Err(FolderError::Foreign {
+                            path: out.to_owned(),
+                            names,
+                            command: writer.command,
+                            product: writer.product,
+                            flag,
+                        });
+                    }
+                },
             }
         }
     }
@@ -255,7 +292,7 @@ impl Staged {
             committed: false,
         };
         // A writer known by the names it writes has no marker: one would be foreign to it.
-        if matches!(writer.owned, Owned::Marker) {
+        if matches!(writer.owned, Owned::Marker | Owned::MarkerOrNames(_)) {
             let marker = staged.stage.join(MARKER);
             std::fs::write(&marker, format!("{}\n", writer.command))
                 .map_err(io("writing", &marker))?;
@@ -372,6 +409,47 @@ mod tests {
         let error = staged_write(&mine, true, "x").unwrap_err().to_string();
         assert!(
             error.contains("output of `gyrodrift report`, not of `fit`"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn an_unmarked_folder_of_the_writers_names_is_named_as_an_older_output_and_forced_away() {
+        const DEMO: Writer = Writer {
+            command: "demo",
+            product: "demo",
+            doing: "writing the demo",
+            owned: Owned::MarkerOrNames(&["campaign", "report"]),
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("demo");
+        std::fs::create_dir_all(out.join("campaign")).unwrap();
+        std::fs::create_dir_all(out.join("report")).unwrap();
+        let error = Staged::begin(&out, false, "--force", &DEMO)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("holds campaign, report but no .gyrodrift-output file: it looks like the output of an older `gyrodrift demo`")
+                && error.contains("pass --force to replace it, or delete the folder"),
+            "{error}"
+        );
+        let staged = Staged::begin(&out, true, "--force", &DEMO).unwrap();
+        std::fs::create_dir(staged.path().join("report")).unwrap();
+        staged.commit().unwrap();
+        let mut left: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, [MARKER, "report"], "replaced whole, and marked");
+
+        std::fs::remove_file(out.join(MARKER)).unwrap();
+        std::fs::write(out.join("notes.txt"), "mine").unwrap();
+        let error = Staged::begin(&out, true, "--force", &DEMO)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("holds files `demo` does not write (notes.txt)"),
             "{error}"
         );
     }

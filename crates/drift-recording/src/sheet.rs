@@ -324,10 +324,35 @@ pub fn read_sheet(path: &Path) -> Result<Vec<SheetRow>, SheetError> {
     Ok(rows)
 }
 
-/// How far the sensor's temperature at switch-on may lie below the chamber's (a chamber still
-/// settling), and above it (heat left from the previous activation), °C.
-const SWITCH_ON_BELOW_C: f64 = 5.0;
-const SWITCH_ON_ABOVE_C: f64 = 30.0;
+/// How far the sensor's temperature at switch-on may lie below and above the chamber's, °C.
+#[derive(Debug, Clone, Copy)]
+struct SwitchOnBand {
+    below: f64,
+    above: f64,
+}
+
+impl SwitchOnBand {
+    /// A protocol's chamber is settled: a chamber still settling (5 °C below), heat left from the
+    /// previous activation (30 °C above).
+    const PROTOCOL: Self = Self {
+        below: 5.0,
+        above: 30.0,
+    };
+    /// A field session's unit may just have been carried to another ambient (up to 20 °C colder
+    /// or warmer than it) and be warm from the previous activation: a file in °F still falls
+    /// outside it from an ambient of about +16 °C up (1.8·T + 32 − T > 45), one in kelvin always.
+    const FIELD: Self = Self {
+        below: 20.0,
+        above: 45.0,
+    };
+
+    fn of(kind: SeriesKind) -> Self {
+        match kind {
+            SeriesKind::Protocol => Self::PROTOCOL,
+            SeriesKind::Field => Self::FIELD,
+        }
+    }
+}
 
 /// The activation's first temperature reading against the sheet's ambient: a label of another
 /// set point, or a temperature in another unit than °C, is refused.
@@ -336,23 +361,26 @@ fn check_switch_on_temperature(
     ambient: f64,
     row: &SheetRow,
 ) -> Result<(), String> {
+    let scale = segment.temperature_scale;
     let first = (0..3)
         .filter_map(|axis| {
             segment.temperature_raw[axis]
                 .iter()
                 .find(|&&r| r != crate::segment::TEMPERATURE_MISSING_RAW)
-                .map(|&r| f64::from(r) / RAW_PER_CELSIUS)
+                .map(|&r| scale.celsius(f64::from(r)))
         })
         .fold(None, |m: Option<f64>, c| Some(m.map_or(c, |m| m.min(c))));
     let Some(celsius) = first else {
         return Ok(());
     };
-    if celsius < ambient - SWITCH_ON_BELOW_C || celsius > ambient + SWITCH_ON_ABOVE_C {
+    let band = SwitchOnBand::of(row.series_kind);
+    if celsius < ambient - band.below || celsius > ambient + band.above {
         return Err(format!(
-            "{ambient} °C, but the data of `{}` start at {celsius:.2} °C: a sensor switched on in this ambient reads between {:.0} and {:.0} °C; the label is another set point's, or the file's temperature is not in °C",
+            "{ambient} °C, but the data of `{}` start at {celsius:.2} °C: a sensor switched on in this ambient ({} session) reads between {:.0} and {:.0} °C; the label is another set point's, or the file's temperature is not in °C (°F or kelvin: convert the file to °C)",
             row.file.display(),
-            ambient - SWITCH_ON_BELOW_C,
-            ambient + SWITCH_ON_ABOVE_C
+            row.series_kind.as_str(),
+            ambient - band.below,
+            ambient + band.above
         ));
     }
     Ok(())
@@ -487,23 +515,19 @@ pub fn read_sheet_campaign_with(
                 }
             };
             let ambient = row.switch_on_ambient_celsius.unwrap_or(set_point);
-            // A field session's chamber may ramp away from the sensor; a protocol's is settled.
-            let checked = if *kind == SeriesKind::Protocol {
-                check_switch_on_temperature(&segment, ambient, row)
-            } else {
-                Ok(())
-            };
-            checked.map_err(|reason| SheetError::Row {
-                path: sheet.to_path_buf(),
-                row: row_number,
-                line,
-                column: if row.switch_on_ambient_celsius.is_some() {
-                    "switch_on_ambient_celsius"
-                } else {
-                    "set_point_celsius"
+            check_switch_on_temperature(&segment, ambient, row).map_err(|reason| {
+                SheetError::Row {
+                    path: sheet.to_path_buf(),
+                    row: row_number,
+                    line,
+                    column: if row.switch_on_ambient_celsius.is_some() {
+                        "switch_on_ambient_celsius"
+                    } else {
+                        "set_point_celsius"
+                    }
+                    .into(),
+                    reason,
                 }
-                .into(),
-                reason,
             })?;
             if let Some((end, (prev_row, _))) = previous {
                 if power_on_ns <= end {

@@ -164,6 +164,7 @@ class Settings:
         ambient_margin_celsius: float | None = None,
         rise_margin_celsius: float | None = None,
         stuck_after_samples: int | None = None,
+        sample_rate_hz: float | None = None,
     ) -> Settings: ...
     @property
     def raw_per_celsius(self) -> float:
@@ -180,6 +181,10 @@ class Settings:
     @property
     def stuck_after_samples(self) -> int:
         """Identical raw readings in a row that mean a stuck sensor; 0 disables (default 2000)."""
+    @property
+    def sample_rate_hz(self) -> float:
+        """The sample rate the tables were fitted at, Hz: `fit` states the recordings' rate, so
+        firmware can check its own against the image's; 0: not stated (default 0)."""
     def celsius(self, raw: float) -> float:
         """A raw temperature reading in °C, computed in f32 as the corrector does."""
     @overload
@@ -931,7 +936,8 @@ def simulate(
     """Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
     does: the same campaign and seed give the same bytes. A folder that is not empty is refused
     (`InputError`), as the command line refuses it; `force=True` replaces a campaign there (and
-    still refuses a folder holding other files). A campaign that would write more than `max_gb`
+    still refuses a folder holding other files), once the new one is whole: it is written into a
+    staging folder beside `out` and put in place at the end. A campaign that would write more than `max_gb`
     (GB) is refused (`InputError`, with its size) before it is planned or written. `campaign` is
     None (the paper's), a dict or TOML/JSON text (drift_sim::Campaign's fields), or a file path
     (os.PathLike; JSON if it ends in .json, else TOML). The keywords are the command line's flags
