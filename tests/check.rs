@@ -8,7 +8,7 @@ mod common;
 
 use common::{gyrodrift, ok};
 use drift_core::blob::decode;
-use drift_core::ModifiedTables;
+use drift_core::RecommendedTables;
 
 fn path(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -75,7 +75,7 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     let tables = dir.path().join("tables");
     ok(&["fit", path(&campaign), "-q", "-o", path(&tables)]);
 
-    // Each unit's own tables on its own recordings.
+    // Each unit's own tables on its own recordings: the recommended image unless told.
     let report = dir.path().join("check");
     let (out, text) = check(&campaign, &tables, &report, &[]);
     assert!(out.status.success(), "{text}");
@@ -88,6 +88,15 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     let own = verdicts(&report.join("check.json"));
     assert_eq!(own.len(), 6);
     assert!(own.iter().all(|(_, passed)| *passed), "{own:?}");
+    let json = std::fs::read_to_string(report.join("check.json")).unwrap();
+    assert!(json.contains("GIU-01/recommended.bin"), "{json}");
+    // The paper's tables, asked for by name, pass too.
+    let paper = dir.path().join("paper");
+    let (out, text) = check(&campaign, &tables, &paper, &["--model", "modified"]);
+    assert!(out.status.success(), "{text}");
+    let json = std::fs::read_to_string(paper.join("check.json")).unwrap();
+    assert!(json.contains("GIU-01/modified.bin"), "{json}");
+    assert!(verdicts(&paper.join("check.json")).iter().all(|(_, p)| *p));
 
     // The same, with a drift limit no unit can meet: exit status 1, report written, axes named.
     let tight = dir.path().join("tight");
@@ -106,8 +115,8 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     for unit in ["GIU-01", "GIU-02"] {
         std::fs::create_dir_all(swapped.join(unit)).unwrap();
         std::fs::copy(
-            tables.join("GIU-01/modified.bin"),
-            swapped.join(unit).join("modified.bin"),
+            tables.join("GIU-01/recommended.bin"),
+            swapped.join(unit).join("recommended.bin"),
         )
         .unwrap();
     }
@@ -115,7 +124,7 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     let (out, text) = check(&campaign, &swapped, &refused, &[]);
     assert_eq!(out.status.code(), Some(2), "{text}");
     assert!(
-        text.contains("GIU-02/modified.bin: this image is unit GIU-01's")
+        text.contains("GIU-02/recommended.bin: this image is unit GIU-01's")
             && text.contains("records unit GIU-02"),
         "{text}"
     );
@@ -123,11 +132,11 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
 
     // GIU-01's tables in an image that names no unit, flashed into GIU-02: GIU-02 fails, GIU-01
     // still passes.
-    let own: ModifiedTables =
-        decode(&std::fs::read(tables.join("GIU-01/modified.bin")).unwrap()).unwrap();
+    let own: RecommendedTables =
+        decode(&std::fs::read(tables.join("GIU-01/recommended.bin")).unwrap()).unwrap();
     let anonymous = drift_evaluate::tables_folder::image_bytes(&own).unwrap();
     for unit in ["GIU-01", "GIU-02"] {
-        std::fs::write(swapped.join(unit).join("modified.bin"), &anonymous).unwrap();
+        std::fs::write(swapped.join(unit).join("recommended.bin"), &anonymous).unwrap();
     }
     let wrong = dir.path().join("wrong");
     let (out, text) = check(&campaign, &swapped, &wrong, &[]);
@@ -151,7 +160,7 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     let (out, text) = check(&campaign, &swapped, &missing, &[]);
     // Exit status 2: check could not run, which is not "the calibration is invalid" (1).
     assert_eq!(out.status.code(), Some(2), "{text}");
-    assert!(text.contains("GIU-02/modified.bin"), "{text}");
+    assert!(text.contains("GIU-02/recommended.bin"), "{text}");
     assert!(!missing.exists());
 
     // A limit that means nothing is refused before anything is read.
@@ -201,14 +210,12 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
         "export",
         "image",
         path(&tables),
-        "--model",
-        "modified",
         "-o",
         path(&images),
         "--address",
         "0x08060000",
     ]);
-    assert!(text.contains("2 units' modified images"), "{text}");
+    assert!(text.contains("2 units' recommended images"), "{text}");
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(images.join("manifest.json")).unwrap())
             .unwrap();
@@ -223,7 +230,7 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
         let bytes = std::fs::read(images.join(format!("{unit}.bin"))).unwrap();
         assert_eq!(
             bytes,
-            std::fs::read(tables.join(unit).join("modified.bin")).unwrap()
+            std::fs::read(tables.join(unit).join("recommended.bin")).unwrap()
         );
         assert_eq!(entry["bytes"], bytes.len());
         let header = drift_core::blob::header(&bytes).unwrap();
@@ -236,21 +243,13 @@ fn stored_tables_pass_on_their_unit_and_fail_on_another() {
     for unit in ["GIU-01", "GIU-02"] {
         std::fs::create_dir_all(swapped.join(unit)).unwrap();
         std::fs::copy(
-            tables.join("GIU-01/modified.bin"),
-            swapped.join(unit).join("modified.bin"),
+            tables.join("GIU-01/recommended.bin"),
+            swapped.join(unit).join("recommended.bin"),
         )
         .unwrap();
     }
     let none = dir.path().join("none");
-    let (out, text) = gyrodrift(&[
-        "export",
-        "image",
-        path(&swapped),
-        "--model",
-        "modified",
-        "-o",
-        path(&none),
-    ]);
+    let (out, text) = gyrodrift(&["export", "image", path(&swapped), "-o", path(&none)]);
     assert_eq!(out.status.code(), Some(2), "{text}");
     assert!(
         text.contains("this image is unit GIU-01's, but it sits in unit GIU-02's folder"),

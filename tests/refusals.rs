@@ -1426,7 +1426,17 @@ fn an_image_of_another_model_is_named_by_model_not_by_number() {
     let unit = tables.join("GIU-01");
     std::fs::copy(unit.join("standard.bin"), unit.join("modified.bin")).unwrap();
     let text = refused(
-        &["check", c, "--tables", s(&tables), "-q", "-o", s(&dir.path().join("check"))],
+        &[
+            "check",
+            c,
+            "--tables",
+            s(&tables),
+            "--model",
+            "modified",
+            "-q",
+            "-o",
+            s(&dir.path().join("check")),
+        ],
         &["modified.bin: the image holds a polynomial baseline (standard.bin, third_order.bin), where the paper's modified tables (modified.bin, by_history.bin) is expected"],
     );
     assert!(!text.contains("kind 2"), "{text}");

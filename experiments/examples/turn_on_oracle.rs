@@ -12,7 +12,12 @@
 //! - *standard's offset*: the same drift correction started from the standard baseline's bias at
 //!   the switch-on temperature (a fitter-legal hybrid);
 //! - *residual heat not held* and *no residual-heat term*: the turn-on bias `q(T_on)` with the
-//!   residual heat's share taken however large, and without it.
+//!   residual heat's share taken however large, and without it;
+//! - *fair oracle*: the recommended model's offset corrected by the best prediction from what the
+//!   instrument knows at switch-on — a least-squares line of each activation's offset error (the
+//!   mean of its low-passed corrected rate: measurable on a static unit, not the simulator's
+//!   truth) in the switch-on temperature and the estimated residual heat, fitted per cell on the
+//!   cell's other activations (leave one out) and, optimistically, on all of them (in sample).
 //!
 //! Each is a mean over a unit × axis × set point cell's field activations, set beside the best
 //! baseline's (the lowest of standard, 3rd-order, relative and relative cubic in that cell), and
@@ -36,16 +41,71 @@ use drift_recording::{read_recording, SeriesKind, TRUTH_DIR, TRUTH_EXTENSION};
 use drift_sim::truth::read_truth;
 
 /// The variants measured, in column order.
-const VARIANTS: [&str; 8] = [
+const VARIANTS: [&str; 10] = [
     "as fitted",
     "true offset",
     "best constant",
     "standard's offset",
     "residual heat not held",
     "no residual-heat term",
+    "fair oracle, leave one out",
+    "fair oracle, in sample",
     "modified",
     "best baseline",
 ];
+
+/// Columns of the fair oracles, filled after every activation of a cell is seen.
+const FAIR_LOO: usize = 6;
+const FAIR_IN_SAMPLE: usize = 7;
+
+/// One field activation × axis, kept for the fair oracles: the low-passed corrected rate, its
+/// mean (the offset error), the switch-on temperature and the residual heat estimated.
+struct Kept {
+    low: Vec<f64>,
+    offset: f64,
+    on: f64,
+    heat: f64,
+}
+
+/// Least squares of `y` on `[1, on, heat]` over `rows` (ridge-stabilised: a cell whose residual
+/// heats are all equal has a singular system), by Cramer's rule on the 3×3 normal equations.
+fn line(rows: &[&Kept]) -> [f64; 3] {
+    let mut a = [[0.0; 3]; 3];
+    let mut b = [0.0; 3];
+    for k in rows {
+        let phi = [1.0, k.on, k.heat];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i][j] += phi[i] * phi[j];
+            }
+            b[i] += phi[i] * k.offset;
+        }
+    }
+    for (i, row) in a.iter_mut().enumerate().skip(1) {
+        row[i] += 1e-6 * rows.len() as f64;
+    }
+    let det = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(&a);
+    let mut c = [0.0; 3];
+    for (k, value) in c.iter_mut().enumerate() {
+        let mut m = a;
+        for i in 0..3 {
+            m[i][k] = b[i];
+        }
+        *value = det(&m) / d;
+    }
+    c
+}
+
+/// RMS of `low − prediction(k)`.
+fn shifted(k: &Kept, c: [f64; 3]) -> f64 {
+    let p = c[0] + c[1] * k.on + c[2] * k.heat;
+    (k.low.iter().map(|v| (v - p).powi(2)).sum::<f64>() / k.low.len().max(1) as f64).sqrt()
+}
 
 /// RMS of the low-passed `rate + shift`.
 fn rms(rate: &[f32], shift: f64, window: usize) -> f64 {
@@ -92,6 +152,7 @@ fn main() -> anyhow::Result<()> {
         ModelKind::RelativeCubic,
     ];
     let mut cells: Cells = BTreeMap::new();
+    let mut kept_rows: BTreeMap<(String, i64, usize), Vec<Kept>> = BTreeMap::new();
     let mut offsets: Vec<(f64, f64, f64)> = Vec::new();
     for path in &files {
         let recording = read_recording(path)?;
@@ -162,9 +223,22 @@ fn main() -> anyhow::Result<()> {
                     rms(rec, model_on - standard_on, window),
                     rms(rec, model_on - q - heat, window),
                     rms(rec, model_on - q, window),
+                    0.0,
+                    0.0,
                     of(ModelKind::Modified),
                     0.0,
                 ];
+                let low = centred_moving_average(rec, window);
+                let offset = low.iter().sum::<f64>() / low.len().max(1) as f64;
+                kept_rows
+                    .entry((recording.unit_id.clone(), set_point, axis))
+                    .or_default()
+                    .push(Kept {
+                        low,
+                        offset,
+                        on: f64::from(on),
+                        heat: residual,
+                    });
                 let entry = cells
                     .entry((recording.unit_id.clone(), set_point, axis))
                     .or_insert(([0.0; VARIANTS.len()], [0.0; 4], 0));
@@ -179,6 +253,22 @@ fn main() -> anyhow::Result<()> {
         }
     }
     let mut rows = Vec::new();
+    for (key, (sums, _, _)) in &mut cells {
+        let members: Vec<&Kept> = kept_rows
+            .get(key)
+            .map_or(Vec::new(), |v| v.iter().collect());
+        let all = line(&members);
+        for (i, k) in members.iter().enumerate() {
+            let others: Vec<&Kept> = members
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, k)| *k)
+                .collect();
+            sums[FAIR_LOO] += shifted(k, line(&others));
+            sums[FAIR_IN_SAMPLE] += shifted(k, all);
+        }
+    }
     for ((unit, set_point, axis), (sums, baseline_sums, n)) in &cells {
         let best = baseline_sums.iter().fold(f64::INFINITY, |b, s| b.min(*s)) / *n as f64;
         let mut means = sums.map(|s| s / *n as f64);

@@ -26,9 +26,10 @@ use drift_report::write_atomic;
 /// Which of a unit's stored models to check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Stored {
-    /// The recommended model (`recommended.bin`): the paper's drift correction with the turn-on
-    /// bias fitted on every calibration activation; each unit's activations run in recording order,
-    /// each starting from what its firmware kept of the one before.
+    /// The recommended model (`recommended.bin`, the default: the image to deploy): the paper's
+    /// drift correction with the turn-on bias fitted on every calibration activation; each unit's
+    /// activations run in recording order, each starting from what its firmware kept of the one
+    /// before.
     Recommended,
     /// The paper's tables (`modified.bin`).
     Modified,
@@ -68,8 +69,8 @@ pub struct Args {
     /// image `<tables>/<unit>/<model>.bin` is what is checked.
     #[arg(long)]
     pub tables: PathBuf,
-    /// Which stored model the units run.
-    #[arg(long, value_enum, default_value = "modified")]
+    /// Which stored model the units run (the recommended one unless told).
+    #[arg(long, value_enum, default_value = "recommended")]
     pub model: Stored,
     /// Most drift left per activation (mean over activations, per axis), °/s.
     #[arg(long, default_value_t = Limits::default().max_drift_dps, allow_negative_numbers = true)]

@@ -3,7 +3,7 @@
 Simulates a small campaign of three units (20-s activations at +30, +40 and +33 °C), starts a
 LocalCluster of two single-threaded worker processes (`distributed.local_cluster`), and runs
 `gyrodrift.distributed.fan_out`: each worker reads one unit's recordings by path, fits its tables,
-evaluates them on the data the fit did not see, checks the paper's tables on the +33 °C recordings
+evaluates them on the data the fit did not see, checks the recommended model on the +33 °C recordings
 and returns plain data. Prints one row per unit and writes each unit's firmware images. On a real
 cluster, connect with `Client("tcp://scheduler:8786")` instead; the workers need gyrodrift installed
 and the same files.
@@ -80,12 +80,12 @@ def main() -> None:
             for name, model in r["tables"].items():
                 (tables / f"{name}.bin").write_bytes(model["image"])
         # The images are the firmware's: load one back and correct with it.
-        image = gyrodrift.ModifiedTables.load_image(
-            folder / "tables" / results[0]["unit_id"] / "modified.bin"
+        image = gyrodrift.RecommendedTables.load_image(
+            folder / "tables" / results[0]["unit_id"] / "recommended.bin"
         )
         print(
             f"\nwrote {len(results) * len(distributed.MODELS)} firmware images; "
-            f"{results[0]['unit_id']}'s modified tables load back: {image.settings.raw_per_celsius} raw/°C"
+            f"{results[0]['unit_id']}'s recommended tables load back: {image.settings.raw_per_celsius} raw/°C"
         )
 
 

@@ -66,13 +66,14 @@ def test_the_fitted_tables_pass_on_data_they_did_not_see(
 def test_python_and_command_line_agree(
     campaign_dir: Path, evaluation: gyrodrift.Evaluation, tmp_path: Path
 ) -> None:
-    """Same tables, same recording: the records equal `gyrodrift check`'s JSON, with its defaults."""
+    """Same tables, same recording: the records equal `gyrodrift check`'s JSON, with its defaults
+    (the recommended model)."""
     binary = os.environ.get("GYRODRIFT_BIN")
     if not binary:
         pytest.skip("GYRODRIFT_BIN not set (scripts/check-python.sh builds and sets it)")
     unit = evaluation.fitted[0]
     (tmp_path / "tables" / "GIU-01").mkdir(parents=True)
-    unit.modified.save_image(tmp_path / "tables" / "GIU-01" / "modified.bin")
+    unit.recommended.save_image(tmp_path / "tables" / "GIU-01" / "recommended.bin")
     recordings = tmp_path / "recordings"
     recordings.mkdir()
     (recordings / "a.mcap").write_bytes(recording_path(campaign_dir, "+33.0").read_bytes())
@@ -83,7 +84,7 @@ def test_python_and_command_line_agree(
         capture_output=True,
     )
     cli = json.loads((tmp_path / "out" / "check.json").read_text())["units"][0]["axes"]
-    ours = unit.modified.check(recordings)
+    ours = unit.recommended.check(recordings)
     for mine, theirs in zip(ours, cli):
         for key in ("corrected_drift_dps", "residual_rms_dps", "removed", "activations", "failures"):
             assert mine[key] == theirs[key], key

@@ -81,5 +81,5 @@ def test_production_line_fits_every_unit_on_two_workers() -> None:
     rows = [line.split(" | ") for line in out.splitlines() if line.startswith("| GIU-")]
     assert [r[0] for r in rows] == ["| GIU-01", "| GIU-02", "| GIU-03"], out
     assert all(r[2] == "XYZ" for r in rows), out  # every axis passes the check on +33 °C
-    # five stored models per unit: modified, by history, standard, third order, relative
-    assert "3 units on 2 workers" in out and "wrote 15 firmware images" in out, out
+    # six stored models per unit: recommended, modified, by history, standard, third order, relative
+    assert "3 units on 2 workers" in out and "wrote 18 firmware images" in out, out

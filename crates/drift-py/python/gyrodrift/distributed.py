@@ -52,9 +52,16 @@ __all__ = [
 ]
 
 _Path = Union[str, "os.PathLike[str]"]
+_Model = Union[
+    "gyrodrift.RecommendedTables",
+    "gyrodrift.ModifiedTables",
+    "gyrodrift.PolynomialTables",
+    "gyrodrift.RelativePolynomialTables",
+]
 
-MODELS = ("modified", "by_history", "standard", "third_order", "relative")
-"""The fitted models a task returns, as `FittedUnit` names them (the CLI's `tables/<unit>/` files)."""
+MODELS = ("recommended", "modified", "by_history", "standard", "third_order", "relative")
+"""The fitted models a task returns, as `FittedUnit` names them (the CLI's `tables/<unit>/` files);
+the first, the recommended model, is the one to deploy and the one `process_unit` checks."""
 
 
 WORKER_CONFIG: dict[str, Any] = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
@@ -136,7 +143,7 @@ def _set_point(metadata: dict[str, str]) -> float | None:
 def _tables(unit: gyrodrift.FittedUnit) -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     for name in MODELS:
-        model: gyrodrift.ModifiedTables | gyrodrift.PolynomialTables = getattr(unit, name)
+        model: _Model = getattr(unit, name)
         out[name] = {"image": model.to_image(), "json": model.to_json()}
     return out
 
@@ -158,8 +165,9 @@ def process_unit(
     `gyrodrift.evaluate(paths, ...)` fits the tables on the protocol activations at the
     `calibration` set points and evaluates them on what the fit did not see (the `validation` set
     points, field sessions, and with `held_out_repeats` each repeat against tables refitted
-    without it); the paper's tables (`modified`) are then checked (`ModifiedTables.check`, with
-    the limits given) on the unit's recordings at the `validation` set points. `settings_json` is
+    without it); the recommended model, the one to deploy, is then checked
+    (`RecommendedTables.check`, with the limits given) on the unit's recordings at the
+    `validation` set points. `settings_json` is
     `FitSettings.to_json()` text (None: the defaults).
 
     Returns plain data (it pickles, and equals what the same call returns anywhere else, apart
@@ -218,7 +226,7 @@ def process_unit(
         check_files = [p for p in files if _set_point(gyrodrift.Recording.read_metadata(p)) in wanted]
         result["check_files"] = check_files
         if check_files:
-            result["check"] = unit.modified.check(
+            result["check"] = unit.recommended.check(
                 check_files, max_drift=max_drift, max_rms=max_rms, min_removed=min_removed, settings=settings
             )
         timings["check"] = time.perf_counter() - step
@@ -236,19 +244,21 @@ def _with_worker(result: dict[str, Any]) -> dict[str, Any]:
     return result
 
 
-def _model_from_image(
-    image: bytes,
-) -> gyrodrift.ModifiedTables | gyrodrift.PolynomialTables | gyrodrift.RelativePolynomialTables:
+def _model_from_image(image: bytes) -> _Model:
     """The model a firmware image holds, whichever kind it is (the image names its kind; a decoder
     of another kind refuses it with `ImageError`)."""
-    try:
-        return gyrodrift.ModifiedTables.from_image(image)
-    except gyrodrift.ImageError:
-        pass
-    try:
-        return gyrodrift.PolynomialTables.from_image(image)
-    except gyrodrift.ImageError:
-        return gyrodrift.RelativePolynomialTables.from_image(image)
+    kinds: tuple[Any, ...] = (
+        gyrodrift.RecommendedTables,
+        gyrodrift.ModifiedTables,
+        gyrodrift.PolynomialTables,
+    )
+    for kind in kinds:
+        try:
+            model: _Model = kind.from_image(image)
+            return model
+        except gyrodrift.ImageError:
+            pass
+    return gyrodrift.RelativePolynomialTables.from_image(image)
 
 
 def check_unit(
@@ -260,9 +270,9 @@ def check_unit(
     min_removed: float = 0.5,
     settings_json: str | None = None,
 ) -> dict[str, Any]:
-    """Is a stored calibration still valid? One unit's firmware table image (`ModifiedTables` or a
-    baseline's, as `process_unit` returns it or `gyrodrift fit` writes it) run over new
-    recordings of that unit, as `ModifiedTables.check` does: returns `check` (one record per axis),
+    """Is a stored calibration still valid? One unit's firmware table image (`RecommendedTables`,
+    `ModifiedTables` or a baseline's, as `process_unit` returns it or `gyrodrift fit` writes it)
+    run over new recordings of that unit, as the model's `check` does: returns `check` (one record per axis),
     `timings_s`, `peak_rss_bytes`, `host`, `pid` and `error` (None or the gyrodrift error's text)."""
     started = time.perf_counter()
     result: dict[str, Any] = {"check": [], "error": None}
