@@ -101,6 +101,14 @@ fn simulate_fit_and_report_from_the_command_line() {
         validation["classes"][0]["samples"].as_u64().unwrap() > 0,
         "{sigma}"
     );
+    // The oracles count the same activations as the coverage they explain.
+    for oracle in ["oracle", "split_half"] {
+        assert_eq!(
+            validation[oracle][0]["axis_activations"], validation["classes"][0]["axis_activations"],
+            "{sigma}"
+        );
+    }
+    assert!(md.contains("split-half oracle"), "{md}");
     let section = std::fs::read(report.join("tables/GIU-01/uncertainty.bin")).unwrap();
     let json: drift_core::Uncertainty = serde_json::from_str(
         &std::fs::read_to_string(report.join("tables/GIU-01/uncertainty.json")).unwrap(),

@@ -3,7 +3,8 @@
 //! the body rate the simulator added is subtracted afterwards to measure the residual bias.
 //!
 //! ```sh
-//! cargo run --release -p experiments --example stillness -- [--seed 1] [--units 2] [--sessions 3]
+//! cargo run --release -p experiments --example stillness -- [--seed 1] [--units 2] [--sessions 3] \
+//!     [--json stillness.json]
 //! ```
 //!
 //! Two campaigns with the same seed differ only in their field motion: rotations with still gaps
@@ -16,6 +17,10 @@
 //! cool-down) the mean over the cell's activations of the residual bias RMS (RMS of the 1-s moving
 //! average of corrected less true rate), °/s; the noise floor is the same RMS on the zero-drift twin
 //! with the learner after perfect tables (its rate less the body rate, nothing to remove).
+//!
+//! The floors: with still gaps, both together leave less than either alone in at least 90 % of
+//! the unit × axis × class cells; without, both together leave no more than the tables alone in
+//! every cell. `--json` writes every cell and each class's count against its floor.
 
 use anyhow::Context;
 use drift_core::{Corrector, StillnessLearner, StillnessSettings};
@@ -26,8 +31,9 @@ use drift_recording::{read_recording, Segment, SeriesKind};
 use drift_sim::motion::{self, Motion, Rotation};
 use drift_sim::schedule::plan;
 use drift_sim::{simulate_campaign, Campaign, Field, Protocol, UnitModel};
+use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 const CALIBRATION: [f64; 2] = [30.0, 40.0];
 
@@ -43,7 +49,13 @@ struct Args {
     /// Field sessions per set point (8 activations each).
     #[arg(long, default_value_t = 3)]
     sessions: u32,
+    /// Also write the cells and the floors' counts here, as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
 }
+
+/// Share of cells in which both together must beat either alone, with still gaps.
+const FLOOR_SHARE_WITH_GAPS: f64 = 0.9;
 
 fn campaign(seed: u64, units: u32, sessions: u32, model: UnitModel, gaps: bool) -> Campaign {
     let motion = Motion {
@@ -234,6 +246,133 @@ fn floor(twin: &[(Segment, Vec<Rotation>)], settings: &FitSettings) -> anyhow::R
     Ok(cells)
 }
 
+/// One unit × axis × class cell: the mean residual bias RMS over its activations, °/s.
+#[derive(Serialize)]
+struct Cell {
+    unit: String,
+    axis: usize,
+    activations: usize,
+    tables: f64,
+    learner: f64,
+    both: f64,
+    floor: f64,
+}
+
+/// One class of one motion case: its cells, their means and the count against the floor.
+#[derive(Serialize)]
+struct Class {
+    class: &'static str,
+    cells: Vec<Cell>,
+    tables: f64,
+    learner: f64,
+    both: f64,
+    floor: f64,
+    /// Cells where both together leave less than either alone.
+    both_below_either: usize,
+    /// Cells where both together leave no more than the tables alone.
+    both_no_worse_than_tables: usize,
+    /// With still gaps: `both_below_either` in at least 90 % of the cells; without:
+    /// `both_no_worse_than_tables` in every cell.
+    floor_met: bool,
+}
+
+#[derive(Serialize)]
+struct Case {
+    motion: &'static str,
+    still_gaps: bool,
+    classes: Vec<Class>,
+}
+
+fn summarise(motion: &'static str, gaps: bool, cells: &Cells, floor: &Cells) -> Case {
+    let mut classes = Vec::new();
+    for warm in [false, true] {
+        let keys: Vec<(String, usize)> = cells
+            .keys()
+            .filter(|k| k.2 == warm && k.3 == Way::Tables)
+            .map(|k| (k.0.clone(), k.1))
+            .collect();
+        if keys.is_empty() {
+            continue;
+        }
+        let get = |k: &(String, usize), way| {
+            cells
+                .get(&(k.0.clone(), k.1, warm, way))
+                .map_or(f64::NAN, |v| mean(v))
+        };
+        let cells: Vec<Cell> = keys
+            .iter()
+            .map(|k| Cell {
+                unit: k.0.clone(),
+                axis: k.1,
+                activations: cells
+                    .get(&(k.0.clone(), k.1, warm, Way::Tables))
+                    .map_or(0, Vec::len),
+                tables: get(k, Way::Tables),
+                learner: get(k, Way::Learner),
+                both: get(k, Way::Both),
+                floor: floor
+                    .get(&(k.0.clone(), k.1, warm, Way::Tables))
+                    .map_or(f64::NAN, |v| mean(v)),
+            })
+            .collect();
+        let column = |f: fn(&Cell) -> f64| mean(&cells.iter().map(f).collect::<Vec<_>>());
+        let both_below_either = cells
+            .iter()
+            .filter(|c| c.both < c.tables.min(c.learner))
+            .count();
+        let both_no_worse_than_tables = cells.iter().filter(|c| c.both <= c.tables).count();
+        let floor_met = if gaps {
+            both_below_either as f64 >= FLOOR_SHARE_WITH_GAPS * cells.len() as f64
+        } else {
+            both_no_worse_than_tables == cells.len()
+        };
+        classes.push(Class {
+            class: if warm { "warm restart" } else { "cold start" },
+            tables: column(|c| c.tables),
+            learner: column(|c| c.learner),
+            both: column(|c| c.both),
+            floor: column(|c| c.floor),
+            both_below_either,
+            both_no_worse_than_tables,
+            floor_met,
+            cells,
+        });
+    }
+    Case {
+        motion,
+        still_gaps: gaps,
+        classes,
+    }
+}
+
+fn print_case(case: &Case) {
+    println!(
+        "\n{}: residual bias RMS, °/s, mean over cells (unit × axis)\n",
+        case.motion
+    );
+    println!("| class | cells | activations per cell | tables | learner | both | floor | cells where both < min(tables, learner) | cells where both ≤ tables | floor met |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    for c in &case.classes {
+        let n = c.cells.len();
+        let share = |k: usize| 100.0 * k as f64 / n as f64;
+        println!(
+            "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} ({:.0} %) | {} ({:.0} %) | {} |",
+            c.class,
+            n,
+            c.cells.first().map_or(0, |x| x.activations),
+            c.tables,
+            c.learner,
+            c.both,
+            c.floor,
+            c.both_below_either,
+            share(c.both_below_either),
+            c.both_no_worse_than_tables,
+            share(c.both_no_worse_than_tables),
+            if c.floor_met { "yes" } else { "no" },
+        );
+    }
+}
+
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
 }
@@ -243,6 +382,7 @@ fn main() -> anyhow::Result<()> {
         seed,
         units,
         sessions,
+        json,
     } = clap::Parser::parse();
     let settings = FitSettings::default();
     let work = tempfile::tempdir()?;
@@ -286,61 +426,23 @@ fn main() -> anyhow::Result<()> {
     )?;
     let floor = floor(&twin, &settings)?;
 
-    for (title, cells) in [
-        ("rotations with still gaps", &cells_gaps),
-        ("rotations without still gaps", &cells_none),
-    ] {
-        println!("\n{title}: residual bias RMS, °/s, mean over cells (unit × axis)\n");
-        println!("| class | cells | activations per cell | tables | learner | both | floor | cells where both < min(tables, learner) | cells where both ≤ tables |");
-        println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
-        for warm in [false, true] {
-            let keys: Vec<(String, usize)> = cells
-                .keys()
-                .filter(|k| k.2 == warm && k.3 == Way::Tables)
-                .map(|k| (k.0.clone(), k.1))
-                .collect();
-            if keys.is_empty() {
-                continue;
-            }
-            let get = |k: &(String, usize), way| {
-                cells
-                    .get(&(k.0.clone(), k.1, warm, way))
-                    .map_or(f64::NAN, |v| mean(v))
-            };
-            let column = |way| mean(&keys.iter().map(|k| get(k, way)).collect::<Vec<_>>());
-            let beats = keys
-                .iter()
-                .filter(|k| get(k, Way::Both) < get(k, Way::Tables).min(get(k, Way::Learner)))
-                .count();
-            let no_worse = keys
-                .iter()
-                .filter(|k| get(k, Way::Both) <= get(k, Way::Tables))
-                .count();
-            let per_cell = cells
-                .get(&(keys[0].0.clone(), keys[0].1, warm, Way::Tables))
-                .map_or(0, Vec::len);
-            let floor = mean(
-                &floor
-                    .iter()
-                    .filter(|(k, _)| k.2 == warm)
-                    .map(|(_, v)| mean(v))
-                    .collect::<Vec<_>>(),
-            );
-            println!(
-                "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} ({:.0} %) | {} ({:.0} %) |",
-                if warm { "warm restart" } else { "cold start" },
-                keys.len(),
-                per_cell,
-                column(Way::Tables),
-                column(Way::Learner),
-                column(Way::Both),
-                floor,
-                beats,
-                100.0 * beats as f64 / keys.len() as f64,
-                no_worse,
-                100.0 * no_worse as f64 / keys.len() as f64,
-            );
-        }
+    let cases = [
+        summarise("rotations with still gaps", true, &cells_gaps, &floor),
+        summarise("rotations without still gaps", false, &cells_none, &floor),
+    ];
+    for case in &cases {
+        print_case(case);
+    }
+    if let Some(path) = json {
+        let out = serde_json::json!({
+            "seed": seed,
+            "units": units,
+            "sessions": sessions,
+            "floor_share_with_gaps": FLOOR_SHARE_WITH_GAPS,
+            "cases": cases,
+        });
+        std::fs::write(&path, serde_json::to_string_pretty(&out)?)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
 }

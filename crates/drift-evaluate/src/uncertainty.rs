@@ -170,12 +170,29 @@ fn quantile(values: &mut [f32], q: f64) -> Option<f32> {
 /// classes' value at that knot, then the previous knot's.
 pub fn fit(calibration: &[Residuals], turn_on: &[TurnOn; 3]) -> Uncertainty {
     let mut u = envelope(calibration, turn_on);
+    u.sigma_dps = curves(&u, calibration, false);
+    u
+}
+
+/// The curves of σ(t) fitted on `residuals` within the envelope and widening of `u` (its curves
+/// unused): per class and knot, half the [`TARGET`] quantile of |residual| over every axis. With
+/// `inside_only`, activation × axis pairs outside the envelope (where σ widens) are left out.
+fn curves(
+    u: &Uncertainty,
+    residuals: &[Residuals],
+    inside_only: bool,
+) -> [[f32; SIGMA_KNOTS]; ACTIVATION_CLASSES] {
     let mut by = vec![vec![Vec::new(); SIGMA_KNOTS]; ACTIVATION_CLASSES + 1];
-    for r in calibration {
+    for r in residuals {
         let state = u.start(&r.switch_on);
         for &(ms, residual) in &r.samples {
             let k = knot_of(ms);
-            for (class, value) in state.class.iter().zip(residual) {
+            for ((class, value), widening) in
+                state.class.iter().zip(residual).zip(state.widening_dps)
+            {
+                if inside_only && widening > 0.0 {
+                    continue;
+                }
                 by[*class as usize][k].push(value.abs());
                 by[ACTIVATION_CLASSES][k].push(value.abs());
             }
@@ -187,12 +204,59 @@ pub fn fit(calibration: &[Residuals], turn_on: &[TurnOn; 3]) -> Uncertainty {
         *value = quantile(&mut by[ACTIVATION_CLASSES][k], TARGET).map_or(previous, |q| q / 2.0);
         previous = *value;
     }
-    for (c, row) in u.sigma_dps.iter_mut().enumerate() {
+    let mut out = [[0.0; SIGMA_KNOTS]; ACTIVATION_CLASSES];
+    for (c, row) in out.iter_mut().enumerate() {
         for (k, sigma) in row.iter_mut().enumerate() {
             *sigma = quantile(&mut by[c][k], TARGET).map_or(pooled[k], |q| q / 2.0);
         }
     }
-    u
+    out
+}
+
+/// σ(t) with the envelope and widening of `u` and its curves fitted on `residuals` inside the
+/// envelope: what the calibration would have had to give for these residuals.
+fn refitted_on(u: &Uncertainty, residuals: &[Residuals]) -> Uncertainty {
+    Uncertainty {
+        sigma_dps: curves(u, residuals, true),
+        ..*u
+    }
+}
+
+/// The oracle: σ(t) whose curves are fitted on `held_out` itself (inside the envelope), checked on
+/// it. Near 95 % when σ's form (per class and knot, every axis alike) can describe these residuals
+/// at all, whatever the calibration showed.
+pub fn oracle_coverage(u: &Uncertainty, held_out: &[Residuals]) -> [Coverage; ACTIVATION_CLASSES] {
+    coverage(&refitted_on(u, held_out), held_out)
+}
+
+/// The split-half oracle: σ(t)'s curves fitted on every other activation of `held_out` and checked
+/// on the rest, then the other way round (the counts summed). How far the coverage of a σ fitted
+/// on residuals of the very same kind scatters at this many activations: no σ from any
+/// calibration can be expected to land closer to 95 % than this.
+pub fn split_half_coverage(
+    u: &Uncertainty,
+    held_out: &[Residuals],
+) -> [Coverage; ACTIVATION_CLASSES] {
+    let half = |parity: usize| -> Vec<Residuals> {
+        held_out
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % 2 == parity)
+            .map(|(_, r)| r.clone())
+            .collect()
+    };
+    let (even, odd) = (half(0), half(1));
+    let mut out = coverage(&refitted_on(u, &even), &odd);
+    let other = coverage(&refitted_on(u, &odd), &even);
+    for (cell, more) in out.iter_mut().zip(other) {
+        cell.axis_activations += more.axis_activations;
+        cell.widened_axis_activations += more.widened_axis_activations;
+        cell.samples += more.samples;
+        cell.inside += more.inside;
+        cell.widened_samples += more.widened_samples;
+        cell.widened_inside += more.widened_inside;
+    }
+    out
 }
 
 /// How many held-out residuals fell within ±2σ, for one class.
@@ -206,6 +270,8 @@ pub struct Coverage {
     pub samples: usize,
     /// Of them, within ±2σ(t).
     pub inside: usize,
+    /// Of the activation × axis pairs, those outside the calibrated envelope, where σ widens.
+    pub widened_axis_activations: usize,
     /// Of the samples, those of activation × axis pairs outside the calibrated envelope, where σ
     /// widens (ambient outside the set points, residual heat beyond the calibration's most).
     pub widened_samples: usize,
@@ -239,6 +305,7 @@ pub fn coverage(
     let mut out = ActivationClass::ALL.map(|class| Coverage {
         class: class.name(),
         axis_activations: 0,
+        widened_axis_activations: 0,
         samples: 0,
         inside: 0,
         widened_samples: 0,
@@ -246,8 +313,11 @@ pub fn coverage(
     });
     for r in held_out {
         let state: SigmaState = uncertainty.start(&r.switch_on);
-        for class in state.class {
-            out[class as usize].axis_activations += 1;
+        for (class, widening) in state.class.iter().zip(state.widening_dps) {
+            out[*class as usize].axis_activations += 1;
+            if widening > 0.0 {
+                out[*class as usize].widened_axis_activations += 1;
+            }
         }
         for &(ms, residual) in &r.samples {
             let sigma = uncertainty.sigma_dps(&state, ms);
@@ -279,6 +349,11 @@ pub struct SplitCoverage {
     pub split: &'static str,
     /// Per class, in [`ActivationClass::ALL`] order.
     pub classes: [Coverage; ACTIVATION_CLASSES],
+    /// Per class, σ's curves fitted on this split's own residuals ([`oracle_coverage`]).
+    pub oracle: [Coverage; ACTIVATION_CLASSES],
+    /// Per class, σ's curves fitted on half of this split's activations and checked on the other
+    /// half ([`split_half_coverage`]).
+    pub split_half: [Coverage; ACTIVATION_CLASSES],
 }
 
 /// One unit's σ(t) and its coverage on held-out activations.
@@ -320,6 +395,8 @@ pub fn per_unit(fitted: &[FittedUnit], residuals: &[(Split, Residuals)]) -> Vec<
                 (!held_out.is_empty()).then(|| SplitCoverage {
                     split: split.name(),
                     classes: coverage(&sigma, &held_out),
+                    oracle: oracle_coverage(&sigma, &held_out),
+                    split_half: split_half_coverage(&sigma, &held_out),
                 })
             })
             .collect();
@@ -417,6 +494,41 @@ mod tests {
             assert!((0.93..=0.97).contains(&cell.share()), "{cell:?}");
             assert_eq!(cell.widened_samples, 0, "inside the envelope: {cell:?}");
         }
+    }
+
+    /// Held-out residuals half again as wide as the calibration's: σ fitted on the calibration
+    /// under-covers them, the oracle (σ's curves fitted on them) covers about 95 %, and the
+    /// split-half oracle counts every held-out pair once.
+    #[test]
+    fn the_oracles_fit_the_held_out_residuals_themselves() {
+        let mut state = 11u64;
+        let mut uniform = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) as f32
+        };
+        // Uniform on ±w: its 95 % quantile of |x| is 0.95 w, whatever w.
+        let mut draw = |set_point: f64, width: f32| {
+            let values: Vec<(u32, f32)> = (0..600)
+                .map(|i| (i * 100, width * (2.0 * uniform() - 1.0)))
+                .collect();
+            residual(set_point, 0.0, &values)
+        };
+        let calibration: Vec<Residuals> = (0..20)
+            .map(|i| draw(if i % 2 == 0 { 30.0 } else { 40.0 }, 0.002))
+            .collect();
+        let held_out: Vec<Residuals> = (0..20).map(|_| draw(33.0, 0.003)).collect();
+        let u = fit(&calibration, &turn_on());
+        let cold = ActivationClass::Cold as usize;
+        let fitted = coverage(&u, &held_out)[cold];
+        let oracle = oracle_coverage(&u, &held_out)[cold];
+        let halves = split_half_coverage(&u, &held_out)[cold];
+        assert!(fitted.share() < 0.7, "{fitted:?}");
+        assert!((0.94..=0.96).contains(&oracle.share()), "{oracle:?}");
+        assert!((0.93..=0.97).contains(&halves.share()), "{halves:?}");
+        assert_eq!(halves.axis_activations, fitted.axis_activations);
+        assert_eq!(halves.samples, fitted.samples);
     }
 
     #[test]
