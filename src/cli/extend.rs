@@ -32,7 +32,9 @@ pub fn run(
         md.push_str("The paper's model is kept unchanged.\n\n");
         return Ok(md);
     }
-    let tables = closed.model(fitted);
+    let mut tables = closed.model(fitted);
+    // The loop refits on block means: the image states the rate the unit was recorded at.
+    tables.settings.sample_rate_hz = fitted.modified.settings.sample_rate_hz;
     let keying = &closed.keying;
     for (what, axes) in [
         ("Stage 3 is keyed by heating history", keying.by_history),

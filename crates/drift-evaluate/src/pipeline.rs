@@ -563,8 +563,8 @@ enum Decoded {
     /// A calibration file's activations follow: its unit.
     File(String),
     /// A calibration activation of that file (boxed: the channel's slots are as large as the
-    /// largest message).
-    Activation(Box<Segment>),
+    /// largest message), with the rate it was recorded at (its block means' may be lower).
+    Activation(Box<Segment>, u32),
     /// The file was read whole and is valid: the samples of all its activations.
     End(u64),
     /// Why a file could not be read; nothing follows.
@@ -693,11 +693,12 @@ fn read_calibration(
             if !calibration_segment(&segment, options) {
                 return true;
             }
+            let recorded_hz = segment.sample_rate_hz;
             let segment = match fit_rate_hz {
                 Some(rate_hz) => block_means(&segment, rate_hz).unwrap_or(segment),
                 None => segment,
             };
-            send(Decoded::Activation(Box::new(segment)))
+            send(Decoded::Activation(Box::new(segment), recorded_hz))
         });
         match read {
             Ok(true) if send(Decoded::End(samples)) => {}
@@ -745,13 +746,17 @@ fn analyse_calibration(
                 }
                 unit = next;
             }
-            Decoded::Activation(segment) => {
+            Decoded::Activation(segment, recorded_hz) => {
                 if failed.is_some() {
                     continue;
                 }
                 let started = Instant::now();
                 match analyse(&segment, &options.fit) {
-                    Ok(analysed) => file.push(analysed),
+                    // The tables state the rate firmware samples at, not the fit's.
+                    Ok(analysed) => file.push(Analysed {
+                        sample_rate_hz: recorded_hz,
+                        ..analysed
+                    }),
                     Err(e) => failed = Some(e),
                 }
                 pass.analyse_seconds += started.elapsed().as_secs_f64();
