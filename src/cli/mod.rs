@@ -10,7 +10,6 @@ pub mod diagnose;
 mod exit;
 pub mod export;
 pub mod export_image;
-mod extend;
 pub mod fit;
 pub mod import;
 pub mod import_campaign;

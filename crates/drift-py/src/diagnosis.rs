@@ -11,6 +11,7 @@ use drift_diagnose::diagnose::AxisDiagnosis;
 use drift_diagnose::extend::Admission;
 use drift_fit::{FitSettings, FittedUnit};
 use drift_recording::{read_recording, Segment};
+use drift_report::diagnosis::{Request, Section};
 use numpy::ndarray::Array3;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -45,6 +46,10 @@ pub struct PyDiagnosis {
     aux_inputs: Vec<String>,
     profiles: Vec<ProfileRow>,
     counts: Vec<(String, usize)>,
+    /// The unit's part of `diagnosis.md`/`.json` and its files, rendered as the command line
+    /// renders them (`drift_report::diagnosis`); absent in pickles of older versions.
+    #[serde(default)]
+    report: Option<Section>,
 }
 
 /// One held-out activation's residual profile ([`Profile`], owned).
@@ -225,7 +230,23 @@ fn run_loop(
             .as_ref()
             .map(|e| e.admissions.clone())
             .unwrap_or_default();
+        let request = Request {
+            top: REPORT_TOP,
+            extend,
+            select_on: &[],
+            evaluation_data: None,
+        };
+        let report = drift_report::diagnosis::unit_section(
+            &unit.unit_id,
+            &closed,
+            unit,
+            settings,
+            &request,
+            None,
+        )
+        .map_err(|e| Error::Input(format!("rendering the diagnosis: {e:#}")))?;
         Ok(PyDiagnosis {
+            report: Some(report),
             unit_id: unit.unit_id.clone(),
             ranking: json(&records(&closed.axes))?,
             paper_ranking: json(&records(&closed.paper_axes))?,
@@ -258,8 +279,29 @@ fn run_loop(
     }
 }
 
+/// Candidates listed per axis in the saved report, as `gyrodrift diagnose` lists by default.
+const REPORT_TOP: usize = 5;
+
 #[pymethods]
 impl PyDiagnosis {
+    /// Writes `diagnosis.md`, `diagnosis.json` and the residual figures (and, with `extend=True`,
+    /// the extended model's image) into `folder`, as `gyrodrift diagnose` writes them; returns
+    /// the path of `diagnosis.md`.
+    fn save(&self, folder: &Bound<'_, PyAny>) -> Result<std::path::PathBuf, Error> {
+        let folder = crate::args::path("folder", folder)?;
+        let section = self.report.as_ref().ok_or_else(|| {
+            Error::Input(
+                "this Diagnosis was unpickled from an older version without its report: run `diagnose` again"
+                    .into(),
+            )
+        })?;
+        let sections = std::slice::from_ref(section);
+        let document = drift_report::diagnosis::document("", sections, "");
+        drift_report::diagnosis::write(&folder, &document, sections)
+            .map_err(|e| Error::Input(format!("{}: {e:#}", folder.display())))?;
+        Ok(folder.join("diagnosis.md"))
+    }
+
     /// Unit id.
     #[getter]
     fn unit_id(&self) -> &str {

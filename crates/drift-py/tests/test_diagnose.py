@@ -198,3 +198,27 @@ def test_a_unit_without_activations_is_an_input_error(campaign: Path) -> None:
         unit.diagnose(calibration_only)
     with pytest.raises(gyrodrift.InputError, match="`segments`"):
         unit.diagnose(42)  # type: ignore[arg-type]
+
+
+def test_save_writes_the_command_lines_report_of_the_unit(
+    diagnosis: gyrodrift.Diagnosis, tmp_path: Path
+) -> None:
+    # The same renderer as `gyrodrift diagnose`: its Markdown, its JSON record per unit, a residual
+    # figure per axis whose top candidate the model does not absorb, and the extended model's image.
+    report = diagnosis.save(tmp_path / "out")
+    assert report == tmp_path / "out" / "diagnosis.md"
+    text = report.read_text()
+    assert text.startswith("# gyrodrift diagnosis")
+    assert f"# Unit {diagnosis.unit_id}" in text
+    assert "## Extended model of unit" in text
+    (record,) = json.loads((tmp_path / "out" / "diagnosis.json").read_text())
+    assert record["unit"] == diagnosis.unit_id
+    assert [a["axis"] for a in record["axes"]] == ["X", "Y", "Z"]
+    figures = sorted(p.name for p in (tmp_path / "out").glob("residual-*.svg"))
+    assert figures, text
+    for name in figures:
+        assert f"]({name})" in text
+    if diagnosis.extended is not None:
+        image = tmp_path / "out" / f"extended-{diagnosis.unit_id}.bin"
+        assert image.stat().st_size > 0
+        assert f"extended-{diagnosis.unit_id}.bin" in text

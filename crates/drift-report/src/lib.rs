@@ -4,6 +4,7 @@
 //! through [`make`], so the same inputs give the same bytes.
 
 mod coverage;
+pub mod diagnosis;
 mod evaluation_units;
 mod figures;
 mod input;

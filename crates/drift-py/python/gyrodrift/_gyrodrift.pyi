@@ -1153,6 +1153,11 @@ class Diagnosis:
         """How many activations played each part: calibration, training, held_out, outside_range,
         diagnosed."""
 
+    def save(self, folder: _Path) -> Path:
+        """Writes `diagnosis.md`, `diagnosis.json` and the residual figures (and, with
+        `extend=True`, the extended model's image) into `folder`, as `gyrodrift diagnose` writes
+        them; returns the path of `diagnosis.md`."""
+
 @final
 class FittedUnit:
     """Everything fitted for one unit: the paper's tables and both baselines."""

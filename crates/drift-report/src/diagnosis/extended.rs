@@ -1,9 +1,9 @@
-//! `gyrodrift diagnose --extend`: the report section of the extended model
+//! The report section of the extended model (`gyrodrift diagnose --extend`)
 //! ([`drift_diagnose::closing`]): the guard's decisions, the admitted terms, the error before and after
 //! on the held-out activations, and the firmware image.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use drift_core::blob;
 use drift_diagnose::before_after::group_errors;
@@ -13,14 +13,15 @@ use drift_evaluate::noise_floor::Floor;
 use drift_evaluate::tables_folder::{self, TablesError};
 use drift_fit::FittedUnit;
 
-/// Writes the extended model of one unit (image and JSON) and returns its Markdown section.
-pub fn run(
+/// The extended model of one unit: its Markdown section, with its image and JSON added to
+/// `files`.
+pub(super) fn run(
     unit: &str,
     closed: &Closed<'_>,
     fitted: &FittedUnit,
     before_after: &[BeforeAfter],
     floor: Option<&Floor>,
-    out: &Path,
+    files: &mut Vec<(PathBuf, Vec<u8>)>,
 ) -> anyhow::Result<String> {
     let mut md = format!("## Extended model of unit {unit}\n\n");
     md.push_str(&terms_markdown(closed));
@@ -57,13 +58,15 @@ pub fn run(
         }
     }
     md.push_str(&before_after_table(before_after, floor));
+    let stem = format!("extended-{unit}");
     let from = tables_folder::provenance(unit).map_err(|problem| TablesError::Encode {
-        path: out.to_owned(),
+        path: PathBuf::from(format!("{stem}.bin")),
         problem,
     })?;
-    let files = tables_folder::model_files(out, &format!("extended-{unit}"), &*tables, &from)?;
-    let image_len = files[1].1.len();
-    tables_folder::write_files(&files)?;
+    // Named relative to the report's folder, where the report's writer puts them.
+    let model = tables_folder::model_files(Path::new(""), &stem, &*tables, &from)?;
+    let image_len = model[1].1.len();
+    files.extend(model);
     let _ = writeln!(
         md,
         "Firmware image of the loop's model: `extended-{unit}.bin` ({} bytes, format version {}); tables as JSON: `extended-{unit}.json`.\n",
@@ -75,7 +78,7 @@ pub fn run(
 
 /// The extended model's outcome for one unit in one console line: what the Markdown section says
 /// at length, so nobody has to open the file to learn that nothing was extended, or why.
-pub fn verdict(unit: &str, closed: &Closed<'_>) -> String {
+pub(super) fn verdict(unit: &str, closed: &Closed<'_>) -> String {
     let keyed = closed.keying.any();
     let kept = if keyed {
         "the paper's tables with stage 3 or warm starts keyed by history"
