@@ -1020,21 +1020,26 @@ fn noisy_bench(dir: &Path, third_rate_divisor: f64) -> PathBuf {
     path
 }
 
+/// `gyrodrift import campaign SHEET -o OUT --rate-hz 10`.
+fn import_campaign_at_10_hz(sheet: &Path, out: &Path) -> Vec<String> {
+    [
+        "import",
+        "campaign",
+        s(sheet),
+        "-o",
+        s(out),
+        "--rate-hz",
+        "10",
+    ]
+    .map(str::to_owned)
+    .to_vec()
+}
+
 #[test]
 fn import_campaign_refuses_a_file_in_rad_s_among_files_in_deg_s() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("imported");
-    let import = |sheet: &Path| {
-        vec![
-            "import".to_owned(),
-            "campaign".into(),
-            s(sheet).into(),
-            "-o".into(),
-            s(&out).into(),
-            "--rate-hz".into(),
-            "10".into(),
-        ]
-    };
+    let import = |sheet: &Path| import_campaign_at_10_hz(sheet, &out);
     let args = import(&noisy_bench(dir.path(), 1.0));
     common::ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     std::fs::remove_dir_all(&out).unwrap();
@@ -1093,17 +1098,7 @@ fn field_bench(dir: &Path, second_in_fahrenheit: bool) -> PathBuf {
 fn import_campaign_refuses_a_field_file_in_fahrenheit() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("imported");
-    let import = |sheet: &Path| {
-        vec![
-            "import".to_owned(),
-            "campaign".into(),
-            s(sheet).into(),
-            "-o".into(),
-            s(&out).into(),
-            "--rate-hz".into(),
-            "10".into(),
-        ]
-    };
+    let import = |sheet: &Path| import_campaign_at_10_hz(sheet, &out);
     let args = import(&field_bench(dir.path(), false));
     common::ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     std::fs::remove_dir_all(&out).unwrap();

@@ -47,9 +47,8 @@ pub struct PyDiagnosis {
     profiles: Vec<ProfileRow>,
     counts: Vec<(String, usize)>,
     /// The unit's part of `diagnosis.md`/`.json` and its files, rendered as the command line
-    /// renders them (`drift_report::diagnosis`); absent in pickles of older versions.
-    #[serde(default)]
-    report: Option<Section>,
+    /// renders them (`drift_report::diagnosis`).
+    report: Section,
 }
 
 /// One held-out activation's residual profile ([`Profile`], owned).
@@ -246,7 +245,7 @@ fn run_loop(
         )
         .map_err(|e| Error::Input(format!("rendering the diagnosis: {e:#}")))?;
         Ok(PyDiagnosis {
-            report: Some(report),
+            report,
             unit_id: unit.unit_id.clone(),
             ranking: json(&records(&closed.axes))?,
             paper_ranking: json(&records(&closed.paper_axes))?,
@@ -289,13 +288,7 @@ impl PyDiagnosis {
     /// the path of `diagnosis.md`.
     fn save(&self, folder: &Bound<'_, PyAny>) -> Result<std::path::PathBuf, Error> {
         let folder = crate::args::path("folder", folder)?;
-        let section = self.report.as_ref().ok_or_else(|| {
-            Error::Input(
-                "this Diagnosis was unpickled from an older version without its report: run `diagnose` again"
-                    .into(),
-            )
-        })?;
-        let sections = std::slice::from_ref(section);
+        let sections = std::slice::from_ref(&self.report);
         let document = drift_report::diagnosis::document("", sections, "");
         drift_report::diagnosis::write(&folder, &document, sections)
             .map_err(|e| Error::Input(format!("{}: {e:#}", folder.display())))?;

@@ -41,7 +41,8 @@ pub struct Section {
     /// Its Markdown.
     pub markdown: String,
     /// Its record of `diagnosis.json`.
-    pub json: serde_json::Value,
+    /// (As JSON text: the section is also kept in postcard, which holds no untyped values.)
+    pub json: String,
     /// What the command line prints of it.
     pub console: String,
     /// Files beside the report, by name: the residual figures, the extended model's image and
@@ -272,7 +273,7 @@ pub fn unit_section(
     });
     Ok(Section {
         markdown: md,
-        json,
+        json: serde_json::to_string(&json)?,
         console,
         files,
     })
@@ -299,7 +300,10 @@ pub fn write(out: &Path, document: &str, sections: &[Section]) -> anyhow::Result
             write_atomic(&out.join(name), bytes)?;
         }
     }
-    let json: Vec<&serde_json::Value> = sections.iter().map(|s| &s.json).collect();
+    let json = sections
+        .iter()
+        .map(|s| serde_json::from_str(&s.json))
+        .collect::<Result<Vec<serde_json::Value>, _>>()?;
     write_atomic(
         &out.join("diagnosis.json"),
         serde_json::to_string_pretty(&json)?.as_bytes(),
