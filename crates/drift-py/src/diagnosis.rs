@@ -5,12 +5,15 @@
 use std::sync::Arc;
 
 use drift_core::ModifiedTables;
+use drift_diagnose::activations::{at_diagnosis_rate, loop_settings, read_by_unit};
 use drift_diagnose::closing::PROFILE_EDGES_S;
 use drift_diagnose::closing::{close, LoopOptions};
 use drift_diagnose::diagnose::AxisDiagnosis;
 use drift_diagnose::extend::Admission;
-use drift_fit::{FitSettings, FittedUnit};
-use drift_recording::{read_recording, Segment};
+use drift_diagnose::roles::Roles;
+use drift_fit::analyse::{analyse, Analysed};
+use drift_fit::{fit_unit, FitSettings, FittedUnit};
+use drift_recording::Segment;
 use drift_report::diagnosis::{Request, Section};
 use numpy::ndarray::Array3;
 use numpy::IntoPyArray;
@@ -92,18 +95,47 @@ struct RankRecord<'a> {
     absorbed_by_model: f64,
 }
 
-/// The activations of `segments`: files are read, objects in memory are shared.
-fn activations(source: Source) -> Result<Vec<Arc<Segment>>, Error> {
-    match source {
-        Source::Segments(segments) => Ok(segments),
-        Source::Files(files) => {
-            let mut all = Vec::new();
-            for path in files {
-                all.extend(read_recording(&path)?.segments.into_iter().map(Arc::new));
+/// The activations of `unit_id` among `segments` at the loop's rate (0.1-s block means,
+/// [`drift_diagnose::activations`]), with how many activations of other units there were: files
+/// are read one activation at a time, objects in memory are averaged into copies.
+fn activations(source: Source, unit_id: &str) -> Result<(Vec<Segment>, usize), Error> {
+    let mut by_unit = match source {
+        Source::Segments(segments) => {
+            let mut by_unit: std::collections::BTreeMap<String, Vec<Segment>> = Default::default();
+            for segment in segments {
+                by_unit
+                    .entry(segment.labels.unit_id.clone())
+                    .or_default()
+                    .push(at_diagnosis_rate(Segment::clone(&segment)));
             }
-            Ok(all)
+            by_unit
         }
-    }
+        Source::Files(files) => read_by_unit(&files, |_, _| {})?,
+    };
+    let own = by_unit.remove(unit_id).unwrap_or_default();
+    Ok((own, by_unit.values().map(Vec::len).sum()))
+}
+
+/// The paper's tables of the unit refitted on its calibration protocol among `own` (at the loop's
+/// rate, with the loop's settings), as `gyrodrift diagnose` fits them; the tables state the rate
+/// the activations were recorded at, `recorded_hz`.
+fn loop_tables(
+    own: &[&Segment],
+    set_points: &[f64],
+    settings: &FitSettings,
+    recorded_hz: u32,
+) -> Result<FittedUnit, Error> {
+    let analysed = Roles::split(own.iter().copied(), set_points)
+        .calibration
+        .iter()
+        .map(|s| {
+            analyse(s, settings).map(|a| Analysed {
+                sample_rate_hz: recorded_hz,
+                ..a
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(fit_unit(&analysed, settings)?)
 }
 
 /// What `FittedUnit.diagnose` was asked beyond its data.
@@ -168,19 +200,20 @@ fn run_loop(
 ) -> Result<PyDiagnosis, Error> {
     let extend = asked.extend;
     {
-        let all = activations(source)?;
-        let own: Vec<&Segment> = all
-            .iter()
-            .map(AsRef::as_ref)
-            .filter(|s| s.labels.unit_id == unit.unit_id)
-            .collect();
+        let recorded_hz = unit.modified.settings.sample_rate_hz as u32;
+        let (own, others) = activations(source, &unit.unit_id)?;
         if own.is_empty() {
             return Err(Error::Input(format!(
-                "`segments` holds no activation of unit {} ({} activations of other units)",
+                "`segments` holds no activation of unit {} ({others} activations of other units)",
                 unit.unit_id,
-                all.len()
             )));
         }
+        let own: Vec<&Segment> = own.iter().collect();
+        // The loop's own tables, fitted as the command line fits them (on the block means, with
+        // the loop's settings): the same data give the command line's diagnosis.
+        let settings = &loop_settings(settings);
+        let base = loop_tables(&own, set_points, settings, recorded_hz)?;
+        let unit = &base;
         let mut options = LoopOptions {
             extend,
             diagnose_on: asked.diagnose_on.clone(),

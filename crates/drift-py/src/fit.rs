@@ -284,7 +284,9 @@ impl PyFittedUnit {
     /// on the held-out activations. `diagnose_on` names set points whose series (field and
     /// protocol) are the diagnosis data, cross-fitted by series: `half` (0 or 1) is the half this
     /// loop ranks and fits on, the other half judges. `bench_channels` are context, never ranked
-    /// (the chamber's set point and air always are). The GIL is released.
+    /// (the chamber's set point and air always are). Like the command line, the loop works on the
+    /// activations' 0.1-s block means and refits this unit's paper tables on its calibration
+    /// protocol among them. The GIL is released.
     #[pyo3(signature = (segments, *, calibration = None, extend = false, diagnose_on = Vec::new(), half = 0, bench_channels = Vec::new()))]
     #[allow(clippy::too_many_arguments)]
     fn diagnose(

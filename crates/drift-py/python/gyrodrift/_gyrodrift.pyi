@@ -1238,8 +1238,10 @@ class FittedUnit:
         protocol) are the diagnosis data, cross-fitted by series: `half` (0 or 1) is the half this
         loop ranks and fits on, the other half is held out and judges (run both halves, as
         `gyrodrift diagnose --diagnose-on` does). `bench_channels` describe the bench and are never
-        ranked (the chamber's set point and air always are). The GIL is released. Raises
-        `InputError` (no activation of this unit to diagnose, `half` not 0 or 1) or `FitError`."""
+        ranked (the chamber's set point and air always are). Like the command line, the loop
+        works on the activations' 0.1-s block means and refits this unit's paper tables on its
+        calibration protocol among them. The GIL is released. Raises `InputError` (no activation
+        of this unit to diagnose, `half` not 0 or 1) or `FitError`."""
     def save(self, folder: _Path) -> Path:
         """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} through
         the command line's own writer (the same bytes as `gyrodrift fit`); returns the unit's
