@@ -3,7 +3,7 @@
 //!
 //! One unit's (or one half's) [`Section`] is its Markdown, its JSON record, its console lines and
 //! the files beside the report (the residual figures, the extended model's image); [`document`]
-//! puts the sections together and [`write`] writes them into a folder.
+//! puts the sections together and [`write()`] writes them into a folder.
 
 mod extended;
 mod figures;
