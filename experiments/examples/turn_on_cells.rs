@@ -11,13 +11,12 @@
 //! cargo run --release -p experiments --example turn_on_cells -- <campaign dir> [30,40] [33]
 //! ```
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::Context;
 use drift_evaluate::evaluate::{ActivationResult, ModelKind};
 use drift_evaluate::pipeline::{recording_files, run, Options};
-use drift_evaluate::summary::ActivationClass;
+use drift_evaluate::summary::cells;
 use drift_fit::FitSettings;
 
 /// Resamples per cell.
@@ -77,18 +76,7 @@ fn main() -> anyhow::Result<()> {
     };
     let files = recording_files(Path::new(&dir))?;
     let outcome = run(&files, &options, false, &|_, _, _| {})?;
-    type Key = (String, i64, ActivationClass, usize);
-    let mut cells: BTreeMap<Key, Vec<&ActivationResult>> = BTreeMap::new();
-    for (split, result) in &outcome.results {
-        let class = ActivationClass::of(*split, &result.labels, settings.independent_after_min);
-        let set_point = (result.labels.nominal_set_point_celsius() * 1000.0).round() as i64;
-        for axis in 0..3 {
-            cells
-                .entry((result.labels.unit_id.clone(), set_point, class, axis))
-                .or_default()
-                .push(result);
-        }
-    }
+    let cells = cells(&outcome.results, settings.independent_after_min);
     let mut rng = SplitMix(1);
     let (mut above, mut distinguishable) = (0, 0);
     println!("| unit | set point | class | axis | activations | recommended | best baseline | ratio | excess (°/s) | 95 % interval |");

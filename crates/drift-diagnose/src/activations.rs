@@ -48,7 +48,6 @@ pub fn read_by_unit(
             activations.push(at_diagnosis_rate(segment));
             true
         })?;
-        // A file is whole or not at all: an error above leaves nothing of it behind.
         by_unit.entry(unit).or_default().extend(activations);
     }
     Ok(by_unit)

@@ -200,6 +200,29 @@ fn activation_name(labels: &drift_recording::SegmentLabels) -> String {
     )
 }
 
+/// A cell of the absolute-error table: unit, nominal set point (m°C), activation class, axis.
+pub type CellKey = (String, i64, ActivationClass, usize);
+
+/// Every held-out activation of `results` (not the noise floor's) by unit × set point × class ×
+/// axis: the cells of [`absolute_error`].
+pub fn cells(
+    results: &[(Split, ActivationResult)],
+    independent_after_min: f64,
+) -> BTreeMap<CellKey, Vec<&ActivationResult>> {
+    let mut cells: BTreeMap<CellKey, Vec<&ActivationResult>> = BTreeMap::new();
+    for (split, result) in results.iter().filter(|(s, _)| *s != Split::NoiseFloor) {
+        let class = ActivationClass::of(*split, &result.labels, independent_after_min);
+        let set_point = (result.labels.nominal_set_point_celsius() * 1000.0).round() as i64;
+        for axis in 0..3 {
+            cells
+                .entry((result.labels.unit_id.clone(), set_point, class, axis))
+                .or_default()
+                .push(result);
+        }
+    }
+    cells
+}
+
 /// The absolute error per unit × axis × set point × activation class, on every held-out
 /// activation of `results` (validation, held-out repeats, field); the noise floor from the
 /// [`Split::NoiseFloor`] results of the same class (any class if that one has none).
@@ -207,31 +230,20 @@ pub fn absolute_error(
     results: &[(Split, ActivationResult)],
     independent_after_min: f64,
 ) -> Vec<AbsoluteCell> {
-    type Key = (String, i64, ActivationClass, usize);
-    let mut cells: BTreeMap<Key, Vec<&ActivationResult>> = BTreeMap::new();
+    let cells = cells(results, independent_after_min);
     let mut floor: BTreeMap<ActivationClass, (f64, usize)> = BTreeMap::new();
-    for (split, result) in results {
+    for (split, result) in results.iter().filter(|(s, _)| *s == Split::NoiseFloor) {
         let class = ActivationClass::of(*split, &result.labels, independent_after_min);
-        if *split == Split::NoiseFloor {
-            if let Some(m) = result
-                .models
-                .iter()
-                .find(|m| m.model == ModelKind::Modified)
-            {
-                let entry = floor.entry(class).or_default();
-                for rms in m.residual_rms_dps {
-                    entry.0 += rms;
-                    entry.1 += 1;
-                }
+        if let Some(m) = result
+            .models
+            .iter()
+            .find(|m| m.model == ModelKind::Modified)
+        {
+            let entry = floor.entry(class).or_default();
+            for rms in m.residual_rms_dps {
+                entry.0 += rms;
+                entry.1 += 1;
             }
-            continue;
-        }
-        let set_point = (result.labels.nominal_set_point_celsius() * 1000.0).round() as i64;
-        for axis in 0..3 {
-            cells
-                .entry((result.labels.unit_id.clone(), set_point, class, axis))
-                .or_default()
-                .push(result);
         }
     }
     let any_floor = floor

@@ -99,21 +99,23 @@ struct RankRecord<'a> {
 /// [`drift_diagnose::activations`]), with how many activations of other units there were: files
 /// are read one activation at a time, objects in memory are averaged into copies.
 fn activations(source: Source, unit_id: &str) -> Result<(Vec<Segment>, usize), Error> {
-    let mut by_unit = match source {
+    match source {
         Source::Segments(segments) => {
-            let mut by_unit: std::collections::BTreeMap<String, Vec<Segment>> = Default::default();
-            for segment in segments {
-                by_unit
-                    .entry(segment.labels.unit_id.clone())
-                    .or_default()
-                    .push(at_diagnosis_rate(Segment::clone(&segment)));
-            }
-            by_unit
+            let (own, others): (Vec<_>, Vec<_>) = segments
+                .into_iter()
+                .partition(|s| s.labels.unit_id == unit_id);
+            let own = own
+                .iter()
+                .map(|s| at_diagnosis_rate(Segment::clone(s)))
+                .collect();
+            Ok((own, others.len()))
         }
-        Source::Files(files) => read_by_unit(&files, |_, _| {})?,
-    };
-    let own = by_unit.remove(unit_id).unwrap_or_default();
-    Ok((own, by_unit.values().map(Vec::len).sum()))
+        Source::Files(files) => {
+            let mut by_unit = read_by_unit(&files, |_, _| {})?;
+            let own = by_unit.remove(unit_id).unwrap_or_default();
+            Ok((own, by_unit.values().map(Vec::len).sum()))
+        }
+    }
 }
 
 /// The paper's tables of the unit refitted on its calibration protocol among `own` (at the loop's
