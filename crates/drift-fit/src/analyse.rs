@@ -12,7 +12,8 @@ use crate::windows::Windows;
 pub struct Analysed {
     /// The activation's labels.
     pub labels: SegmentLabels,
-    /// Spacing of the curves, ms.
+    /// Spacing of the curves, ms: the settings' grid, or the smallest multiple of it that is a
+    /// whole number of samples at the activation's rate ([`FitSettings::grid_at`]).
     pub grid_ms: u32,
     /// The activation's sample rate, Hz: the fitted tables state it for firmware to check.
     pub sample_rate_hz: u32,
@@ -240,11 +241,11 @@ pub fn analyse(segment: &Segment, settings: &FitSettings) -> Result<Analysed, Fi
             needed,
         });
     }
-    let step = ((f64::from(settings.grid_ms) * samples_per_ms).round() as usize).max(1);
+    let (step, grid_ms) = settings.grid_at(segment.sample_rate_hz);
     let window = settings.lowpass_window(segment.sample_rate_hz);
     let mut out = Analysed {
         labels: segment.labels.clone(),
-        grid_ms: settings.grid_ms,
+        grid_ms,
         sample_rate_hz: segment.sample_rate_hz,
         switch_on_raw: [0.0; 3],
         switch_on_celsius: [0.0; 3],

@@ -409,8 +409,41 @@ pub fn fit_unit_at(
             other.temperature_scale.raw_at_zero_celsius,
         )));
     }
-    let mut set_points = group(activations, settings);
+    // The activations' analysis grid: the settings' own, or a multiple of it where that is not a
+    // whole number of samples at their rate (`FitSettings::grid_at`). Reference times are its points.
+    let grid_ms = activations.first().map_or(settings.grid_ms, |a| a.grid_ms);
+    if let Some(other) = activations.iter().find(|a| a.grid_ms != grid_ms) {
+        let first = activations.first().map_or(0, |a| a.sample_rate_hz);
+        return Err(insufficient(format!(
+            "its activations were analysed on grids of {grid_ms} and {} ms (recorded at {first} and \
+             {} Hz): fit the activations of one rate, or bring them to one (block means)",
+            other.grid_ms, other.sample_rate_hz
+        )));
+    }
     let mut notes = Vec::new();
+    let on_grid;
+    let settings = if grid_ms == settings.grid_ms {
+        settings
+    } else {
+        if references.is_some() {
+            return Err(insufficient(format!(
+                "reference times were given on the {} ms grid, the activations were analysed on \
+                 {grid_ms} ms",
+                settings.grid_ms
+            )));
+        }
+        notes.push(format!(
+            "analysis grid {grid_ms} ms: {} ms is not a whole number of samples at {} Hz",
+            settings.grid_ms,
+            activations.first().map_or(0, |a| a.sample_rate_hz)
+        ));
+        on_grid = FitSettings {
+            grid_ms,
+            ..settings.clone()
+        };
+        &on_grid
+    };
+    let mut set_points = group(activations, settings);
     if set_points.is_empty() {
         return Err(insufficient("no protocol activations to fit".into()));
     }

@@ -62,6 +62,22 @@ impl FitSettings {
     }
 }
 
+impl FitSettings {
+    /// The analysis grid at `sample_rate_hz`, as (samples, ms): the smallest multiple of
+    /// [`Self::grid_ms`] that is a whole number of samples, so that grid point `i` lies exactly
+    /// `i · ms` after switch-on (10 ms is 2.5 samples at 250 Hz: the grid there is 20 ms). A
+    /// thousand grid spacings are whole samples at every integer rate, so there always is one.
+    pub fn grid_at(&self, sample_rate_hz: u32) -> (usize, u32) {
+        let rate = u64::from(sample_rate_hz.max(1));
+        let grid_ms = u64::from(self.grid_ms.max(1));
+        (1..=1000)
+            .map(|multiple| grid_ms * multiple)
+            .find(|ms| ms * rate % 1000 == 0)
+            .and_then(|ms| Some(((ms * rate / 1000) as usize, u32::try_from(ms).ok()?)))
+            .unwrap_or((rate as usize, 1000))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -73,5 +89,26 @@ mod tests {
         assert_eq!(settings.lowpass_window(200), 200);
         assert_eq!(settings.lowpass_window(100), 100);
         assert_eq!(settings.lowpass_window(0), 1);
+    }
+
+    #[test]
+    fn the_grid_is_whole_samples_at_every_rate() {
+        let settings = FitSettings::default();
+        assert_eq!(settings.grid_at(1000), (10, 10));
+        assert_eq!(settings.grid_at(200), (2, 10));
+        assert_eq!(settings.grid_at(100), (1, 10));
+        assert_eq!(settings.grid_at(250), (5, 20));
+        assert_eq!(settings.grid_at(50), (1, 20));
+        assert_eq!(settings.grid_at(10), (1, 100));
+        assert_eq!(settings.grid_at(833), (833, 1000));
+        for rate in 1..=2000 {
+            let (samples, ms) = settings.grid_at(rate);
+            assert_eq!(
+                samples as u64 * 1000,
+                u64::from(ms) * u64::from(rate),
+                "{rate} Hz"
+            );
+            assert_eq!(ms % settings.grid_ms, 0, "{rate} Hz");
+        }
     }
 }
