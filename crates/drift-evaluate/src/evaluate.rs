@@ -180,34 +180,54 @@ pub fn mean_floor(per_activation: &[[(f64, f64); 3]]) -> [(f64, f64); 3] {
 /// interval over the activations resamples, [`crate::excess`]). The low-pass is `window_s`
 /// seconds of each activation's own samples.
 pub fn noise_floor_per_activation(activations: &[&Segment], window_s: f64) -> Vec<[(f64, f64); 3]> {
-    let n = activations.len().max(1) as f64;
-    let offset: [f64; 3] = std::array::from_fn(|a| {
-        activations
-            .iter()
-            .map(|s| {
-                s.rate_dps[a].iter().map(|&v| f64::from(v)).sum::<f64>() / s.len().max(1) as f64
-            })
-            .sum::<f64>()
-            / n
-    });
+    let offset = constant_bias(activations.iter().map(|s| mean_rate(s)));
     activations
         .iter()
-        .map(|s| {
-            let centred: [Vec<f32>; 3] = std::array::from_fn(|a| {
-                s.rate_dps[a]
-                    .iter()
-                    .map(|&v| (f64::from(v) - offset[a]) as f32)
-                    .collect()
-            });
-            let window = FitSettings {
-                lowpass_window_s: window_s,
-                ..FitSettings::default()
-            }
-            .lowpass_window(s.sample_rate_hz);
-            let (drift, rms) = metric(&centred, window);
-            std::array::from_fn(|a| (drift[a], rms[a]))
-        })
+        .map(|s| activation_floor(s, offset, window_s))
         .collect()
+}
+
+/// An activation's mean rate per axis, °/s: what [`constant_bias`] averages.
+pub fn mean_rate(segment: &Segment) -> [f64; 3] {
+    std::array::from_fn(|a| {
+        segment.rate_dps[a]
+            .iter()
+            .map(|&v| f64::from(v))
+            .sum::<f64>()
+            / segment.len().max(1) as f64
+    })
+}
+
+/// A zero-drift unit's constant bias per axis: the mean of its activations' [`mean_rate`]s, in
+/// their order (so a caller streaming the activations gets the same bits).
+pub fn constant_bias(mean_rates: impl Iterator<Item = [f64; 3]>) -> [f64; 3] {
+    let mut sums = [0.0; 3];
+    let mut n = 0usize;
+    for means in mean_rates {
+        for (sum, mean) in sums.iter_mut().zip(means) {
+            *sum += mean;
+        }
+        n += 1;
+    }
+    sums.map(|sum| sum / n.max(1) as f64)
+}
+
+/// One activation's noise floor per axis, (drift, RMS) of its 1-s mean less `offset` (the unit's
+/// [`constant_bias`]).
+pub fn activation_floor(segment: &Segment, offset: [f64; 3], window_s: f64) -> [(f64, f64); 3] {
+    let centred: [Vec<f32>; 3] = std::array::from_fn(|a| {
+        segment.rate_dps[a]
+            .iter()
+            .map(|&v| (f64::from(v) - offset[a]) as f32)
+            .collect()
+    });
+    let window = FitSettings {
+        lowpass_window_s: window_s,
+        ..FitSettings::default()
+    }
+    .lowpass_window(segment.sample_rate_hz);
+    let (drift, rms) = metric(&centred, window);
+    std::array::from_fn(|a| (drift[a], rms[a]))
 }
 
 /// The switch-on reading firmware passes to `power_on`: the mean raw temperature over the first

@@ -5,9 +5,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use drift_recording::{read_recording, Segment};
+use drift_recording::{OpenRecording, Segment};
 
-use crate::evaluate::{mean_floor, noise_floor_per_activation};
+use crate::evaluate::{activation_floor, constant_bias, mean_floor, mean_rate};
 use crate::pipeline::{self, PipelineError};
 
 /// The noise floor per group of activations (`+33.0 °C field`, as [`group_name`] names it).
@@ -24,6 +24,20 @@ pub struct FloorGroup {
     pub drift: [Vec<f64>; 3],
 }
 
+/// Per axis, (drift, RMS) of one activation, °/s.
+type PerAxis = [(f64, f64); 3];
+
+/// The (group, unit) an activation of `unit` is measured in.
+fn key(segment: &Segment, unit: &str) -> (String, String) {
+    (
+        group_name(
+            segment.labels.nominal_set_point_celsius(),
+            segment.labels.series_kind.as_str(),
+        ),
+        unit.to_owned(),
+    )
+}
+
 /// The group an activation's result goes in.
 pub fn group_name(set_point_celsius: f64, series_kind: &str) -> String {
     format!("{set_point_celsius:+.1} °C {series_kind}")
@@ -34,25 +48,42 @@ pub fn group_name(set_point_celsius: f64, series_kind: &str) -> String {
 /// ([`crate::evaluate::noise_floor`]); the mean
 /// over its units.
 pub fn measure(dir: &Path, window_s: f64) -> Result<Floor, PipelineError> {
-    let mut groups: BTreeMap<(String, String), Vec<Segment>> = BTreeMap::new();
-    for path in pipeline::recording_files(dir)? {
-        let recording = read_recording(&path)?;
-        for segment in recording.segments {
-            let key = group_name(
-                segment.labels.nominal_set_point_celsius(),
-                segment.labels.series_kind.as_str(),
-            );
-            groups
-                .entry((key, recording.unit_id.clone()))
+    let files = pipeline::recording_files(dir)?;
+    // Two passes, one activation in memory at a time (a twin campaign at 1 kHz is gigabytes): the
+    // constant bias of each unit and group first, then each activation about it.
+    let mut means: BTreeMap<(String, String), Vec<[f64; 3]>> = BTreeMap::new();
+    for path in &files {
+        let recording = OpenRecording::open(path)?;
+        let unit = recording.unit_id().to_owned();
+        recording.for_each_activation(|segment| {
+            means
+                .entry(key(&segment, &unit))
                 .or_default()
-                .push(segment);
-        }
+                .push(mean_rate(&segment));
+            true
+        })?;
+    }
+    let offsets: BTreeMap<(String, String), [f64; 3]> = means
+        .into_iter()
+        .map(|(group, means)| (group, constant_bias(means.into_iter())))
+        .collect();
+    let mut groups: BTreeMap<(String, String), Vec<PerAxis>> = BTreeMap::new();
+    for path in &files {
+        let recording = OpenRecording::open(path)?;
+        let unit = recording.unit_id().to_owned();
+        recording.for_each_activation(|segment| {
+            let group = key(&segment, &unit);
+            let offset = offsets.get(&group).copied().unwrap_or_default();
+            groups
+                .entry(group)
+                .or_default()
+                .push(activation_floor(&segment, offset, window_s));
+            true
+        })?;
     }
     let mut sums: BTreeMap<String, (FloorGroup, usize)> = BTreeMap::new();
-    for ((key, _unit), segments) in &groups {
-        let refs: Vec<&Segment> = segments.iter().collect();
-        let per_activation = noise_floor_per_activation(&refs, window_s);
-        let entry = sums.entry(key.clone()).or_default();
+    for ((name, _unit), per_activation) in groups {
+        let entry = sums.entry(name).or_default();
         for (sum, (drift, rms)) in entry.0.mean.iter_mut().zip(mean_floor(&per_activation)) {
             sum.0 += drift;
             sum.1 += rms;
@@ -71,9 +102,9 @@ pub fn measure(dir: &Path, window_s: f64) -> Result<Floor, PipelineError> {
     }
     Ok(sums
         .into_iter()
-        .map(|(key, (mut group, n))| {
+        .map(|(name, (mut group, n))| {
             group.mean = group.mean.map(|(d, r)| (d / n as f64, r / n as f64));
-            (key, group)
+            (name, group)
         })
         .collect())
 }
