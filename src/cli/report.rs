@@ -79,7 +79,7 @@ pub fn make(
         options,
         out,
         provenance,
-        &|s, d, t| steps.update(s, d, t),
+        &steps,
     );
     steps.finish();
     let made = made?;
@@ -217,7 +217,7 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
         options,
         staged.path(),
         provenance,
-        &|s, d, t| steps.update(s, d, t),
+        &steps,
     );
     steps.finish();
     let (path, outcome, warnings) = made?;
