@@ -101,10 +101,12 @@ pub fn in_target(out: &Path, path: &Path) -> PathBuf {
 /// Prints the headline table of a finished report, its absolute-error verdict and its field-like
 /// results.
 pub fn print_headline(outcome: &Outcome, options: &Options) {
-    print!(
-        "{}",
-        drift_report::headline_of(outcome, options.fit.independent_after_min)
-    );
+    print!("{}", headline(outcome, options));
+}
+
+/// The headline [`print_headline`] prints.
+pub fn headline(outcome: &Outcome, options: &Options) -> String {
+    drift_report::headline_of(outcome, options.fit.independent_after_min)
 }
 
 /// Runs `gyrodrift report`.
