@@ -64,7 +64,9 @@ def test_simulate_forced_over_a_campaign_keeps_the_earlier_one_whole(tmp_path: P
     )
 
 
-def test_fit_evaluate_and_report_stop(many_files: Path, segments: list[gyrodrift.Segment], tmp_path: Path) -> None:
+def test_fit_evaluate_and_report_stop(
+    many_files: Path, segments: list[gyrodrift.Segment], tmp_path: Path
+) -> None:
     interrupted(lambda: gyrodrift.fit(segments * MANY))
     interrupted(lambda: gyrodrift.fit(many_files))
     interrupted(lambda: gyrodrift.evaluate(many_files))
@@ -83,7 +85,9 @@ def test_reading_and_diagnosing_stop(
     interrupted(lambda: unit.evaluate_series(segments * MANY))
 
 
-def test_after_an_interruption_the_same_call_runs_whole(campaign_dir: Path, segments: list[gyrodrift.Segment]) -> None:
+def test_after_an_interruption_the_same_call_runs_whole(
+    campaign_dir: Path, segments: list[gyrodrift.Segment]
+) -> None:
     interrupted(lambda: gyrodrift.fit(segments * MANY))
     (unit,) = gyrodrift.fit(campaign_dir)
     assert unit.unit_id == "GIU-01"
@@ -97,7 +101,9 @@ def monotonic(calls: list[tuple[str, int, int]]) -> None:
         assert 0 <= done <= total, calls
 
 
-def test_progress_counts_grow_to_the_total(tmp_path: Path, campaign_dir: Path, segments: list[gyrodrift.Segment]) -> None:
+def test_progress_counts_grow_to_the_total(
+    tmp_path: Path, campaign_dir: Path, segments: list[gyrodrift.Segment]
+) -> None:
     calls: list[tuple[str, int, int]] = []
 
     def progress(step: str, done: int, total: int) -> None:
