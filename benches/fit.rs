@@ -63,7 +63,8 @@ fn bench(c: &mut Criterion) {
         campaign::default_campaign()
     });
     let options = options();
-    let outcome = pipeline::run(&simulated.files, &options, false, &|_, _, _| {}).expect("fit");
+    let outcome =
+        pipeline::run(&simulated.files, &options, false, drift_recording::QUIET).expect("fit");
     let samples = outcome.samples_read;
     let mut by_unit: BTreeMap<String, Vec<Analysed>> = BTreeMap::new();
     for a in outcome.calibration {
@@ -82,9 +83,14 @@ fn bench(c: &mut Criterion) {
     });
     group.bench_function("read_analyse_fit", |b| {
         b.iter(|| {
-            pipeline::run(black_box(&simulated.files), &options, false, &|_, _, _| {})
-                .expect("fit")
-                .fitted
+            pipeline::run(
+                black_box(&simulated.files),
+                &options,
+                false,
+                drift_recording::QUIET,
+            )
+            .expect("fit")
+            .fitted
         })
     });
     group.bench_function("fit_from_analysed", |b| {

@@ -68,7 +68,7 @@ fn main() -> anyhow::Result<()> {
             wall.elapsed().as_secs_f64()
         );
         let (wall, cpu) = (Instant::now(), cpu_seconds()?);
-        let outcome = pipeline::run(&files, &options, false, &|_, _, _| {})?;
+        let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET)?;
         let cpu = cpu_seconds()? - cpu;
         println!(
             "read_analyse_fit {:.2} {cpu:.2} {}",

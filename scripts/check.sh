@@ -27,7 +27,7 @@ arm-none-eabi-gcc --version | head -n 1
 
 step "format"
 cargo fmt --all --check
-(cd embedded && cargo fmt --check)
+(cd embedded && cargo fmt --all --check)
 
 step "structure: no two modules of a crate import each other"
 python3 scripts/module-cycles.py
@@ -59,9 +59,9 @@ cargo bench --workspace --locked -- --test
 step "docs: rustdoc without warnings"
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --locked
 
-step "firmware: clippy, build, and the shared test vectors on QEMU mps2-an386 (Cortex-M4F)"
-(cd embedded && cargo clippy --release --locked -- -D warnings)
-(cd embedded && cargo build --release --locked && cargo run --release --locked --bin vectors)
+step "firmware: clippy, build (the template firmware too), and the shared test vectors on QEMU mps2-an386 (Cortex-M4F)"
+(cd embedded && cargo clippy --workspace --release --locked -- -D warnings)
+(cd embedded && cargo build --workspace --release --locked && cargo run --release --locked --bin vectors)
 
 step "firmware: without LTO, a minimal firmware links no panic or formatting code (llvm-nm) and keeps its empty tables in .bss"
 ./scripts/check-firmware-link.sh

@@ -35,7 +35,7 @@ fn stage3_notes(effects: HiddenEffects) -> Vec<String> {
         held_out_repeats: false,
         evaluate: false,
     };
-    let outcome = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap();
+    let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap();
     outcome.fitted[0]
         .notes
         .iter()
@@ -85,7 +85,7 @@ fn validation_drift(effects: HiddenEffects) -> [(f64, f64); 3] {
         held_out_repeats: false,
         evaluate: true,
     };
-    let outcome = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap();
+    let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap();
     let fitted = &outcome.fitted[0];
     assert!(fitted.by_history.axes.iter().all(|a| a.keyed_by_history()));
     assert!(fitted.modified.axes.iter().all(|a| !a.keyed_by_history()));

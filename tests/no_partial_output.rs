@@ -142,7 +142,7 @@ fn drift_fit_unit() -> drift_fit::FittedUnit {
         held_out_repeats: false,
         evaluate: false,
     };
-    drift_evaluate::pipeline::run(&files, &options, false, &|_, _, _| {})
+    drift_evaluate::pipeline::run(&files, &options, false, drift_recording::QUIET)
         .unwrap()
         .fitted
         .remove(0)

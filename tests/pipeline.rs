@@ -37,7 +37,7 @@ fn options() -> Options {
 
 fn run(dir: &Path) -> Outcome {
     let files = pipeline::recording_files(dir).unwrap();
-    pipeline::run(&files, &options(), false, &|_, _, _| {}).unwrap()
+    pipeline::run(&files, &options(), false, drift_recording::QUIET).unwrap()
 }
 
 /// Mean drift over axes of `model` at `set_point` in `split`.
@@ -136,7 +136,7 @@ fn the_fit_never_depends_on_validation_recordings() {
             evaluate: false,
             ..options()
         };
-        pipeline::run(&files, &options, false, &|_, _, _| {})
+        pipeline::run(&files, &options, false, drift_recording::QUIET)
             .unwrap()
             .fitted
     };
@@ -170,7 +170,7 @@ fn a_campaign_without_first_activations_is_refused_clearly() {
         validation_set_points: vec![],
         ..options()
     };
-    let outcome = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap();
+    let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap();
     // A single independent curve still gives a valid (degenerate: no heating dynamics) table.
     assert_eq!(outcome.fitted[0].curve_keys.len(), 1);
 
@@ -179,7 +179,7 @@ fn a_campaign_without_first_activations_is_refused_clearly() {
         calibration_set_points: vec![50.0],
         ..options
     };
-    let error = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap_err();
+    let error = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap_err();
     assert!(
         format!("{error:#}").contains("no protocol activations at the calibration set points"),
         "{error:#}"
@@ -268,7 +268,7 @@ fn the_noise_floor_keeps_every_activation_of_the_twins_validation_sessions() {
     )
     .unwrap();
     let files = pipeline::recording_files(dir.path()).unwrap();
-    let outcome = pipeline::run(&files, &options(), true, &|_, _, _| {}).unwrap();
+    let outcome = pipeline::run(&files, &options(), true, drift_recording::QUIET).unwrap();
     assert!(outcome.results.iter().all(|(s, _)| *s == Split::NoiseFloor));
     // The +33 °C protocol's 6 activations and the +33 °C field session's 5, wherever the ramp
     // had taken the ambient at switch-on.

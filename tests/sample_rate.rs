@@ -70,7 +70,7 @@ fn drifts(dir: &Path, rate: u32) -> Vec<(ModelKind, f64)> {
         held_out_repeats: true,
         evaluate: true,
     };
-    let outcome = pipeline::run(&files, &options, false, &|_, _, _| {}).unwrap();
+    let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap();
     for unit in &outcome.fitted {
         let stated = [
             unit.modified.settings,

@@ -84,7 +84,7 @@ fn the_corrector_holds_and_flags_injected_faults_and_is_exact_elsewhere() {
 
     // The fitter refuses the faulty calibration recordings, naming unit, activation, axis, sample.
     let files = pipeline::recording_files(&faulty_dir).unwrap();
-    let error = pipeline::run(&files, &options(), false, &|_, _, _| {})
+    let error = pipeline::run(&files, &options(), false, drift_recording::QUIET)
         .unwrap_err()
         .to_string();
     assert!(
@@ -95,7 +95,7 @@ fn the_corrector_holds_and_flags_injected_faults_and_is_exact_elsewhere() {
     );
 
     let files = pipeline::recording_files(&clean_dir).unwrap();
-    let fitted: FittedUnit = pipeline::run(&files, &options(), false, &|_, _, _| {})
+    let fitted: FittedUnit = pipeline::run(&files, &options(), false, drift_recording::QUIET)
         .unwrap()
         .fitted
         .remove(0);

@@ -74,7 +74,7 @@ fn options() -> Options {
 
 fn run(dir: &Path) -> Result<Outcome, PipelineError> {
     let files = pipeline::recording_files(dir).unwrap();
-    pipeline::run(&files, &options(), false, &|_, _, _| {})
+    pipeline::run(&files, &options(), false, drift_recording::QUIET)
 }
 
 fn mean_drift(outcome: &Outcome, model: ModelKind) -> f64 {

@@ -116,7 +116,7 @@ fn main() -> anyhow::Result<()> {
         let dir = root.path().join(name.split(' ').next().unwrap_or("x"));
         simulate_campaign(&campaign(faults), &dir, |_| {})?;
         let files = pipeline::recording_files(&dir)?;
-        let fit = pipeline::run(&files, &options(), false, &|_, _, _| {});
+        let fit = pipeline::run(&files, &options(), false, drift_recording::QUIET);
         let clean_dir = root.path().join("none");
         let fit_note = match &fit {
             // What fitting on the faulty twin costs: its tables on the clean validation data.

@@ -76,7 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         evaluate: false,
     };
     let files = recording_files(Path::new(&dir))?;
-    let outcome = run(&files, &options, false, &|_, _, _| {})?;
+    let outcome = run(&files, &options, false, drift_recording::QUIET)?;
     for unit in &outcome.fitted {
         for note in unit.notes.iter().filter(|n| n.contains("stage 3")) {
             println!("{}: {note}", unit.unit_id);

@@ -75,7 +75,7 @@ fn main() -> anyhow::Result<()> {
         evaluate: true,
     };
     let files = recording_files(Path::new(&dir))?;
-    let outcome = run(&files, &options, false, &|_, _, _| {})?;
+    let outcome = run(&files, &options, false, drift_recording::QUIET)?;
     let cells = cells(&outcome.results, settings.independent_after_min);
     let mut rng = SplitMix(1);
     let (mut above, mut distinguishable) = (0, 0);

@@ -144,7 +144,7 @@ fn main() -> anyhow::Result<()> {
     };
     let dir = Path::new(&dir);
     let files = recording_files(dir)?;
-    let outcome = run(&files, &options, false, &|_, _, _| {})?;
+    let outcome = run(&files, &options, false, drift_recording::QUIET)?;
     let baselines = [
         ModelKind::Standard,
         ModelKind::ThirdOrder,

@@ -135,7 +135,7 @@ pub fn campaign(
 /// ([`drift_diagnose::activations`]).
 pub fn segments(dir: &Path) -> anyhow::Result<Vec<Segment>> {
     let files = drift_evaluate::pipeline::recording_files(dir)?;
-    Ok(read_by_unit(&files, |_, _| {})?
+    Ok(read_by_unit(&files, drift_recording::QUIET)?
         .into_values()
         .flatten()
         .collect())

@@ -3,7 +3,7 @@
 //! field-like sessions beside it, and a zero-drift unit for the noise floor; fits the tables on
 //! +30/+40 °C; evaluates on everything the fit did not see; writes the tables and the report.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
@@ -11,8 +11,8 @@ use drift_sim::campaign::TruthBias;
 use drift_sim::{Campaign, Field, Protocol, UnitModel};
 
 use super::progress::Steps;
-use super::report::{make, print_headline};
-use drift_evaluate::pipeline::Options;
+use super::report::{headline, make};
+use drift_evaluate::pipeline::{Options, Outcome};
 use drift_recording::output_folder::{Owned, Writer};
 
 /// Options of `gyrodrift demo`.
@@ -123,12 +123,26 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.quiet,
     )?;
     staged.commit()?;
-    let report_dir = args.out.join("report");
-    let path = report_dir.join("report.md");
-    println!();
-    print_headline(&outcome, &options);
-    println!("tables:  {}", report_dir.join("tables").display());
-    println!("report:  {}", path.display());
-    println!("total:   {:.1} s", started.elapsed().as_secs_f64());
+    print!(
+        "{}",
+        console(
+            &outcome,
+            &options,
+            &args.out.join("report"),
+            started.elapsed().as_secs_f64()
+        )
+    );
     Ok(())
+}
+
+/// What the demo prints once its report is in `report_dir`: the report's headline (the drift
+/// table, the absolute-error verdict, the field-like results), then where the tables and the
+/// report are and how long it all took.
+pub fn console(outcome: &Outcome, options: &Options, report_dir: &Path, total_s: f64) -> String {
+    format!(
+        "\n{}tables:  {}\nreport:  {}\ntotal:   {total_s:.1} s\n",
+        headline(outcome, options),
+        report_dir.join("tables").display(),
+        report_dir.join("report.md").display(),
+    )
 }

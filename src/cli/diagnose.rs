@@ -87,7 +87,7 @@ fn evaluation_segments(
     fitted: &[FittedUnit],
 ) -> anyhow::Result<BTreeMap<String, Vec<Segment>>> {
     let files = pipeline::recording_files(dir)?;
-    let mut units = read_by_unit(&files, |_, _| {})?;
+    let mut units = read_by_unit(&files, drift_recording::QUIET)?;
     let seen: Vec<String> = units.keys().cloned().collect();
     units.retain(|unit, _| fitted.iter().any(|f| &f.unit_id == unit));
     anyhow::ensure!(
@@ -155,13 +155,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let out = staged.path().to_path_buf();
     let steps = Steps::new(input.quiet);
     // The tables are fitted on the activations as the loop sees them: at its rate.
-    let outcome = pipeline::fit_at_rate(&files, &options, DIAGNOSIS_RATE_HZ, &|s, d, t| {
-        steps.update(s, d, t)
-    })
-    .map_err(|e| super::measured::explain(e, &files))?;
-    let recorded = read_by_unit(&files, |done, total| {
-        steps.update("reading activations by role", done, total)
-    })?;
+    let outcome = pipeline::fit_at_rate(&files, &options, DIAGNOSIS_RATE_HZ, &steps)
+        .map_err(|e| super::measured::explain(e, &files))?;
+    let recorded = read_by_unit(&files, &steps)?;
     let diagnosis_data = args
         .diagnosis_data
         .as_deref()

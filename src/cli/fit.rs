@@ -35,7 +35,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let options = args.input.options(&[], false)?;
     let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let steps = Steps::new(args.input.quiet);
-    let outcome = pipeline::run(&files, &options, false, &|s, d, t| steps.update(s, d, t))
+    let outcome = pipeline::run(&files, &options, false, &steps)
         .map_err(|e| super::measured::explain(e, &files))?;
     steps.finish();
     drift_evaluate::tables_folder::write(staged.path(), &outcome.fitted)?;

@@ -5,7 +5,9 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-/// A bar per named step, created when the step first reports; `quiet` hides them all.
+/// A bar per named step, created when the step first reports; `quiet` hides them all. As the
+/// library's [`drift_recording::Progress`] it only listens: Ctrl-C ends the process
+/// (`super::interrupt`).
 pub struct Steps {
     quiet: bool,
     current: Mutex<Option<(String, ProgressBar)>>,
@@ -67,5 +69,12 @@ impl Steps {
                 bar.finish();
             }
         }
+    }
+}
+
+impl drift_recording::Progress for Steps {
+    fn report(&self, step: &str, done: u64, total: u64) -> std::ops::ControlFlow<()> {
+        self.update(step, done, total);
+        std::ops::ControlFlow::Continue(())
     }
 }

@@ -79,7 +79,7 @@ pub fn make(
         options,
         out,
         provenance,
-        &|s, d, t| steps.update(s, d, t),
+        &steps,
     );
     steps.finish();
     let made = made?;
@@ -101,10 +101,12 @@ pub fn in_target(out: &Path, path: &Path) -> PathBuf {
 /// Prints the headline table of a finished report, its absolute-error verdict and its field-like
 /// results.
 pub fn print_headline(outcome: &Outcome, options: &Options) {
-    print!(
-        "{}",
-        drift_report::headline_of(outcome, options.fit.independent_after_min)
-    );
+    print!("{}", headline(outcome, options));
+}
+
+/// The headline [`print_headline`] prints.
+pub fn headline(outcome: &Outcome, options: &Options) -> String {
+    drift_report::headline_of(outcome, options.fit.independent_after_min)
 }
 
 /// Runs `gyrodrift report`.
@@ -217,7 +219,7 @@ fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Re
         options,
         staged.path(),
         provenance,
-        &|s, d, t| steps.update(s, d, t),
+        &steps,
     );
     steps.finish();
     let (path, outcome, warnings) = made?;

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use drift_fit::FitSettings;
-use drift_recording::{block_means, OpenRecording, ReadError, Segment};
+use drift_recording::{block_means, OpenRecording, Progress, ReadError, Segment, Within};
 
 /// The rate the loop works at, Hz: ten block means per second of the fit's 1-s window.
 pub const DIAGNOSIS_RATE_HZ: u32 = 10;
@@ -31,23 +31,40 @@ pub fn loop_settings(settings: &FitSettings) -> FitSettings {
     }
 }
 
+/// The step [`read_by_unit`] reports.
+pub const READ_BY_ROLE: &str = "reading activations by role";
+
 /// Every activation of `files`, by unit, in file and recording order, at the diagnosis rate:
 /// each recording is decoded one activation at a time, and only its block means are kept.
-/// `progress` is called before each file with (done, total).
+/// `progress` is told each file done ([`READ_BY_ROLE`]) and asked between activations whether to
+/// go on ([`ReadError::Interrupted`] when not).
 pub fn read_by_unit(
     files: &[PathBuf],
-    progress: impl Fn(u64, u64),
+    progress: &dyn Progress,
 ) -> Result<BTreeMap<String, Vec<Segment>>, ReadError> {
     let mut by_unit: BTreeMap<String, Vec<Segment>> = BTreeMap::new();
+    let total = files.len() as u64;
     for (i, path) in files.iter().enumerate() {
-        progress(i as u64, files.len() as u64);
+        let done = i as u64;
+        let within = Within {
+            outer: progress,
+            step: READ_BY_ROLE,
+            done,
+            total,
+        };
+        if progress.check(READ_BY_ROLE, done, total).is_err() {
+            return Err(ReadError::Interrupted { path: path.clone() });
+        }
         let recording = OpenRecording::open(path)?;
         let mut activations = Vec::new();
         let unit = recording.unit_id().to_owned();
-        recording.for_each_activation(|segment| {
-            activations.push(at_diagnosis_rate(segment));
-            true
-        })?;
+        recording.for_each_activation_with(
+            |segment| {
+                activations.push(at_diagnosis_rate(segment));
+                true
+            },
+            &within,
+        )?;
         by_unit.entry(unit).or_default().extend(activations);
     }
     Ok(by_unit)

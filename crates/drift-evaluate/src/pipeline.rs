@@ -14,8 +14,8 @@ use std::sync::mpsc::{channel, sync_channel, Receiver};
 use std::time::Instant;
 
 use drift_recording::{
-    block_means, paper, read_metadata, read_recording, OpenRecording, ReadError, Recording,
-    Segment, SeriesKind, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR,
+    block_means, paper, read_metadata, read_recording_with, Interrupted, OpenRecording, ReadError,
+    Recording, Segment, SeriesKind, Within, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR,
 };
 use rayon::prelude::*;
 
@@ -56,6 +56,9 @@ pub enum PipelineError {
     /// A recording failed to read or validate (the error names file, topic and message).
     #[error(transparent)]
     Read(#[from] ReadError),
+    /// Stopped by its [`Progress`] (Ctrl-C in Python).
+    #[error("interrupted")]
+    Interrupted(#[from] Interrupted),
     /// Analysing or fitting failed (the error names the unit and activation).
     #[error(transparent)]
     Fit(#[from] FitError),
@@ -199,8 +202,10 @@ pub struct Outcome {
     pub coverage: Vec<UnitCoverage>,
 }
 
-/// Reports progress: (step, done, total).
-pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
+/// Told how far the pipeline got, between files and activations, and asked whether to go on: a
+/// closure `Fn(step, done, total)` listens; a [`drift_recording::Progress`] of its own may stop
+/// the run ([`PipelineError::Interrupted`]).
+pub type Progress<'a> = &'a dyn drift_recording::Progress;
 
 /// Whether `set_point` (°C) is one of `list`, to a micro-degree.
 pub fn is_one_of(set_point: f64, list: &[f64]) -> bool {
@@ -430,9 +435,11 @@ fn evaluate_files<'a>(
     mut choose: impl FnMut(&str, &Segment) -> Option<(Split, &'a FittedUnit)>,
 ) -> Result<Vec<(Split, ActivationResult)>, PipelineError> {
     let mut out = Vec::new();
+    let total = files.len() as u64;
     for (i, path) in files.iter().enumerate() {
-        progress("correcting and evaluating", i as u64, files.len() as u64);
-        let recording = read_recording(path)?;
+        let done = i as u64;
+        progress.check(EVALUATE_STEP, done, total)?;
+        let recording = read_recording_with(path, &within(progress, EVALUATE_STEP, done, total))?;
         let chosen: Vec<Option<(Split, &FittedUnit)>> = recording
             .segments
             .iter()
@@ -465,11 +472,7 @@ fn evaluate_files<'a>(
             .collect();
         out.extend(results);
     }
-    progress(
-        "correcting and evaluating",
-        files.len() as u64,
-        files.len() as u64,
-    );
+    progress.check(EVALUATE_STEP, total, total)?;
     Ok(out)
 }
 
@@ -495,6 +498,20 @@ fn same_scale(
         tables_per_celsius: tables.raw_per_celsius,
         tables_at_zero: tables.raw_at_zero_celsius,
     })
+}
+
+/// The progress step of pass 2.
+const EVALUATE_STEP: &str = "correcting and evaluating";
+
+/// A [`Progress`] for reading one file of `step`: the step's position is kept, and the reading
+/// stops between activations when `progress` asks.
+fn within<'a>(progress: Progress<'a>, step: &'a str, done: u64, total: u64) -> Within<'a> {
+    Within {
+        outer: progress,
+        step,
+        done,
+        total,
+    }
 }
 
 /// The progress step of pass 1.
@@ -671,8 +688,13 @@ fn read_calibration(
     mut send: impl FnMut(Decoded) -> bool,
 ) -> f64 {
     let started = Instant::now();
+    let total = files.len() as u64;
     for (i, path) in files.iter().enumerate() {
-        progress(READ_STEP, i as u64, files.len() as u64);
+        let done = i as u64;
+        if let Err(stop) = progress.check(READ_STEP, done, total) {
+            send(Decoded::Failed(stop.into()));
+            break;
+        }
         let file = match OpenRecording::open(path) {
             Ok(file) => file,
             Err(e) => {
@@ -688,18 +710,21 @@ fn read_calibration(
             break;
         }
         let mut samples = 0;
-        let read = file.for_each_activation(|segment| {
-            samples += segment.len() as u64;
-            if !calibration_segment(&segment, options) {
-                return true;
-            }
-            let recorded_hz = segment.sample_rate_hz;
-            let segment = match fit_rate_hz {
-                Some(rate_hz) => block_means(&segment, rate_hz).unwrap_or(segment),
-                None => segment,
-            };
-            send(Decoded::Activation(Box::new(segment), recorded_hz))
-        });
+        let read = file.for_each_activation_with(
+            |segment| {
+                samples += segment.len() as u64;
+                if !calibration_segment(&segment, options) {
+                    return true;
+                }
+                let recorded_hz = segment.sample_rate_hz;
+                let segment = match fit_rate_hz {
+                    Some(rate_hz) => block_means(&segment, rate_hz).unwrap_or(segment),
+                    None => segment,
+                };
+                send(Decoded::Activation(Box::new(segment), recorded_hz))
+            },
+            &within(progress, READ_STEP, done, total),
+        );
         match read {
             Ok(true) if send(Decoded::End(samples)) => {}
             Ok(_) => break,
@@ -829,7 +854,8 @@ fn run_at(
     // Pass 1: read and analyse the calibration activations, fitting each unit whose files are
     // all read while the next unit's are decoded.
     let pass = read_and_analyse(files, options, fit_rate_hz, progress)?;
-    progress(READ_STEP, files.len() as u64, files.len() as u64);
+    let total = files.len() as u64;
+    progress.check(READ_STEP, total, total)?;
     outcome.samples_read = pass.samples_read;
     let (read_seconds, analyse_seconds) = (pass.read_seconds, pass.analyse_seconds);
     let by_unit = pass.by_unit;
@@ -856,6 +882,7 @@ fn run_at(
     let started = Instant::now();
     let mut held_out: BTreeMap<(String, u32), FittedUnit> = BTreeMap::new();
     for (unit, analysed) in &by_unit {
+        progress.check(READ_STEP, total, total)?;
         let fits = match early.remove(unit) {
             Some((seen, fits)) if seen == analysed.len() => fits,
             _ => fit_with_refits(analysed, options),
@@ -874,8 +901,9 @@ fn run_at(
     let mut recorded_set_points = Vec::new();
     let mut residuals: Vec<(Split, Residuals)> = Vec::new();
     for (i, path) in evaluated.iter().enumerate() {
-        progress("correcting and evaluating", i as u64, files.len() as u64);
-        let recording = read_recording(path)?;
+        let done = i as u64;
+        progress.check(EVALUATE_STEP, done, total)?;
+        let recording = read_recording_with(path, &within(progress, EVALUATE_STEP, done, total))?;
         for segment in &recording.segments {
             note_set_point(
                 &mut recorded_set_points,
@@ -944,11 +972,7 @@ fn run_at(
             }
         }
     }
-    progress(
-        "correcting and evaluating",
-        files.len() as u64,
-        files.len() as u64,
-    );
+    progress.check(EVALUATE_STEP, total, total)?;
     // A validation set point asked for and never seen would vanish from the report silently
     // (field sessions at it count: they are validated too, in their own table).
     let validated = if noise_floor {

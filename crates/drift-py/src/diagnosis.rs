@@ -13,7 +13,7 @@ use drift_diagnose::extend::Admission;
 use drift_diagnose::roles::Roles;
 use drift_fit::analyse::{analyse, Analysed};
 use drift_fit::{fit_unit, FitSettings, FittedUnit};
-use drift_recording::Segment;
+use drift_recording::{Progress, Segment};
 use drift_report::diagnosis::{Request, Section};
 use numpy::ndarray::Array3;
 use numpy::IntoPyArray;
@@ -22,6 +22,7 @@ use pyo3::types::{PyDict, PyTuple};
 use serde::{Deserialize, Serialize};
 
 use crate::errors::Error;
+use crate::interrupt;
 use crate::outputs::vector;
 use crate::pickle_state::{self, Pickled};
 use crate::sources::{self, Source};
@@ -95,23 +96,33 @@ struct RankRecord<'a> {
     absorbed_by_model: f64,
 }
 
+/// The step of averaging activations in memory into their block means.
+const AVERAGING: &str = "averaging activations";
+
 /// The activations of `unit_id` among `segments` at the loop's rate (0.1-s block means,
 /// [`drift_diagnose::activations`]), with how many activations of other units there were: files
 /// are read one activation at a time, objects in memory are averaged into copies.
-fn activations(source: Source, unit_id: &str) -> Result<(Vec<Segment>, usize), Error> {
+fn activations(
+    source: Source,
+    unit_id: &str,
+    progress: &dyn Progress,
+) -> Result<(Vec<Segment>, usize), Error> {
     match source {
         Source::Segments(segments) => {
-            let (own, others): (Vec<_>, Vec<_>) = segments
-                .into_iter()
-                .partition(|s| s.labels.unit_id == unit_id);
-            let own = own
-                .iter()
-                .map(|s| at_diagnosis_rate(Segment::clone(s)))
-                .collect();
-            Ok((own, others.len()))
+            let total = segments.len() as u64;
+            let (mut own, mut others) = (Vec::new(), 0);
+            for (i, segment) in segments.iter().enumerate() {
+                progress.check(AVERAGING, i as u64, total)?;
+                if segment.labels.unit_id == unit_id {
+                    own.push(at_diagnosis_rate(Segment::clone(segment)));
+                } else {
+                    others += 1;
+                }
+            }
+            Ok((own, others))
         }
         Source::Files(files) => {
-            let mut by_unit = read_by_unit(&files, |_, _| {})?;
+            let mut by_unit = read_by_unit(&files, progress)?;
             let own = by_unit.remove(unit_id).unwrap_or_default();
             Ok((own, by_unit.values().map(Vec::len).sum()))
         }
@@ -160,6 +171,7 @@ pub fn diagnose_unit(
     segments: &Bound<'_, PyAny>,
     calibration: Option<&Bound<'_, PyAny>>,
     asked: Asked,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyDiagnosis> {
     let source = sources::source(py, "segments", segments)?;
     let set_points = match calibration {
@@ -170,27 +182,21 @@ pub fn diagnose_unit(
             .map(|s| s.set_point_celsius)
             .collect(),
     };
-    // The loop runs on a thread of its own with a stack sized for it: its host types (tables of
+    // The loop runs on the work's thread, whose stack is sized for it: its host types (tables of
     // every model, refitted per candidate and fold) are values of hundreds of KB, and on the
     // interpreter's main thread, whose stack Python's own frames share, they overflowed it.
-    let diagnosis = py.detach(|| {
-        std::thread::scope(|scope| {
-            std::thread::Builder::new()
-                .name("gyrodrift-diagnose".into())
-                .stack_size(LOOP_STACK_BYTES)
-                .spawn_scoped(scope, || {
-                    run_loop(unit, settings, source, &set_points, &asked)
-                })
-                .map_err(|e| Error::Input(format!("internal: starting the loop's thread: {e}")))?
-                .join()
-                .map_err(|_| Error::Input("internal: the closed loop's thread panicked".into()))?
-        })
-    })?;
+    let diagnosis = interrupt::run(py, progress, |progress| {
+        run_loop(unit, settings, source, &set_points, &asked, progress)
+    })??;
     Ok(diagnosis)
 }
 
-/// Stack of the closed loop's thread, bytes (reserved address space, not memory in use).
-const LOOP_STACK_BYTES: usize = 256 << 20;
+/// The steps of the loop after reading, as its progress reports them (one unit each).
+const LOOP_STEPS: [&str; 3] = [
+    "fitting the loop's tables",
+    "ranking, fitting and guarding",
+    "measuring before and after",
+];
 
 /// The loop itself, off the interpreter's thread.
 fn run_loop(
@@ -199,11 +205,20 @@ fn run_loop(
     source: Source,
     set_points: &[f64],
     asked: &Asked,
+    progress: &dyn Progress,
 ) -> Result<PyDiagnosis, Error> {
     let extend = asked.extend;
+    let step = |done: usize| {
+        let total = LOOP_STEPS.len() as u64;
+        progress.check(
+            LOOP_STEPS[done.min(LOOP_STEPS.len() - 1)],
+            done as u64,
+            total,
+        )
+    };
     {
         let recorded_hz = unit.modified.settings.sample_rate_hz as u32;
-        let (own, others) = activations(source, &unit.unit_id)?;
+        let (own, others) = activations(source, &unit.unit_id, progress)?;
         if own.is_empty() {
             return Err(Error::Input(format!(
                 "`segments` holds no activation of unit {} ({others} activations of other units)",
@@ -214,7 +229,9 @@ fn run_loop(
         // The loop's own tables, fitted as the command line fits them (on the block means, with
         // the loop's settings): the same data give the command line's diagnosis.
         let settings = &loop_settings(settings);
+        step(0)?;
         let base = loop_tables(&own, set_points, settings, recorded_hz)?;
+        step(1)?;
         let unit = &base;
         let mut options = LoopOptions {
             extend,
@@ -226,6 +243,7 @@ fn run_loop(
             .bench_channels
             .extend(asked.bench_channels.iter().cloned());
         let closed = close(unit, own, &[], &options, settings)?;
+        step(2)?;
         if closed.series.is_empty() {
             return Err(Error::Input(format!(
                 "`segments` holds no activation of unit {} outside the calibration protocol at {set_points:?} °C to diagnose",

@@ -165,6 +165,13 @@ pub enum Error {
     Report(String),
 }
 
+impl From<drift_recording::Interrupted> for Error {
+    /// Never shown: the exception that stopped the work (`interrupt::run`) is raised instead.
+    fn from(_: drift_recording::Interrupted) -> Self {
+        Error::Input("interrupted".into())
+    }
+}
+
 impl From<ReadError> for Error {
     fn from(error: ReadError) -> Self {
         match error {

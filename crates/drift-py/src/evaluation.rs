@@ -18,6 +18,7 @@ use crate::arrays::describe;
 use crate::errors::Error;
 use crate::fit::PyFittedUnit;
 use crate::fit_settings;
+use crate::interrupt;
 use crate::results::PyActivationResult;
 use crate::sources::{self, Source};
 
@@ -186,9 +187,11 @@ fn pipeline_inputs(
 /// `report.json`, `timings.json` and the tables folder `tables/` — through the same function, so
 /// the same recordings and options give the same bytes; returns the path of `report.md`. `source`
 /// is a campaign folder, a folder of `.mcap` files or a list of files; `noise_floor` a campaign of
-/// zero-drift units measured like it. The GIL is released.
+/// zero-drift units measured like it. The GIL is released; Ctrl-C stops it within a second, before
+/// anything is written, and `progress(step, done, total)` is told how far it got.
 #[pyfunction]
-#[pyo3(signature = (source, out, *, calibration = None, validation = None, settings = None, noise_floor = None))]
+#[pyo3(signature = (source, out, *, calibration = None, validation = None, settings = None, noise_floor = None, progress = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn report(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
@@ -197,7 +200,9 @@ pub fn report(
     validation: Option<&Bound<'_, PyAny>>,
     settings: Option<&Bound<'_, PyAny>>,
     noise_floor: Option<&Bound<'_, PyAny>>,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PathBuf> {
+    let progress = interrupt::callable(progress)?;
     let out = args::path("out", out)?;
     let (files, noise_files, options) = pipeline_inputs(
         py,
@@ -209,16 +214,16 @@ pub fn report(
         true,
     )?;
     let described = describe_source(source);
-    py.detach(|| {
+    interrupt::run(py, progress.as_ref(), |progress| {
         drift_report::make(
             &files,
             noise_files.as_deref(),
             &options,
             &out,
             drift_report::provenance(&described, &options),
-            &|_, _, _| {},
+            progress,
         )
-    })
+    })?
     .map(|(path, _)| path)
     .map_err(|error| match error.downcast::<pipeline::PipelineError>() {
         Ok(error) => Error::from(error).into(),
@@ -238,9 +243,11 @@ fn describe_source(source: &Bound<'_, PyAny>) -> String {
 /// `gyrodrift report` does: validation set points, field sessions, and (with `held_out_repeats`)
 /// each repeat at the calibration set points against tables refitted without it. `source` is a
 /// campaign folder, a folder of `.mcap` files or a list of files; `noise_floor` a campaign of
-/// zero-drift units measured at the validation set points. The GIL is released.
+/// zero-drift units measured at the validation set points. The GIL is released; Ctrl-C stops it
+/// within a second, and `progress(step, done, total)` is told how far it got.
 #[pyfunction]
-#[pyo3(signature = (source, *, calibration = None, validation = None, settings = None, held_out_repeats = true, noise_floor = None))]
+#[pyo3(signature = (source, *, calibration = None, validation = None, settings = None, held_out_repeats = true, noise_floor = None, progress = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
@@ -249,7 +256,9 @@ pub fn evaluate(
     settings: Option<&Bound<'_, PyAny>>,
     held_out_repeats: bool,
     noise_floor: Option<&Bound<'_, PyAny>>,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyEvaluation> {
+    let progress = interrupt::callable(progress)?;
     let (files, noise_files, options) = pipeline_inputs(
         py,
         source,
@@ -259,11 +268,10 @@ pub fn evaluate(
         settings,
         held_out_repeats,
     )?;
-    let (outcome, noise_floor_units) = py
-        .detach(|| {
-            pipeline::run_with_noise_floor(&files, noise_files.as_deref(), &options, &|_, _, _| {})
-        })
-        .map_err(Error::from)?;
+    let (outcome, noise_floor_units) = interrupt::run(py, progress.as_ref(), |progress| {
+        pipeline::run_with_noise_floor(&files, noise_files.as_deref(), &options, progress)
+    })?
+    .map_err(Error::from)?;
     let fitted = outcome
         .fitted
         .into_iter()

@@ -10,7 +10,9 @@ use drift_evaluate::pipeline::{self, Options};
 use drift_evaluate::summary::Split;
 use drift_fit::analyse::{analyse, Analysed};
 use drift_fit::{fit_unit, FitSettings, FittedUnit};
-use drift_recording::{Segment, SeriesKind};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use drift_recording::{Progress, Segment, SeriesKind};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
@@ -18,6 +20,7 @@ use crate::args;
 use crate::arrays::describe;
 use crate::errors::{Error, FitError};
 use crate::fit_settings::{self, PyFitSettings};
+use crate::interrupt;
 use crate::results::{split_from, PyActivationResult};
 use crate::segment::PySegment;
 use crate::sources::{self, Source};
@@ -44,16 +47,29 @@ fn is_calibration(segment: &Segment, set_points: &[f64]) -> bool {
 }
 
 /// Fits every unit among in-memory segments, as the pipeline's first pass does for files.
+/// `progress` is told each activation analysed ([`ANALYSING`]) and may stop the fit.
 fn fit_segments(
     segments: &[Arc<Segment>],
     set_points: &[f64],
     settings: &FitSettings,
+    progress: &dyn Progress,
 ) -> Result<Vec<FittedUnit>, Error> {
-    let analysed: Vec<Analysed> = segments
-        .par_iter()
+    let calibration: Vec<&Segment> = segments
+        .iter()
         .filter(|s| is_calibration(s, set_points))
-        .map(|s| analyse(s, settings))
-        .collect::<Result<_, _>>()?;
+        .map(|s| &**s)
+        .collect();
+    let total = calibration.len() as u64;
+    let analysed_so_far = AtomicU64::new(0);
+    let analysed: Vec<Analysed> = calibration
+        .par_iter()
+        .map(|s| {
+            let analysed = analyse(s, settings)?;
+            let done = analysed_so_far.fetch_add(1, Ordering::Relaxed) + 1;
+            progress.check(ANALYSING, done, total)?;
+            Ok(analysed)
+        })
+        .collect::<Result<_, Error>>()?;
     let mut by_unit: BTreeMap<String, Vec<Analysed>> = BTreeMap::new();
     for a in analysed {
         by_unit.entry(a.labels.unit_id.clone()).or_default().push(a);
@@ -66,12 +82,19 @@ fn fit_segments(
         .collect()
 }
 
-/// Fits `source` at the calibration set points.
+/// The step `FittedUnit.evaluate_series` reports.
+const EVALUATING: &str = "evaluating";
+
+/// The step [`fit_segments`] reports.
+const ANALYSING: &str = "analysing activations";
+
+/// Fits `source` at the calibration set points; Ctrl-C and `progress` as [`interrupt::run`].
 pub fn fit_source(
     py: Python<'_>,
     source: Source,
     set_points: Vec<f64>,
     settings: FitSettings,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Vec<PyFittedUnit>> {
     let fitted = match source {
         Source::Files(files) => {
@@ -82,12 +105,16 @@ pub fn fit_source(
                 held_out_repeats: false,
                 evaluate: false,
             };
-            py.detach(|| pipeline::run(&files, &options, false, &|_, _, _| {}))
-                .map_err(Error::from)?
-                .fitted
+            interrupt::run(py, progress, |progress| {
+                pipeline::run(&files, &options, false, progress)
+            })?
+            .map_err(Error::from)?
+            .fitted
         }
         Source::Segments(segments) => {
-            let fitted = py.detach(|| fit_segments(&segments, &set_points, &settings))?;
+            let fitted = interrupt::run(py, progress, |progress| {
+                fit_segments(&segments, &set_points, &settings, progress)
+            })??;
             if fitted.is_empty() {
                 return Err(FitError::new_err(format!(
                     "no protocol activations at the calibration set points {set_points:?} °C in {} segments",
@@ -108,22 +135,25 @@ pub fn fit_source(
 
 /// Fits the paper's tables and both baselines for every unit in `source`, on the protocol
 /// activations at the `calibration` set points (the command line's `gyrodrift fit`). Returns one
-/// `FittedUnit` per unit, sorted by unit id. The GIL is released while fitting.
+/// `FittedUnit` per unit, sorted by unit id. The GIL is released while fitting; Ctrl-C stops it
+/// within a second, and `progress(step, done, total)` is told how far it got.
 #[pyfunction]
-#[pyo3(signature = (source, *, calibration = None, settings = None))]
+#[pyo3(signature = (source, *, calibration = None, settings = None, progress = None))]
 pub fn fit(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
     calibration: Option<&Bound<'_, PyAny>>,
     settings: Option<&Bound<'_, PyAny>>,
+    progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Vec<PyFittedUnit>> {
+    let progress = interrupt::callable(progress)?;
     let source = sources::source(py, "source", source)?;
     let set_points = match calibration {
         Some(v) => sources::set_points("calibration", v, false)?,
         None => drift_recording::paper::CALIBRATION_SET_POINTS_CELSIUS.to_vec(),
     };
     let settings = fit_settings::or_default(settings)?;
-    fit_source(py, source, set_points, settings)
+    fit_source(py, source, set_points, settings, progress.as_ref())
 }
 
 #[pymethods]
@@ -237,7 +267,7 @@ impl PyFittedUnit {
     /// Corrects a recording's activations (`segments`, one unit's) with every model, as
     /// `gyrodrift report` does: the history-keyed model starts each from what firmware kept of the
     /// one before in switch-on order, knowing a full cool-down from the recorded off-time; results
-    /// in the order given. The GIL is released.
+    /// in the order given. The GIL is released, and Ctrl-C stops it between activations.
     #[pyo3(signature = (segments, *, split = None))]
     fn evaluate_series(
         &self,
@@ -260,16 +290,25 @@ impl PyFittedUnit {
             })?;
             owned.push(Arc::clone(&segment.get().segment));
         }
-        let results = py.detach(|| {
+        let results = interrupt::run(py, None, |progress| {
             let refs: Vec<&drift_recording::Segment> = owned.iter().map(|s| &**s).collect();
             let kept = kept_before(&refs, &self.settings, &self.unit.by_history.settings, true);
+            let total = refs.len() as u64;
             refs.iter()
                 .zip(&kept)
-                .map(|(segment, previous)| {
-                    evaluate_after(&self.unit, segment, &self.settings, previous)
+                .enumerate()
+                .map(|(i, (segment, previous))| {
+                    progress.check(EVALUATING, i as u64, total)?;
+                    Ok(evaluate_after(
+                        &self.unit,
+                        segment,
+                        &self.settings,
+                        previous,
+                    ))
                 })
-                .collect::<Vec<_>>()
-        });
+                .collect::<Result<Vec<_>, drift_recording::Interrupted>>()
+        })?
+        .map_err(Error::from)?;
         Ok(results
             .into_iter()
             .map(|result| PyActivationResult { split, result })
@@ -286,8 +325,9 @@ impl PyFittedUnit {
     /// loop ranks and fits on, the other half judges. `bench_channels` are context, never ranked
     /// (the chamber's set point and air always are). Like the command line, the loop works on the
     /// activations' 0.1-s block means and refits this unit's paper tables on its calibration
-    /// protocol among them. The GIL is released.
-    #[pyo3(signature = (segments, *, calibration = None, extend = false, diagnose_on = Vec::new(), half = 0, bench_channels = Vec::new()))]
+    /// protocol among them. The GIL is released; Ctrl-C stops the loop within a second of reading
+    /// and between its steps, and `progress(step, done, total)` is told how far it got.
+    #[pyo3(signature = (segments, *, calibration = None, extend = false, diagnose_on = Vec::new(), half = 0, bench_channels = Vec::new(), progress = None))]
     #[allow(clippy::too_many_arguments)]
     fn diagnose(
         &self,
@@ -298,7 +338,9 @@ impl PyFittedUnit {
         diagnose_on: Vec<f64>,
         half: usize,
         bench_channels: Vec<String>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<crate::diagnosis::PyDiagnosis> {
+        let progress = interrupt::callable(progress)?;
         if half > 1 {
             return Err(crate::errors::Error::Input(format!(
                 "`half` must be 0 or 1 (which half of the diagnosis series ranks), got {half}"
@@ -317,6 +359,7 @@ impl PyFittedUnit {
                 half,
                 bench_channels,
             },
+            progress.as_ref(),
         )
     }
 

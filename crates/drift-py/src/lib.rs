@@ -19,6 +19,7 @@ mod extension;
 mod fit;
 mod fit_settings;
 mod flags;
+mod interrupt;
 mod labels;
 mod model_io;
 mod outputs;

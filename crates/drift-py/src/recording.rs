@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use drift_evaluate::pipeline::recording_files;
 use drift_recording::{
-    check_named_aux_channel, fixed_aux_unit, read_metadata, read_recording, write_recording,
+    check_named_aux_channel, fixed_aux_unit, read_metadata, read_recording_with, write_recording,
     Recording, AUX_RATE_HZ,
 };
 use pyo3::prelude::*;
@@ -15,6 +15,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::args;
 use crate::errors::Error;
+use crate::interrupt;
 use crate::segment::PySegment;
 
 /// The format's own auxiliary channels (all at 100 Hz), which every segment written needs; any
@@ -63,9 +64,10 @@ impl PyRecording {
     }
 }
 
-/// Reads one recording with the GIL released.
+/// Reads one recording with the GIL released; Ctrl-C stops it between activations.
 pub fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyRecording> {
-    let recording = py.detach(|| read_recording(&path)).map_err(Error::from)?;
+    let recording = interrupt::run(py, None, |progress| read_recording_with(&path, progress))?
+        .map_err(Error::from)?;
     PyRecording::wrap(py, recording)
 }
 
@@ -365,10 +367,17 @@ impl PyRecording {
 }
 
 /// Every recording of a campaign folder (its `recordings/`) or of a folder of `.mcap` files,
-/// sorted by name; ground truth is never opened.
+/// sorted by name; ground truth is never opened. Ctrl-C stops it between activations.
 #[pyfunction]
 pub fn load_campaign(py: Python<'_>, folder: &Bound<'_, PyAny>) -> PyResult<Vec<PyRecording>> {
     let folder = args::path("folder", folder)?;
     let files = recording_files(&folder).map_err(Error::from)?;
-    files.into_iter().map(|path| load(py, path)).collect()
+    files
+        .into_iter()
+        .map(|path| {
+            // Between files too: each is read in less time than Ctrl-C is looked for.
+            py.check_signals()?;
+            load(py, path)
+        })
+        .collect()
 }

@@ -14,6 +14,7 @@ use pyo3::types::{PyDict, PyString};
 use crate::args;
 use crate::arrays::describe;
 use crate::errors::Error;
+use crate::interrupt;
 
 /// `--set-points`: a list of floats, or the flag's text (`"30,40,33"` or `"-40:60:10"`).
 fn set_points(value: &Bound<'_, PyAny>) -> Result<Vec<f64>, Error> {
@@ -237,13 +238,15 @@ fn folder_error(error: FolderError) -> Error {
 /// Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
 /// does: a folder that is not empty is refused unless `force` (then an earlier campaign there is
 /// replaced once the new one is whole, and anything else refused), and a campaign writing more than `max_gb` is refused
-/// before it is planned; returns the summary (files, samples, bytes, wall time) as a dict. The GIL is released.
+/// before it is planned; returns the summary (files, samples, bytes, wall time) as a dict. The GIL is released;
+/// Ctrl-C stops the run within a second and leaves `out` as it was; `progress(step, done, total)`
+/// is called with the samples simulated.
 #[pyfunction]
 #[pyo3(signature = (
     out, campaign = None, *, seed = None, units = None, set_points = None, intervals = None,
     repeats = None, field = false, field_only = false, zero_drift = false, paper_exact = false,
     effects = None,
-    noise_scale = None, truth_at_aux_rate = false, force = false, max_gb = 20.0,
+    noise_scale = None, truth_at_aux_rate = false, force = false, max_gb = 20.0, progress = None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -264,8 +267,10 @@ pub fn simulate<'py>(
     truth_at_aux_rate: bool,
     force: bool,
     max_gb: f64,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let out = args::path("out", out)?;
+    let progress = interrupt::callable(progress)?;
     if !(max_gb.is_finite() && max_gb > 0.0) {
         return Err(Error::Input(format!("`max_gb` must be > 0, got {max_gb}")).into());
     }
@@ -285,16 +290,16 @@ pub fn simulate<'py>(
         noise_scale,
         truth_at_aux_rate,
     )?;
-    let summary = py.detach(|| -> Result<_, Error> {
+    let summary = interrupt::run(py, progress.as_ref(), |progress| -> Result<_, Error> {
         // Sized before anything is planned in full or written.
         drift_sim::size::within(&c, max_gb, "max_gb").map_err(|e| Error::Input(e.to_string()))?;
         // Written into a staging folder put in place at the end, as the command line does:
         // `force=True` replaces an earlier campaign only once the new one is whole.
         let staged = Staged::begin(&out, force, "force=True", &SIMULATE).map_err(folder_error)?;
-        drift_sim::simulate_campaign(&c, staged.path(), |_| {})?;
+        drift_sim::simulate_campaign_with(&c, staged.path(), progress)?;
         let text = summary_in_place(staged.path(), &out).map_err(folder_error)?;
         staged.commit().map_err(folder_error)?;
         Ok(text)
-    })?;
+    })??;
     py.import("json")?.call_method1("loads", (summary,))
 }

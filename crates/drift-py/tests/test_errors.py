@@ -363,6 +363,47 @@ def test_json_of_another_model_type(models: dict[str, Model]) -> None:
         ModifiedTables.from_json(models["standard"].to_json())
 
 
+TABLES = ["modified", "by_history", "standard", "third_order", "relative", "recommended"]
+
+
+def nested_objects(value: Any, path: str = "") -> list[tuple[str, dict[str, Any]]]:
+    """Every JSON object inside `value` with its path (`axes[0].stage1`), depth first."""
+    found: list[tuple[str, dict[str, Any]]] = []
+    if isinstance(value, dict):
+        found.append((path, value))
+        for key, item in value.items():
+            found += nested_objects(item, f"{path}.{key}" if path else key)
+    elif isinstance(value, list):
+        for i, item in enumerate(value):
+            found += nested_objects(item, f"{path}[{i}]")
+    return found
+
+
+@pytest.mark.parametrize("name", TABLES)
+def test_from_json_refuses_an_unknown_field_anywhere_and_names_it(
+    evaluation: gyrodrift.Evaluation, name: str
+) -> None:
+    model = getattr(evaluation.fitted[0], name)
+    kind = type(model)
+    text = model.to_json()
+    assert kind.from_json(text) == model
+    objects = nested_objects(json.loads(text))
+    assert len(objects) > 1, "the tables nest objects"
+    for path, _ in objects:
+        tables = json.loads(text)
+        target = dict(nested_objects(tables))[path]
+        target["colour"] = 1
+        with pytest.raises(TableError, match=rf"not a valid {kind.__name__} JSON: unknown field `colour`"):
+            kind.from_json(json.dumps(tables))
+
+
+def test_fit_settings_from_json_refuses_an_unknown_field_and_names_it() -> None:
+    settings = json.loads(gyrodrift.FitSettings().to_json())
+    settings["lowpass_window"] = 1.0
+    with pytest.raises(InputError, match="unknown field `lowpass_window`"):
+        gyrodrift.FitSettings.from_json(json.dumps(settings))
+
+
 def test_json_with_invalid_contents_names_the_field(modified: ModifiedTables) -> None:
     tables = json.loads(modified.to_json())
     tables["axes"][2]["reference_ms"][3] = tables["axes"][2]["reference_ms"][2]

@@ -88,6 +88,12 @@ pub enum ReadError {
         /// The mcap error.
         source: mcap::McapError,
     },
+    /// The reading was stopped by its [`crate::Progress`] (Ctrl-C in Python).
+    #[error("{path}: reading interrupted")]
+    Interrupted {
+        /// The file.
+        path: PathBuf,
+    },
     /// The file is a ground-truth sidecar; fitting and diagnosis code must not read it.
     #[error("{path}: is simulator ground truth ({why}); the recording reader refuses to read it")]
     GroundTruth {

@@ -22,6 +22,7 @@ mod layout;
 mod messages;
 pub mod output_folder;
 pub mod paper;
+mod progress;
 mod read;
 pub mod ros2;
 pub mod schema;
@@ -44,9 +45,10 @@ pub use csv_file::{
 pub use error::{ReadError, WriteError};
 pub use layout::{AUX_RATE_HZ, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 pub use messages::RECORD_LENGTH_LIMIT;
+pub use progress::{Interrupted, Progress, Within, QUIET};
 pub use read::{
     is_truth_path, read_campaign_dir, read_metadata, read_recording, read_recording_bytes,
-    OpenRecording, Recording, REQUIRED_TOPICS,
+    read_recording_with, OpenRecording, Recording, READING, REQUIRED_TOPICS,
 };
 pub use segment::{
     temperature_reading, AuxChannel, Segment, SegmentLabels, SeriesKind, TemperatureScale,

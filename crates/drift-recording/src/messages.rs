@@ -33,14 +33,15 @@ pub(crate) struct ChannelInfo {
     pub metadata: BTreeMap<String, String>,
 }
 
-/// Calls `each(channel, log_time_ns, data)` for every message of the data section, in file order.
+/// Calls `each(channel, log_time_ns, data, bytes_in)` for every message of the data section, in
+/// file order; `bytes_in` is how much of `buf` the reader has taken so far (for progress).
 /// Errors of `each` are passed through; container errors come back as `Err(Ok(mcap error))`.
 ///
 /// Channels and schemas are taken from the data section, not the summary: they are then covered
 /// by the same chunk CRCs as the messages.
 pub(crate) fn for_each_message<E>(
     buf: &[u8],
-    mut each: impl FnMut(&ChannelInfo, u64, &[u8]) -> Result<(), E>,
+    mut each: impl FnMut(&ChannelInfo, u64, &[u8], usize) -> Result<(), E>,
 ) -> Result<(), Result<McapError, E>> {
     // CRCs too: a flipped bit in a chunk or in the data section is then a CRC error naming the
     // file, not a plausible wrong sample (chunks are checked before any of their messages is used).
@@ -96,7 +97,7 @@ pub(crate) fn for_each_message<E>(
                             header.sequence,
                             header.channel_id,
                         )))?;
-                each(channel, header.log_time, &data).map_err(Err)?;
+                each(channel, header.log_time, &data, buf.len() - rest.len()).map_err(Err)?;
             }
             // The summary repeats channels; messages are all in the data section.
             Record::DataEnd(_) => break,

@@ -16,6 +16,7 @@ use crate::aux::check_named_aux_channel;
 use crate::error::ReadError;
 use crate::layout::{aux_samples_covered, AUX_RATE_HZ, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use crate::messages::ChannelInfo;
+use crate::progress::{Progress, QUIET};
 use crate::schema::{self, PowerEvent, RawTemperatureBatch, ScalarBatch, Vector3Batch};
 use crate::segment::{AuxChannel, Segment, SegmentLabels, SeriesKind, TemperatureScale};
 use std::collections::{BTreeMap, HashMap};
@@ -271,6 +272,11 @@ pub fn read_recording(path: &Path) -> Result<Recording, ReadError> {
     OpenRecording::open(path)?.read()
 }
 
+/// [`read_recording`], telling `progress` how far it got ([`OpenRecording::read_with`]).
+pub fn read_recording_with(path: &Path, progress: &dyn Progress) -> Result<Recording, ReadError> {
+    OpenRecording::open(path)?.read_with(progress)
+}
+
 /// A recording file read into memory and checked up to its metadata (the checks of
 /// [`read_metadata`]), its messages not yet decoded: a reader that chooses files by their metadata
 /// reads each file once, and one that wants activations one at a time never holds a whole
@@ -301,6 +307,12 @@ impl OpenRecording {
 
     /// Decodes and validates every message, as [`read_recording`] does.
     pub fn read(self) -> Result<Recording, ReadError> {
+        self.read_with(QUIET)
+    }
+
+    /// [`OpenRecording::read`], telling `progress` after each activation how many of the file's
+    /// bytes are decoded (step [`READING`]); [`ReadError::Interrupted`] when it asks to stop.
+    pub fn read_with(self, progress: &dyn Progress) -> Result<Recording, ReadError> {
         let mut segments = Vec::new();
         let (path, metadata, unit_id, sample_rate_hz) = (
             self.path.clone(),
@@ -308,10 +320,15 @@ impl OpenRecording {
             self.opened.unit_id.clone(),
             self.opened.sample_rate_hz,
         );
-        decode(&self.path, self.opened, &mut |segment| {
-            segments.push(segment);
-            true
-        })?;
+        decode(
+            &self.path,
+            self.opened,
+            &mut |segment| {
+                segments.push(segment);
+                true
+            },
+            progress,
+        )?;
         Ok(Recording {
             path,
             metadata,
@@ -330,7 +347,17 @@ impl OpenRecording {
         self,
         mut each: impl FnMut(Segment) -> bool,
     ) -> Result<bool, ReadError> {
-        decode(&self.path, self.opened, &mut each)
+        decode(&self.path, self.opened, &mut each, QUIET)
+    }
+
+    /// [`OpenRecording::for_each_activation`], telling `progress` after each activation as
+    /// [`OpenRecording::read_with`] does; [`ReadError::Interrupted`] when it asks to stop.
+    pub fn for_each_activation_with(
+        self,
+        mut each: impl FnMut(Segment) -> bool,
+        progress: &dyn Progress,
+    ) -> Result<bool, ReadError> {
+        decode(&self.path, self.opened, &mut each, progress)
     }
 }
 
@@ -346,9 +373,14 @@ pub fn read_recording_bytes(name: &Path, bytes: &[u8]) -> Result<Recording, Read
     .read()
 }
 
+/// The step a reader reports to its [`Progress`]: bytes of the file decoded.
+pub const READING: &str = "reading";
+
 /// Why decoding stopped before the end of the file.
 enum Halt {
     Invalid(ReadError),
+    /// The progress hook asked to stop.
+    Interrupted,
     /// The receiver of the activations wanted no more.
     Stopped,
 }
@@ -359,6 +391,7 @@ fn decode(
     path: &Path,
     opened: Opened,
     each: &mut dyn FnMut(Segment) -> bool,
+    progress: &dyn Progress,
 ) -> Result<bool, ReadError> {
     let Opened {
         buf,
@@ -381,15 +414,21 @@ fn decode(
         open: None,
         each,
         stopped: false,
+        finished: 0,
         topics: HashMap::new(),
         named_units: HashMap::new(),
     };
-    let decoded = crate::messages::for_each_message(&buf, |channel, log_ns, data| {
+    let total = buf.len() as u64;
+    let decoded = crate::messages::for_each_message(&buf, |channel, log_ns, data, bytes_in| {
+        let finished = reader.finished;
         reader
             .message(channel, log_ns, data)
             .map_err(Halt::Invalid)?;
         if reader.stopped {
             return Err(Halt::Stopped);
+        }
+        if reader.finished != finished && progress.check(READING, bytes_in as u64, total).is_err() {
+            return Err(Halt::Interrupted);
         }
         Ok(())
     });
@@ -398,6 +437,11 @@ fn decode(
         Err(Ok(e)) => return Err(mcap_err(e)),
         Err(Err(Halt::Invalid(e))) => return Err(e),
         Err(Err(Halt::Stopped)) => return Ok(false),
+        Err(Err(Halt::Interrupted)) => {
+            return Err(ReadError::Interrupted {
+                path: path.to_path_buf(),
+            })
+        }
     }
     if reader.open.is_some() {
         let index = reader
@@ -426,6 +470,8 @@ struct Reader<'p> {
     each: &'p mut dyn FnMut(Segment) -> bool,
     /// `each` returned `false`.
     stopped: bool,
+    /// Activations handed to `each`.
+    finished: u64,
     topics: HashMap<String, TopicState>,
     /// Unit of each named channel, from the first channel record it was read with.
     named_units: HashMap<String, String>,
@@ -611,6 +657,7 @@ impl Reader<'_> {
             temperature_scale: self.temperature_scale,
             aux,
         };
+        self.finished += 1;
         self.stopped = !(self.each)(segment);
         Ok(())
     }

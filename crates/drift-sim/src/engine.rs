@@ -19,6 +19,7 @@ use drift_recording::{SeriesKind, AUX_RATE_HZ, RAW_PER_CELSIUS};
 use rand::rngs::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use std::collections::BTreeMap;
+use std::ops::ControlFlow;
 use std::path::Path;
 
 /// Full-scale range of the rate output (°/s); readings saturate here.
@@ -212,12 +213,13 @@ impl FileSim<'_> {
         Ok(f)
     }
 
-    /// Runs the whole file. `progress` receives the number of samples just done.
+    /// Runs the whole file. `progress` receives the number of samples just done, after each
+    /// block of samples; when it breaks, the run stops with [`SimError::Interrupted`].
     pub fn run(
         &self,
         recording: &Path,
         truth: &Path,
-        progress: &mut dyn FnMut(u64),
+        progress: &mut dyn FnMut(u64) -> ControlFlow<()>,
     ) -> Result<FileCounts, SimError> {
         let c = self.campaign;
         let mut rec = self.open_recording(recording)?;
@@ -377,7 +379,7 @@ impl FileSim<'_> {
         rec: &mut McapFile,
         tru: &mut McapFile,
         buf: &mut Buffers,
-        progress: &mut dyn FnMut(u64),
+        progress: &mut dyn FnMut(u64) -> ControlFlow<()>,
     ) -> Result<(), SimError> {
         let c = self.campaign;
         let unit = self.unit;
@@ -670,7 +672,9 @@ impl FileSim<'_> {
                     );
                     tru.write_encoded(schema::TOPIC_TRUTH_EFFECT, log_ns)?;
                 }
-                progress(buf.rate[0].len() as u64);
+                if progress(buf.rate[0].len() as u64).is_break() {
+                    return Err(SimError::Interrupted);
+                }
                 buf.clear();
             }
         }

@@ -30,6 +30,9 @@ pub enum SimError {
         /// Reason.
         reason: String,
     },
+    /// The run was stopped by its progress hook (Ctrl-C in Python); its files are unfinished.
+    #[error("simulation interrupted")]
+    Interrupted,
     /// File-system error.
     #[error("{path}: {source}")]
     Io {

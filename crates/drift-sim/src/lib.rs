@@ -29,5 +29,8 @@ pub use drift_recording::{
     read_campaign_dir, read_recording, AuxChannel, ReadError, Recording, Segment, SegmentLabels,
 };
 pub use schedule::SeriesKind;
-pub use simulate::{simulate_campaign, Progress, Summary};
+pub use simulate::{
+    simulate_campaign, simulate_campaign_until, simulate_campaign_with, Progress, Summary,
+    SIMULATING,
+};
 pub use unit::{UnitModel, UnitParams};

@@ -16,6 +16,7 @@ use crate::unit::UnitParams;
 use crate::world::runtime::{AuxActivation, Runtime};
 use drift_recording::{SeriesKind, COMPLETION_MARKER, RECORDINGS_DIR, TRUTH_DIR, TRUTH_EXTENSION};
 use serde::Serialize;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -104,12 +105,41 @@ pub fn simulate_campaign(
     out_dir: &Path,
     mut progress: impl FnMut(Progress),
 ) -> Result<Summary, SimError> {
+    simulate_campaign_until(c, out_dir, |p| {
+        progress(p);
+        ControlFlow::Continue(())
+    })
+}
+
+/// [`simulate_campaign`] with a `progress` that may stop the run: called after each block of
+/// samples (a tenth of a second of recording), a break ends it with [`SimError::Interrupted`],
+/// leaving the files of the run unfinished (a caller writing into a staging folder removes it).
+pub fn simulate_campaign_until(
+    c: &Campaign,
+    out_dir: &Path,
+    mut progress: impl FnMut(Progress) -> ControlFlow<()>,
+) -> Result<Summary, SimError> {
     c.validate()?;
     let started = Instant::now();
     let plans = schedule::plan(c);
     let units = draw_units(c);
     record(c, &units, &plans, None, out_dir, started, &mut progress)
 }
+
+/// [`simulate_campaign_until`] reporting to a [`drift_recording::Progress`]: step
+/// [`SIMULATING`], samples done of the campaign's samples.
+pub fn simulate_campaign_with(
+    c: &Campaign,
+    out_dir: &Path,
+    progress: &dyn drift_recording::Progress,
+) -> Result<Summary, SimError> {
+    simulate_campaign_until(c, out_dir, |p| {
+        progress.report(SIMULATING, p.samples_done, p.samples_total)
+    })
+}
+
+/// The step [`simulate_campaign_with`] reports.
+pub const SIMULATING: &str = "simulating";
 
 /// A world's part of a run: its runtime, and its named channels per file and activation.
 pub(crate) type WorldPart<'a> = (&'a Runtime, &'a [Vec<AuxActivation>]);
@@ -122,7 +152,7 @@ pub(crate) fn record(
     world: Option<WorldPart>,
     out_dir: &Path,
     started: Instant,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(Progress) -> ControlFlow<()>,
 ) -> Result<Summary, SimError> {
     let recordings = out_dir.join(RECORDINGS_DIR);
     let truth = out_dir.join(TRUTH_DIR);
@@ -178,10 +208,12 @@ pub(crate) fn record(
         let truth_path = truth.join(format!("{}.{TRUTH_EXTENSION}", plan.stem));
         let counts = sim.run(&rec_path, &truth_path, &mut |n| {
             state.samples_done += n;
-            progress(state);
+            progress(state)
         })?;
         state.files_done += 1;
-        progress(state);
+        if progress(state).is_break() {
+            return Err(SimError::Interrupted);
+        }
         files.push(FileSummary {
             recording: rec_path,
             truth: truth_path,

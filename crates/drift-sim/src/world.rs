@@ -297,7 +297,10 @@ impl World {
             Some((&runtime, &aux)),
             out_dir,
             started,
-            &mut progress,
+            &mut |p| {
+                progress(p);
+                std::ops::ControlFlow::Continue(())
+            },
         )
     }
 

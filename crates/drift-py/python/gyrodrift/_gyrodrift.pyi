@@ -7,7 +7,7 @@ temperature-sensor units (see `Settings`), `_celsius` °C. All arithmetic is f32
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Final, Literal, final, overload
 
@@ -84,6 +84,9 @@ _Floats: TypeAlias = NDArray[np.float32] | NDArray[np.float64]
 _Floats4: TypeAlias = Sequence[float] | NDArray[np.floating]
 _TermKind: TypeAlias = Literal["temperature_rate", "aux", "axis_rise", "rise_squared", "aux_times_rise"]
 _Source: TypeAlias = _Path | Recording | Segment | Sequence[_Path | Recording | Segment]
+# Called by a long call (at most every 0.1 s, when it moved) with (step, done, total): `done`
+# grows within a step. An exception it raises stops the call and is raised from it.
+_Progress: TypeAlias = Callable[[str, int, int], object]
 _Record: TypeAlias = dict[str, Any]
 
 # Status flags (bits of each `flags` output value); `gyrodrift.Flags` is the IntFlag of these.
@@ -876,7 +879,8 @@ class Recording:
         """`from_dataframe(pandas.read_csv(path), ...)`: the same options; errors name the file."""
     @staticmethod
     def load(path: _Path) -> Recording:
-        """Reads and validates an MCAP recording (the GIL is released). Raises `FileError`
+        """Reads and validates an MCAP recording (the GIL is released; Ctrl-C stops it between
+        activations). Raises `FileError`
         (missing or unreadable file) or `RecordingError` (naming file, topic and message index)."""
     @staticmethod
     def read_metadata(path: _Path) -> dict[str, str]:
@@ -932,6 +936,7 @@ def simulate(
     truth_at_aux_rate: bool = False,
     force: bool = False,
     max_gb: float = 20.0,
+    progress: _Progress | None = None,
 ) -> dict[str, Any]:
     """Simulates a campaign into `out` (recordings/, truth/, summary.json), as `gyrodrift simulate`
     does: the same campaign and seed give the same bytes. A folder that is not empty is refused
@@ -942,7 +947,9 @@ def simulate(
     None (the paper's), a dict or TOML/JSON text (drift_sim::Campaign's fields), or a file path
     (os.PathLike; JSON if it ends in .json, else TOML). The keywords are the command line's flags
     (`set_points` also takes its text, "30,40,33" or "-40:60:10"). Returns the run's summary. The
-    GIL is released while simulating. Raises `CampaignError`, `InputError` or `FileError`."""
+    GIL is released while simulating; Ctrl-C stops it within a second (`KeyboardInterrupt`, the
+    staging folder removed, `out` as it was), and `progress` is called with ("simulating", samples
+    done, samples in the campaign). Raises `CampaignError`, `InputError` or `FileError`."""
 
 def resolve_campaign(
     campaign: Mapping[str, Any] | str | os.PathLike[str] | None = None,
@@ -1218,7 +1225,8 @@ class FittedUnit:
         """Corrects a recording's activations (one unit's) with every model, as `gyrodrift report`
         does: the history-keyed model starts each from what firmware kept of the one before in
         switch-on order, knowing a full cool-down from the recorded off-time; results in the order
-        given. The GIL is released. Raises `InputError` for an item that is not a Segment."""
+        given. The GIL is released, and Ctrl-C stops it between activations. Raises `InputError`
+        for an item that is not a Segment."""
     def diagnose(
         self,
         segments: _Source,
@@ -1228,6 +1236,7 @@ class FittedUnit:
         diagnose_on: Sequence[float] = ...,
         half: int = 0,
         bench_channels: Sequence[str] = ...,
+        progress: _Progress | None = None,
     ) -> Diagnosis:
         """Diagnoses what the paper's model leaves in the residual of this unit's activations among
         `segments` (recordings, segments or files; other units' activations are skipped), as
@@ -1240,7 +1249,8 @@ class FittedUnit:
         `gyrodrift diagnose --diagnose-on` does). `bench_channels` describe the bench and are never
         ranked (the chamber's set point and air always are). Like the command line, the loop
         works on the activations' 0.1-s block means and refits this unit's paper tables on its
-        calibration protocol among them. The GIL is released. Raises `InputError` (no activation
+        calibration protocol among them. The GIL is released; Ctrl-C stops it while it reads and
+        between its steps, and `progress` is told the steps. Raises `InputError` (no activation
         of this unit to diagnose, `half` not 0 or 1) or `FitError`."""
     def save(self, folder: _Path) -> Path:
         """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} through
@@ -1252,12 +1262,14 @@ def fit(
     *,
     calibration: Sequence[float] | None = None,
     settings: FitSettings | None = None,
+    progress: _Progress | None = None,
 ) -> list[FittedUnit]:
     """Fits the tables and both baselines for every unit in `source`, on the protocol activations
     at the `calibration` set points (default 30, 40 °C), as `gyrodrift fit` does. `source` is a
     campaign folder, a folder of .mcap files, one file, a list of files, or recordings/segments in
-    memory. One `FittedUnit` per unit, sorted by unit id. The GIL is released. Raises `FitError`,
-    `RecordingError`, `FileError` or `InputError`."""
+    memory. One `FittedUnit` per unit, sorted by unit id. The GIL is released; Ctrl-C stops it
+    within a second (`KeyboardInterrupt`), and `progress` is told how far it got. Raises
+    `FitError`, `RecordingError`, `FileError` or `InputError`."""
 
 @final
 class Evaluation:
@@ -1294,14 +1306,17 @@ def evaluate(
     settings: FitSettings | None = None,
     held_out_repeats: bool = True,
     noise_floor: _Path | Sequence[_Path] | None = None,
+    progress: _Progress | None = None,
 ) -> Evaluation:
     """Fits at the `calibration` set points (default 30, 40 °C) and evaluates every activation no
     fit saw, as `gyrodrift report` does: the `validation` set points (default 33 °C), field
     sessions, and (with `held_out_repeats`) each repeat at the calibration set points against
     tables refitted without it. `source` is recording files (a campaign folder, a folder of .mcap
     files, a list of files); `noise_floor` a campaign of zero-drift units, measured at the
-    validation set points. The GIL is released. Raises `FitError`, `RecordingError`, `FileError`
-    or `InputError`."""
+    validation set points. The GIL is released; Ctrl-C stops it within a second
+    (`KeyboardInterrupt`), and `progress` is called with (step, done, total): "reading
+    recordings" and "correcting and evaluating" count files. Raises `FitError`, `RecordingError`,
+    `FileError` or `InputError`."""
 
 def report(
     source: _Path | Sequence[_Path],
@@ -1311,12 +1326,14 @@ def report(
     validation: Sequence[float] | None = None,
     settings: FitSettings | None = None,
     noise_floor: _Path | Sequence[_Path] | None = None,
+    progress: _Progress | None = None,
 ) -> Path:
     """Writes the report of `gyrodrift report` into `out`: `report.md` with its SVG figures,
     `report.json` (the table as data), `timings.json` and the fitted tables folder `tables/`, through
     the same function as the command line, so the same recordings and options give the same bytes.
-    Returns the path of `report.md`. Arguments as `evaluate`'s. The GIL is released. Raises
-    `FitError`, `RecordingError`, `FileError` or `InputError`."""
+    Returns the path of `report.md`. Arguments as `evaluate`'s. The GIL is released; Ctrl-C stops
+    it within a second, before anything is written. Raises `FitError`, `RecordingError`,
+    `FileError` or `InputError`."""
 
 def summarise(results: Sequence[ActivationResult]) -> list[_Record]:
     """Averages activation results into the report's records (as `Evaluation.records`)."""

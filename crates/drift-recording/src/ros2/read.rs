@@ -468,7 +468,7 @@ pub fn read_bag(
         if n == 0 {
             labels = read_labels(file, &buf).map_err(mcap_error)?;
         }
-        crate::messages::for_each_message(&buf, |channel, log_ns, data| {
+        crate::messages::for_each_message(&buf, |channel, log_ns, data, _| {
             let topic = channel.topic.as_str();
             if !all_topics.contains_key(topic) {
                 all_topics.insert(
