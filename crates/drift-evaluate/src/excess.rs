@@ -24,6 +24,21 @@ pub fn excess_ratio(before: f64, after: f64, floor: f64) -> f64 {
     (before - floor) / (after - floor).max(1e-9)
 }
 
+/// [`excess_ratio`] for one bootstrap draw of a positive ratio, whose means can fall below the
+/// floor where the point figures are barely above it: a draw with no excess before has nothing to cut, so it counts as
+/// no change (1) when after has none either and as worse (0) when after has some. Without this, a
+/// numerator below zero over a denominator clamped to 1e-9 gave bounds like −8234× for a model that
+/// changed nothing.
+fn resampled_ratio(before: f64, after: f64, floor: f64) -> f64 {
+    if before > floor {
+        excess_ratio(before, after, floor)
+    } else if after > floor {
+        0.0
+    } else {
+        1.0
+    }
+}
+
 /// An excess cut with its 95 % bootstrap interval.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ExcessCut {
@@ -106,11 +121,17 @@ pub fn excess_cut(before: &[f64], after: &[f64], floor: &[f64]) -> ExcessCut {
         .map(|_| {
             let picks: Vec<usize> = (0..n).map(|_| rng.random_range(0..n)).collect();
             let twin = mean((0..floor.len()).map(|_| floor[rng.random_range(0..floor.len())]));
-            excess_ratio(
+            let (b, a) = (
                 mean(picks.iter().map(|&i| before[i])),
                 mean(picks.iter().map(|&i| after[i])),
-                twin,
-            )
+            );
+            // With no excess before at all (a ratio that is not positive, shown as "–") the draws
+            // stay on the ratio's own scale.
+            if ratio > 0.0 {
+                resampled_ratio(b, a, twin)
+            } else {
+                excess_ratio(b, a, twin)
+            }
         })
         .collect();
     draws.sort_by(f64::total_cmp);
@@ -130,6 +151,15 @@ mod tests {
     fn noise(i: usize, salt: u64) -> f64 {
         let mut rng = ChaCha8Rng::seed_from_u64(salt.wrapping_mul(1_000_003) + i as u64);
         rng.random::<f64>() * 2.0 - 1.0
+    }
+
+    #[test]
+    fn a_model_that_changes_nothing_at_the_floor_cuts_nothing_in_every_draw() {
+        // Before and after the same, scattered about the twin's floor: draws fall on both sides.
+        let before: Vec<f64> = (0..16).map(|i| 1.0 + 0.3 * noise(i, 4)).collect();
+        let floor: Vec<f64> = (0..16).map(|i| 1.0 + 0.3 * noise(i, 5)).collect();
+        let cut = excess_cut(&before, &before, &floor);
+        assert_eq!((cut.low, cut.high), (1.0, 1.0), "{cut:?}");
     }
 
     #[test]
