@@ -279,12 +279,46 @@ pub fn correct_segment_after<M: Model>(
     (corrected, flags)
 }
 
+/// [`correct_segment_after`] started at the ambient the instrument measured at switch-on
+/// (`power_on_at_ambient`, or `power_on_after_at_ambient` when `previous` is given): the paper's
+/// stage 2 and initial bias read there, not at the switch-on temperature.
+pub fn correct_segment_at_ambient<M: Model>(
+    model: &M,
+    segment: &Segment,
+    switch_on: [f32; 3],
+    ambient_celsius: f32,
+    previous: Option<&[Previous; 3]>,
+) -> ([Vec<f32>; 3], [u16; 3]) {
+    let (corrected, flags, _) = correct_started(
+        model,
+        segment,
+        switch_on,
+        previous,
+        Some(ambient_celsius),
+        drift_core::Flags::NONE,
+    );
+    (corrected, flags)
+}
+
 /// [`correct_segment_after`] that also counts, per axis, the samples any of `counted` flags.
 pub fn correct_segment_counting<M: Model>(
     model: &M,
     segment: &Segment,
     switch_on: [f32; 3],
     previous: Option<&[Previous; 3]>,
+    counted: drift_core::Flags,
+) -> ([Vec<f32>; 3], [u16; 3], [usize; 3]) {
+    correct_started(model, segment, switch_on, previous, None, counted)
+}
+
+/// One activation through the corrector, started with `previous` and at `ambient_celsius` where
+/// they are given, counting the samples any of `counted` flags.
+fn correct_started<M: Model>(
+    model: &M,
+    segment: &Segment,
+    switch_on: [f32; 3],
+    previous: Option<&[Previous; 3]>,
+    ambient_celsius: Option<f32>,
     counted: drift_core::Flags,
 ) -> ([Vec<f32>; 3], [u16; 3], [usize; 3]) {
     let n = segment.len();
@@ -302,9 +336,13 @@ pub fn correct_segment_counting<M: Model>(
             count,
         );
     };
-    let started = match previous {
-        Some(previous) => corrector.power_on_after(switch_on, &mut previous.clone()),
-        None => corrector.power_on(switch_on),
+    let started = match (previous, ambient_celsius) {
+        (Some(previous), None) => corrector.power_on_after(switch_on, &mut previous.clone()),
+        (None, None) => corrector.power_on(switch_on),
+        (Some(previous), Some(ambient)) => {
+            corrector.power_on_after_at_ambient(switch_on, ambient, &mut previous.clone())
+        }
+        (None, Some(ambient)) => corrector.power_on_at_ambient(switch_on, ambient),
     };
     if started.is_err() {
         return (
