@@ -36,6 +36,11 @@ pub enum ModelKind {
     /// The recommended model: the paper's drift after switch-on with the turn-on bias fitted on
     /// every calibration activation, fed what firmware would have kept of the previous activation.
     Recommended,
+    /// The paper's modified method started at the ambient the instrument measured at switch-on
+    /// (a logged channel, `drift_core`'s `power_on_at_ambient`): stage 2 and the initial bias read
+    /// there, not at the switch-on temperature. Evaluated only where that channel is named
+    /// ([`evaluate_at`]); not in [`ModelKind::ALL`].
+    AtAmbient,
 }
 
 impl ModelKind {
@@ -71,6 +76,7 @@ impl ModelKind {
             Self::Modified => "modified",
             Self::ByHistory => "by-history",
             Self::Recommended => "recommended",
+            Self::AtAmbient => "modified-at-ambient",
         }
     }
 }
@@ -444,10 +450,25 @@ pub fn evaluate_after(
     settings: &FitSettings,
     previous: &[Previous; 3],
 ) -> ActivationResult {
+    evaluate_at(fitted, segment, settings, previous, None)
+}
+
+/// [`evaluate_after`], and with `ambient_celsius` (the ambient the instrument measured at
+/// switch-on, °C) also the paper's tables started there ([`ModelKind::AtAmbient`], after every
+/// model of [`ModelKind::ALL`]).
+pub fn evaluate_at(
+    fitted: &FittedUnit,
+    segment: &Segment,
+    settings: &FitSettings,
+    previous: &[Previous; 3],
+    ambient_celsius: Option<f32>,
+) -> ActivationResult {
     let window = settings.lowpass_window(segment.sample_rate_hz);
     let switch_on = switch_on_raw(segment, settings);
+    let at_ambient = ambient_celsius.map(|_| ModelKind::AtAmbient);
     let models = ModelKind::ALL
         .iter()
+        .chain(&at_ambient)
         .map(|&model| {
             let (rates, flags) = match model {
                 ModelKind::Uncorrected => (segment.rate_dps.clone(), [0; 3]),
@@ -464,6 +485,13 @@ pub fn evaluate_after(
                 ModelKind::Recommended => {
                     correct_segment_after(&fitted.recommended, segment, switch_on, Some(previous))
                 }
+                ModelKind::AtAmbient => correct_segment_at_ambient(
+                    &fitted.modified,
+                    segment,
+                    switch_on,
+                    ambient_celsius.unwrap_or(f32::NAN),
+                    None,
+                ),
             };
             let (drift_dps, residual_rms_dps) = metric(&rates, window);
             ModelResult {

@@ -81,6 +81,7 @@ pub fn fit_source(
                 fit: settings.clone(),
                 held_out_repeats: false,
                 evaluate: false,
+                switch_on_ambient: None,
             };
             py.detach(|| pipeline::run(&files, &options, false, &|_, _, _| {}))
                 .map_err(Error::from)?
