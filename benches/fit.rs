@@ -33,6 +33,7 @@ fn options() -> Options {
         fit: FitSettings::default(),
         held_out_repeats: false,
         evaluate: false,
+        switch_on_ambient: None,
     }
 }
 

@@ -34,6 +34,7 @@ fn stage3_notes(effects: HiddenEffects) -> Vec<String> {
         fit: FitSettings::default(),
         held_out_repeats: false,
         evaluate: false,
+        switch_on_ambient: None,
     };
     let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap();
     outcome.fitted[0]
@@ -84,6 +85,7 @@ fn validation_drift(effects: HiddenEffects) -> [(f64, f64); 3] {
         fit: FitSettings::default(),
         held_out_repeats: false,
         evaluate: true,
+        switch_on_ambient: None,
     };
     let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap();
     let fitted = &outcome.fitted[0];

@@ -141,6 +141,7 @@ fn drift_fit_unit() -> drift_fit::FittedUnit {
         fit: drift_fit::FitSettings::default(),
         held_out_repeats: false,
         evaluate: false,
+        switch_on_ambient: None,
     };
     drift_evaluate::pipeline::run(&files, &options, false, drift_recording::QUIET)
         .unwrap()

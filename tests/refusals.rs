@@ -217,6 +217,63 @@ fn report_refuses_a_validation_set_point_without_data() {
 }
 
 #[test]
+fn report_refuses_a_switch_on_ambient_channel_a_recording_lacks() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &[
+            "report",
+            s(campaign()),
+            "-q",
+            "--switch-on-ambient",
+            "chamber_air",
+            "-o",
+            s(&dir.path().join("report")),
+        ],
+        &[
+            ".mcap: unit GIU-01, set point ",
+            " series ",
+            " activation ",
+            "no finite `chamber_air` value at switch-on",
+            "--switch-on-ambient",
+            "channels logged: ",
+            "chamber_set_point",
+        ],
+    );
+    assert!(!dir.path().join("report").exists());
+}
+
+#[test]
+fn report_compares_the_switch_on_at_a_logged_ambient() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    common::ok(&[
+        "report",
+        s(campaign()),
+        "-q",
+        "--switch-on-ambient",
+        "chamber_set_point",
+        "-o",
+        s(&out),
+    ]);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("Switch-on ambient: the `chamber_set_point` channel"),
+        "{md}"
+    );
+    let section = md
+        .split("## Switch-on at a measured ambient")
+        .nth(1)
+        .expect("the section");
+    assert!(
+        section.contains("| validation | +33 °C | drift |")
+            && section.contains("| validation | +33 °C | RMS |"),
+        "{section}"
+    );
+    let json = std::fs::read_to_string(out.join("report.json")).unwrap();
+    assert!(json.contains("modified-at-ambient"));
+}
+
+#[test]
 fn report_footnote_names_the_validation_set_point_used() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("report");

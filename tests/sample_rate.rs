@@ -69,6 +69,7 @@ fn drifts(dir: &Path, rate: u32) -> Vec<(ModelKind, f64)> {
         fit: FitSettings::default(),
         held_out_repeats: true,
         evaluate: true,
+        switch_on_ambient: None,
     };
     let outcome = pipeline::run(&files, &options, false, drift_recording::QUIET).unwrap();
     for unit in &outcome.fitted {

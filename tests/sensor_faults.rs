@@ -36,6 +36,7 @@ fn options() -> Options {
         fit: FitSettings::default(),
         held_out_repeats: false,
         evaluate: false,
+        switch_on_ambient: None,
     }
 }
 

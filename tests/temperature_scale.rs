@@ -69,6 +69,7 @@ fn options() -> Options {
         fit: FitSettings::default(),
         held_out_repeats: true,
         evaluate: true,
+        switch_on_ambient: None,
     }
 }
 

@@ -61,6 +61,7 @@ fn main() -> Result<()> {
         fit: FitSettings::default(),
         held_out_repeats: false,
         evaluate: false,
+        switch_on_ambient: None,
     };
     let settings = &options.fit;
     let mut segments = Vec::new();

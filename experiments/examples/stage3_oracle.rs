@@ -74,6 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         fit: FitSettings::default(),
         held_out_repeats: false,
         evaluate: false,
+        switch_on_ambient: None,
     };
     let files = recording_files(Path::new(&dir))?;
     let outcome = run(&files, &options, false, drift_recording::QUIET)?;

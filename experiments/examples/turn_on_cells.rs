@@ -73,6 +73,7 @@ fn main() -> anyhow::Result<()> {
         fit: settings.clone(),
         held_out_repeats: true,
         evaluate: true,
+        switch_on_ambient: None,
     };
     let files = recording_files(Path::new(&dir))?;
     let outcome = run(&files, &options, false, drift_recording::QUIET)?;

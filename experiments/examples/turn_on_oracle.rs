@@ -141,6 +141,7 @@ fn main() -> anyhow::Result<()> {
         fit: settings.clone(),
         held_out_repeats: false,
         evaluate: false,
+        switch_on_ambient: None,
     };
     let dir = Path::new(&dir);
     let files = recording_files(dir)?;

@@ -53,6 +53,7 @@ impl CampaignArgs {
             fit: load_settings(self.settings.as_deref())?,
             held_out_repeats: evaluate,
             evaluate,
+            switch_on_ambient: None,
         })
     }
 }

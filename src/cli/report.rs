@@ -43,6 +43,13 @@ pub struct Args {
     /// Replace an earlier `gyrodrift report` output in the output folder, whole.
     #[arg(long)]
     pub force: bool,
+    /// A logged channel that holds the ambient the instrument measured (`chamber_air`, or
+    /// `chamber_set_point`, which a field recording logs as the ambient it went through): the
+    /// paper's tables are also evaluated with stage 2 and the initial bias read at its value at
+    /// each activation's switch-on (`modified-at-ambient`, drift-core's `power_on_at_ambient`).
+    /// Every evaluated activation must log it.
+    #[arg(long, value_name = "CHANNEL")]
+    pub switch_on_ambient: Option<String>,
 }
 
 /// `report` as a writer of output folders.
@@ -112,7 +119,10 @@ pub fn headline(outcome: &Outcome, options: &Options) -> String {
 /// Runs `gyrodrift report`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let input = &args.input;
-    let options = input.options(&args.validation, true)?;
+    let mut options = input.options(&args.validation, true)?;
+    options
+        .switch_on_ambient
+        .clone_from(&args.switch_on_ambient);
     if let Some(evaluation) = &args.evaluation_data {
         return run_separate(args, evaluation, &options);
     }
@@ -183,12 +193,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// `gyrodrift report --calibration-data A --evaluation-data B`: fit on A, judge on B.
 fn run_separate(args: &Args, evaluation: &Path, options: &Options) -> anyhow::Result<()> {
     let input = &args.input;
-    let provenance = vec![format!(
+    let mut provenance = vec![format!(
         "Calibration data: `{}` (calibration {:?} °C); evaluation data: `{}` (every activation of the fitted units; none reaches a fit).",
         input.source().display(),
         options.calibration_set_points,
         evaluation.display()
     )];
+    provenance.extend(drift_report::ambient_provenance(options));
     let staged = super::interrupt::stage(&args.out, args.force, &WRITER)?;
     let steps = Steps::new(input.quiet);
     let calibration = pipeline::recording_files(input.source())?;

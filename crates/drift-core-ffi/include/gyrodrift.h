@@ -89,6 +89,9 @@ typedef enum gyrodrift_status {
   GYRODRIFT_STATUS_INVALID = -11,
   // `gyrodrift_power_on`: a switch-on temperature is not finite (the state is unchanged).
   GYRODRIFT_STATUS_BAD_SWITCH_ON = -12,
+  // `gyrodrift_power_on_at_ambient`: the measured ambient is not finite (the state is
+  // unchanged).
+  GYRODRIFT_STATUS_BAD_AMBIENT = -13,
 } gyrodrift_status;
 
 // One 3-axis sample, as drift-core's `Sample`.
@@ -189,6 +192,36 @@ enum gyrodrift_status gyrodrift_power_on_after(struct gyrodrift_context *ctx,
                                                struct gyrodrift_previous *previous,
                                                uint16_t *flags);
 
+// [`gyrodrift_power_on`] with the ambient the instrument measured at switch-on
+// (`ambient_celsius`, °C, one for the unit: an air or board thermistor): the paper's stage 2 and
+// initial bias are read there, not at the switch-on temperature; time since switch-on and the
+// rise as always. An ambient outside the calibration is flagged as a switch-on temperature is; a
+// non-finite one is refused (`GYRODRIFT_STATUS_BAD_AMBIENT`), the state unchanged. The same
+// per-sample cost as after [`gyrodrift_power_on`].
+//
+// # Safety
+//
+// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw` and `flags` (which
+// may be null).
+enum gyrodrift_status gyrodrift_power_on_at_ambient(struct gyrodrift_context *ctx,
+                                                    const float *switch_on_raw,
+                                                    float ambient_celsius,
+                                                    uint16_t *flags);
+
+// [`gyrodrift_power_on_at_ambient`] with what was kept of the previous activation (`previous`,
+// as for [`gyrodrift_power_on_after`]): the measured ambient replaces the estimate and is written
+// into `previous`.
+//
+// # Safety
+//
+// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw`, `previous` and
+// `flags` (which may be null).
+enum gyrodrift_status gyrodrift_power_on_after_at_ambient(struct gyrodrift_context *ctx,
+                                                          const float *switch_on_raw,
+                                                          float ambient_celsius,
+                                                          struct gyrodrift_previous *previous,
+                                                          uint16_t *flags);
+
 // Corrects one sample into `output`. Never fails on the sample's values: clamps, holds and
 // faults are in `output->flags`; before a power-on the rates pass through, flagged.
 //
@@ -254,6 +287,27 @@ enum gyrodrift_status gyrodrift_large_power_on_after(struct gyrodrift_large_cont
                                                      const float *switch_on_raw,
                                                      struct gyrodrift_previous *previous,
                                                      uint16_t *flags);
+
+// [`gyrodrift_power_on_at_ambient`] for the large profile (`gyrodrift_large_context`).
+//
+// # Safety
+//
+// As [`gyrodrift_power_on_at_ambient`].
+enum gyrodrift_status gyrodrift_large_power_on_at_ambient(struct gyrodrift_large_context *ctx,
+                                                          const float *switch_on_raw,
+                                                          float ambient_celsius,
+                                                          uint16_t *flags);
+
+// [`gyrodrift_power_on_after_at_ambient`] for the large profile (`gyrodrift_large_context`).
+//
+// # Safety
+//
+// As [`gyrodrift_power_on_after_at_ambient`].
+enum gyrodrift_status gyrodrift_large_power_on_after_at_ambient(struct gyrodrift_large_context *ctx,
+                                                                const float *switch_on_raw,
+                                                                float ambient_celsius,
+                                                                struct gyrodrift_previous *previous,
+                                                                uint16_t *flags);
 
 // [`gyrodrift_correct`] for the large profile (`gyrodrift_large_context`).
 //

@@ -104,6 +104,7 @@ unsafe fn power_on<const R: usize, const A: usize, const C: usize>(
     ctx: *mut Context<R, A, C>,
     switch_on_raw: *const f32,
     previous: Option<*mut GyrodriftPrevious>,
+    ambient_celsius: Option<f32>,
     flags: *mut u16,
 ) -> GyrodriftStatus {
     status((|| {
@@ -117,7 +118,7 @@ unsafe fn power_on<const R: usize, const A: usize, const C: usize>(
             None => None,
         };
         let mut theirs = kept.as_deref().map(|kept| kept.map(Previous::from));
-        let started = context.power_on(raw, theirs.as_mut());
+        let started = context.power_on(raw, theirs.as_mut(), ambient_celsius);
         if let (Some(kept), Some(theirs)) = (kept, theirs) {
             *kept = theirs.map(GyrodriftPrevious::from);
         }
@@ -253,7 +254,9 @@ pub unsafe extern "C" fn gyrodrift_power_on(
     flags: *mut u16,
 ) -> GyrodriftStatus {
     // SAFETY: the caller's conditions, passed on.
-    unsafe { power_on::<DEFAULT_R, DEFAULT_A, DEFAULT_C>(ctx.cast(), switch_on_raw, None, flags) }
+    unsafe {
+        power_on::<DEFAULT_R, DEFAULT_A, DEFAULT_C>(ctx.cast(), switch_on_raw, None, None, flags)
+    }
 }
 
 /// [`gyrodrift_power_on`] with what was kept of the previous activation (`previous`, three
@@ -278,6 +281,65 @@ pub unsafe extern "C" fn gyrodrift_power_on_after(
             ctx.cast(),
             switch_on_raw,
             Some(previous),
+            None,
+            flags,
+        )
+    }
+}
+
+/// [`gyrodrift_power_on`] with the ambient the instrument measured at switch-on
+/// (`ambient_celsius`, °C, one for the unit: an air or board thermistor): the paper's stage 2 and
+/// initial bias are read there, not at the switch-on temperature; time since switch-on and the
+/// rise as always. An ambient outside the calibration is flagged as a switch-on temperature is; a
+/// non-finite one is refused (`GYRODRIFT_STATUS_BAD_AMBIENT`), the state unchanged. The same
+/// per-sample cost as after [`gyrodrift_power_on`].
+///
+/// # Safety
+///
+/// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw` and `flags` (which
+/// may be null).
+#[no_mangle]
+pub unsafe extern "C" fn gyrodrift_power_on_at_ambient(
+    ctx: *mut GyrodriftContext,
+    switch_on_raw: *const f32,
+    ambient_celsius: f32,
+    flags: *mut u16,
+) -> GyrodriftStatus {
+    // SAFETY: the caller's conditions, passed on.
+    unsafe {
+        power_on::<DEFAULT_R, DEFAULT_A, DEFAULT_C>(
+            ctx.cast(),
+            switch_on_raw,
+            None,
+            Some(ambient_celsius),
+            flags,
+        )
+    }
+}
+
+/// [`gyrodrift_power_on_at_ambient`] with what was kept of the previous activation (`previous`,
+/// as for [`gyrodrift_power_on_after`]): the measured ambient replaces the estimate and is written
+/// into `previous`.
+///
+/// # Safety
+///
+/// The pointer conditions (gyrodrift.h's preamble) on `ctx`, `switch_on_raw`, `previous` and
+/// `flags` (which may be null).
+#[no_mangle]
+pub unsafe extern "C" fn gyrodrift_power_on_after_at_ambient(
+    ctx: *mut GyrodriftContext,
+    switch_on_raw: *const f32,
+    ambient_celsius: f32,
+    previous: *mut GyrodriftPrevious,
+    flags: *mut u16,
+) -> GyrodriftStatus {
+    // SAFETY: the caller's conditions, passed on.
+    unsafe {
+        power_on::<DEFAULT_R, DEFAULT_A, DEFAULT_C>(
+            ctx.cast(),
+            switch_on_raw,
+            Some(previous),
+            Some(ambient_celsius),
             flags,
         )
     }
@@ -375,7 +437,7 @@ pub unsafe extern "C" fn gyrodrift_large_power_on(
     flags: *mut u16,
 ) -> GyrodriftStatus {
     // SAFETY: the caller's conditions, passed on.
-    unsafe { power_on::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), switch_on_raw, None, flags) }
+    unsafe { power_on::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), switch_on_raw, None, None, flags) }
 }
 
 /// [`gyrodrift_power_on_after`] for the large profile (`gyrodrift_large_context`).
@@ -392,7 +454,62 @@ pub unsafe extern "C" fn gyrodrift_large_power_on_after(
 ) -> GyrodriftStatus {
     // SAFETY: the caller's conditions, passed on.
     unsafe {
-        power_on::<LARGE_R, LARGE_A, LARGE_C>(ctx.cast(), switch_on_raw, Some(previous), flags)
+        power_on::<LARGE_R, LARGE_A, LARGE_C>(
+            ctx.cast(),
+            switch_on_raw,
+            Some(previous),
+            None,
+            flags,
+        )
+    }
+}
+
+/// [`gyrodrift_power_on_at_ambient`] for the large profile (`gyrodrift_large_context`).
+///
+/// # Safety
+///
+/// As [`gyrodrift_power_on_at_ambient`].
+#[no_mangle]
+pub unsafe extern "C" fn gyrodrift_large_power_on_at_ambient(
+    ctx: *mut GyrodriftLargeContext,
+    switch_on_raw: *const f32,
+    ambient_celsius: f32,
+    flags: *mut u16,
+) -> GyrodriftStatus {
+    // SAFETY: the caller's conditions, passed on.
+    unsafe {
+        power_on::<LARGE_R, LARGE_A, LARGE_C>(
+            ctx.cast(),
+            switch_on_raw,
+            None,
+            Some(ambient_celsius),
+            flags,
+        )
+    }
+}
+
+/// [`gyrodrift_power_on_after_at_ambient`] for the large profile (`gyrodrift_large_context`).
+///
+/// # Safety
+///
+/// As [`gyrodrift_power_on_after_at_ambient`].
+#[no_mangle]
+pub unsafe extern "C" fn gyrodrift_large_power_on_after_at_ambient(
+    ctx: *mut GyrodriftLargeContext,
+    switch_on_raw: *const f32,
+    ambient_celsius: f32,
+    previous: *mut GyrodriftPrevious,
+    flags: *mut u16,
+) -> GyrodriftStatus {
+    // SAFETY: the caller's conditions, passed on.
+    unsafe {
+        power_on::<LARGE_R, LARGE_A, LARGE_C>(
+            ctx.cast(),
+            switch_on_raw,
+            Some(previous),
+            Some(ambient_celsius),
+            flags,
+        )
     }
 }
 

@@ -3,8 +3,8 @@
 
 use drift_core::blob::{self, decode_into, Kind};
 use drift_core::{
-    CorrectorState, Flags, ModifiedAxisState, ModifiedTables, Output, Previous, RecommendedTables,
-    Sample, AUX_INPUTS, AXES,
+    AxisModel, CorrectorState, Flags, Model, ModifiedAxisState, ModifiedTables, Output, Previous,
+    RecommendedTables, Sample, AUX_INPUTS, AXES,
 };
 
 use crate::status::GyrodriftStatus;
@@ -106,22 +106,29 @@ impl<const R: usize, const A: usize, const C: usize> Context<R, A, C> {
         }
     }
 
+    /// Starts an activation, after `previous` and at a measured `ambient_celsius` where given.
     pub(crate) fn power_on(
         &mut self,
         switch_on_raw: [f32; AXES],
         previous: Option<&mut [Previous; AXES]>,
+        ambient_celsius: Option<f32>,
     ) -> Result<[Flags; AXES], GyrodriftStatus> {
-        let started = match (&self.tables, previous) {
-            (Tables::Modified(tables), None) => self.state.power_on(tables, switch_on_raw),
-            (Tables::Recommended(tables), None) => self.state.power_on(tables, switch_on_raw),
-            (Tables::Modified(tables), Some(kept)) => {
-                self.state.power_on_after(tables, switch_on_raw, kept)
+        let state = &mut self.state;
+        let started = match &self.tables {
+            Tables::Modified(tables) => {
+                start(state, tables, switch_on_raw, previous, ambient_celsius)
             }
-            (Tables::Recommended(tables), Some(kept)) => {
-                self.state.power_on_after(tables, switch_on_raw, kept)
+            Tables::Recommended(tables) => {
+                start(state, tables, switch_on_raw, previous, ambient_celsius)
             }
         };
-        started.map_err(|_| GyrodriftStatus::BadSwitchOn)
+        started.map_err(|error| {
+            if error.field == "ambient_celsius" {
+                GyrodriftStatus::BadAmbient
+            } else {
+                GyrodriftStatus::BadSwitchOn
+            }
+        })
     }
 
     pub(crate) fn correct(&mut self, sample: &Sample, aux: Option<&[f32; AUX_INPUTS]>) -> Output {
@@ -146,5 +153,27 @@ impl<const R: usize, const A: usize, const C: usize> Context<R, A, C> {
 
     pub(crate) fn power_off(&mut self) {
         self.state.power_off();
+    }
+}
+
+/// One of the corrector's four switch-ons, by what is given.
+fn start<M>(
+    state: &mut CorrectorState<ModifiedAxisState>,
+    tables: &M,
+    switch_on_raw: [f32; AXES],
+    previous: Option<&mut [Previous; AXES]>,
+    ambient_celsius: Option<f32>,
+) -> Result<[Flags; AXES], drift_core::Error>
+where
+    M: Model,
+    M::Axis: AxisModel<State = ModifiedAxisState>,
+{
+    match (previous, ambient_celsius) {
+        (None, None) => state.power_on(tables, switch_on_raw),
+        (Some(kept), None) => state.power_on_after(tables, switch_on_raw, kept),
+        (None, Some(ambient)) => state.power_on_at_ambient(tables, switch_on_raw, ambient),
+        (Some(kept), Some(ambient)) => {
+            state.power_on_after_at_ambient(tables, switch_on_raw, ambient, kept)
+        }
     }
 }

@@ -35,6 +35,9 @@ pub enum GyrodriftStatus {
     Invalid = -11,
     /// `gyrodrift_power_on`: a switch-on temperature is not finite (the state is unchanged).
     BadSwitchOn = -12,
+    /// `gyrodrift_power_on_at_ambient`: the measured ambient is not finite (the state is
+    /// unchanged).
+    BadAmbient = -13,
 }
 
 impl From<BlobError> for GyrodriftStatus {

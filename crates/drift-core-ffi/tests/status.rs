@@ -178,3 +178,75 @@ fn the_large_profile_takes_the_same_images() {
     }
     assert!(out.corrected_dps[0].is_finite());
 }
+
+#[test]
+fn a_measured_ambient_starts_where_the_tables_read_it_and_a_bad_one_is_refused() {
+    let mut ctx = context();
+    let sample = GyrodriftSample {
+        since_power_on_ms: 20_000,
+        rate_dps: [0.5, 0.0, 0.0],
+        temperature_raw: [6700.0; 3],
+    };
+    let raw = [6600.0_f32; 3];
+    let mut flags = [0u16; 3];
+    let run = |start: &dyn Fn(&mut GyrodriftContext) -> GyrodriftStatus| {
+        let mut ctx = context();
+        assert_eq!(init(&mut ctx, &image("modified")), GyrodriftStatus::Ok);
+        assert_eq!(start(&mut ctx), GyrodriftStatus::Ok);
+        let mut out = GyrodriftOutput::default();
+        // SAFETY: valid pointers to a context, a sample and an output.
+        let status = unsafe { gyrodrift_correct(&mut *ctx, &sample, &mut out) };
+        assert_eq!(status, GyrodriftStatus::Ok);
+        out.bias_dps
+    };
+    let paper = run(&|ctx| {
+        // SAFETY: valid pointers to a context and three readings; null flags.
+        unsafe { gyrodrift_power_on(ctx, raw.as_ptr(), core::ptr::null_mut()) }
+    });
+    let at = |ambient: f32| {
+        move |ctx: &mut GyrodriftContext| {
+            // SAFETY: valid pointers to a context and three readings; null flags.
+            unsafe {
+                gyrodrift_power_on_at_ambient(ctx, raw.as_ptr(), ambient, core::ptr::null_mut())
+            }
+        }
+    };
+    // The switch-on temperature of 6600 raw units: a start at that ambient is the paper's.
+    let celsius = drift_core::Settings::default().celsius(raw[0]);
+    assert_eq!(run(&at(celsius)), paper, "at {celsius} °C");
+    assert_ne!(run(&at(celsius - 3.0)), paper);
+    assert_eq!(init(&mut ctx, &image("modified")), GyrodriftStatus::Ok);
+    let mut previous = [GyrodriftPrevious {
+        ambient_celsius: f32::NAN,
+        switch_off_celsius: f32::NAN,
+    }; 3];
+    // SAFETY: valid pointers to a context, three readings, three kept entries and three flags.
+    unsafe {
+        assert_eq!(
+            gyrodrift_power_on_at_ambient(&mut *ctx, raw.as_ptr(), f32::NAN, flags.as_mut_ptr()),
+            GyrodriftStatus::BadAmbient
+        );
+        assert_eq!(
+            gyrodrift_power_on_after_at_ambient(
+                &mut *ctx,
+                raw.as_ptr(),
+                f32::INFINITY,
+                previous.as_mut_ptr(),
+                flags.as_mut_ptr()
+            ),
+            GyrodriftStatus::BadAmbient
+        );
+        assert!(previous[0].ambient_celsius.is_nan(), "previous unchanged");
+        assert_eq!(
+            gyrodrift_power_on_after_at_ambient(
+                &mut *ctx,
+                raw.as_ptr(),
+                29.0,
+                previous.as_mut_ptr(),
+                flags.as_mut_ptr()
+            ),
+            GyrodriftStatus::Ok
+        );
+        assert_eq!(previous[0].ambient_celsius, 29.0);
+    }
+}

@@ -196,7 +196,41 @@ impl<S: Copy + Default> CorrectorState<S> {
         M: Model,
         M::Axis: AxisModel<State = S>,
     {
-        self.start(model, switch_on_raw, None, &mut [f32::NAN; AXES])
+        self.start(model, switch_on_raw, None, None, &mut [f32::NAN; AXES])
+    }
+
+    /// [`Self::power_on`] with the ambient the instrument measured at switch-on (an air or board
+    /// thermistor), °C, one for the unit: the paper's stage 2 and initial bias are read there
+    /// rather than at each axis's switch-on temperature, which residual heat after a short
+    /// off-time and a changing ambient move away from it. Time since switch-on and the rise
+    /// (stage 3) are read as always; a table keyed by history reads the residual heat as the
+    /// switch-on temperature's height above the ambient ([`SwitchOn::measured`]: a known start).
+    /// An ambient outside the calibrated range is flagged `AMBIENT_OUT_OF_RANGE`, as a
+    /// switch-on temperature is. Models that read no ambient (the polynomials) start as
+    /// [`Self::power_on`] does, with the measured start.
+    ///
+    /// With the ambient equal to the switch-on temperature on every axis, the activation is the
+    /// one [`Self::power_on_after`] starts after [`Previous::COOLED`], bit for bit. A non-finite
+    /// `ambient_celsius` or reading is rejected, naming it, and the state is left unchanged.
+    ///
+    /// Runs once per switch-on: the per-sample path is the same as after [`Self::power_on`].
+    pub fn power_on_at_ambient<M>(
+        &mut self,
+        model: &M,
+        switch_on_raw: [f32; AXES],
+        ambient_celsius: f32,
+    ) -> Result<[Flags; AXES], Error>
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        self.start(
+            model,
+            switch_on_raw,
+            None,
+            Some(ambient_celsius),
+            &mut [f32::NAN; AXES],
+        )
     }
 
     /// [`Self::power_on`] with what firmware kept of the previous activation across power-off
@@ -214,8 +248,48 @@ impl<S: Copy + Default> CorrectorState<S> {
         M: Model,
         M::Axis: AxisModel<State = S>,
     {
+        self.start_after(model, switch_on_raw, None, previous)
+    }
+
+    /// [`Self::power_on_at_ambient`] with what firmware kept of the previous activation
+    /// (`previous`, as for [`Self::power_on_after`]): the measured ambient replaces the estimate,
+    /// and what was kept tells how far the cooling had gone ([`SwitchOn::measured`]). Writes the
+    /// measured ambient into `previous` and clears its switch-off temperature, which
+    /// [`Self::keep`] then records. A non-finite `ambient_celsius` or reading is rejected, naming
+    /// it, and neither the state nor `previous` is changed.
+    pub fn power_on_after_at_ambient<M>(
+        &mut self,
+        model: &M,
+        switch_on_raw: [f32; AXES],
+        ambient_celsius: f32,
+        previous: &mut [Previous; AXES],
+    ) -> Result<[Flags; AXES], Error>
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
+        self.start_after(model, switch_on_raw, Some(ambient_celsius), previous)
+    }
+
+    fn start_after<M>(
+        &mut self,
+        model: &M,
+        switch_on_raw: [f32; AXES],
+        ambient_celsius: Option<f32>,
+        previous: &mut [Previous; AXES],
+    ) -> Result<[Flags; AXES], Error>
+    where
+        M: Model,
+        M::Axis: AxisModel<State = S>,
+    {
         let mut ambients = [f32::NAN; AXES];
-        let flags = self.start(model, switch_on_raw, Some(previous), &mut ambients)?;
+        let flags = self.start(
+            model,
+            switch_on_raw,
+            Some(previous),
+            ambient_celsius,
+            &mut ambients,
+        )?;
         for (kept, ambient_celsius) in previous.iter_mut().zip(ambients) {
             *kept = Previous {
                 ambient_celsius,
@@ -246,6 +320,7 @@ impl<S: Copy + Default> CorrectorState<S> {
         model: &M,
         switch_on_raw: [f32; AXES],
         previous: Option<&[Previous; AXES]>,
+        measured_ambient: Option<f32>,
         ambients: &mut [f32; AXES],
     ) -> Result<[Flags; AXES], Error>
     where
@@ -256,6 +331,13 @@ impl<S: Copy + Default> CorrectorState<S> {
             return Err(Error::new(
                 "switch_on_raw",
                 Location::axis(axis),
+                Problem::NonFinite,
+            ));
+        }
+        if measured_ambient.is_some_and(|celsius| !celsius.is_finite()) {
+            return Err(Error::new(
+                "ambient_celsius",
+                Location::default(),
                 Problem::NonFinite,
             ));
         }
@@ -271,10 +353,12 @@ impl<S: Copy + Default> CorrectorState<S> {
             .zip(&mut switch_ons)
             .enumerate()
         {
-            *switch_on = SwitchOn::estimate(
-                settings.celsius(raw),
-                previous.and_then(|p| p.get(a)).copied(),
-            );
+            let celsius = settings.celsius(raw);
+            let kept = previous.and_then(|p| p.get(a)).copied();
+            *switch_on = match measured_ambient {
+                Some(ambient) => SwitchOn::measured(celsius, ambient, kept),
+                None => SwitchOn::estimate(celsius, kept),
+            };
             if let Some(ambient) = ambients.get_mut(a) {
                 *ambient = switch_on.ambient_celsius;
             }
@@ -283,8 +367,11 @@ impl<S: Copy + Default> CorrectorState<S> {
                 last_raw: raw,
                 ..AxisState::default()
             };
-            let (initial_bias, mut activation) =
-                axis.power_on_after(settings, switch_on, &mut state.model);
+            let (initial_bias, mut activation) = if measured_ambient.is_some() {
+                axis.power_on_at_ambient(settings, switch_on, &mut state.model)
+            } else {
+                axis.power_on_after(settings, switch_on, &mut state.model)
+            };
             if plausible(initial_bias) {
                 state.initial_bias_dps = initial_bias;
             } else {
@@ -802,6 +889,27 @@ impl<'a, M: Model> Corrector<'a, M> {
     ) -> Result<[Flags; AXES], Error> {
         self.state
             .power_on_after(self.model, switch_on_raw, previous)
+    }
+
+    /// See [`CorrectorState::power_on_at_ambient`].
+    pub fn power_on_at_ambient(
+        &mut self,
+        switch_on_raw: [f32; AXES],
+        ambient_celsius: f32,
+    ) -> Result<[Flags; AXES], Error> {
+        self.state
+            .power_on_at_ambient(self.model, switch_on_raw, ambient_celsius)
+    }
+
+    /// See [`CorrectorState::power_on_after_at_ambient`].
+    pub fn power_on_after_at_ambient(
+        &mut self,
+        switch_on_raw: [f32; AXES],
+        ambient_celsius: f32,
+        previous: &mut [Previous; AXES],
+    ) -> Result<[Flags; AXES], Error> {
+        self.state
+            .power_on_after_at_ambient(self.model, switch_on_raw, ambient_celsius, previous)
     }
 
     /// See [`CorrectorState::keep`].

@@ -107,6 +107,43 @@ impl SwitchOn {
     }
 }
 
+impl SwitchOn {
+    /// The start with an ambient the instrument measured at switch-on (an air or board
+    /// thermistor), °C, instead of one estimated: no residual heat is read into it or out of it.
+    /// The residual heat is how far the switch-on temperature stands above it (0 at or below it),
+    /// and the start is known. `remaining` is that heat as a fraction of the heat the unit had at
+    /// the previous switch-off over the same ambient, where that was kept (0 otherwise).
+    ///
+    /// Total: an ambient that is not a number gives [`Self::estimate`]'s start (the corrector
+    /// refuses one before it gets here).
+    pub fn measured(
+        switch_on_celsius: f32,
+        ambient_celsius: f32,
+        previous: Option<Previous>,
+    ) -> Self {
+        if ambient_celsius.is_nan() {
+            return Self::estimate(switch_on_celsius, previous);
+        }
+        let above = switch_on_celsius - ambient_celsius;
+        let residual_heat_celsius = if above > 0.0 { above } else { 0.0 };
+        let at_switch_off = previous.map_or(f32::NAN, |p| p.switch_off_celsius - ambient_celsius);
+        let remaining = residual_heat_celsius / at_switch_off;
+        Self {
+            switch_on_celsius,
+            ambient_celsius,
+            residual_heat_celsius,
+            // NaN (nothing kept), infinite or negative (a cooled mark, an ambient above the
+            // switch-off) all say nothing of the cooling: 0, as for a cold start.
+            remaining: if remaining.is_finite() && at_switch_off > 0.0 {
+                remaining.clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+            known: true,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -161,6 +198,50 @@ mod tests {
         assert_eq!(
             (s.ambient_celsius, s.residual_heat_celsius, s.known),
             (36.0, 0.0, true)
+        );
+    }
+
+    #[test]
+    fn a_measured_ambient_is_taken_as_it_is() {
+        // After a short off-time: the residual heat is what stands above the air, whatever was
+        // kept, and the start is known.
+        let s = SwitchOn::measured(32.0, 29.0, None);
+        assert_eq!(
+            (
+                s.ambient_celsius,
+                s.residual_heat_celsius,
+                s.remaining,
+                s.known
+            ),
+            (29.0, 3.0, 0.0, true)
+        );
+        // Kept: 3 of the 6 °C it had at switch-off over that air.
+        let s = SwitchOn::measured(32.0, 29.0, previous(30.0, 35.0));
+        assert_eq!(s.remaining, 0.5);
+        // Colder than the air (it lags a rising ambient): no residual heat.
+        let s = SwitchOn::measured(28.0, 29.0, previous(30.0, 35.0));
+        assert_eq!((s.residual_heat_celsius, s.remaining), (0.0, 0.0));
+        // The cooled mark says nothing of the cooling's progress.
+        let s = SwitchOn::measured(32.0, 29.0, Some(Previous::COOLED[0]));
+        assert_eq!((s.residual_heat_celsius, s.remaining), (3.0, 0.0));
+    }
+
+    #[test]
+    fn a_measured_ambient_at_the_switch_on_is_a_known_cold_start() {
+        for kept in [None, previous(30.0, 35.0), Some(Previous::COOLED[0])] {
+            assert_eq!(
+                SwitchOn::measured(31.0, 31.0, kept),
+                SwitchOn::estimate(31.0, Some(Previous::COOLED[0]))
+            );
+        }
+    }
+
+    #[test]
+    fn a_measured_ambient_that_is_not_a_number_is_the_estimate() {
+        let kept = previous(30.0, 35.0);
+        assert_eq!(
+            SwitchOn::measured(32.0, f32::NAN, kept),
+            SwitchOn::estimate(32.0, kept)
         );
     }
 }

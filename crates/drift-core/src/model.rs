@@ -45,6 +45,20 @@ pub trait AxisModel {
         self.power_on(settings, switch_on.switch_on_celsius, state)
     }
 
+    /// [`Self::power_on_after`] with an ambient the instrument measured at switch-on
+    /// (`switch_on` from [`SwitchOn::measured`]): a model that reads anything at the ambient (the
+    /// paper's stage 2 and initial bias) reads it at `switch_on.ambient_celsius`, not at the
+    /// switch-on temperature. Models that read no ambient (the default) take it as
+    /// [`Self::power_on_after`] does.
+    fn power_on_at_ambient(
+        &self,
+        settings: &Settings,
+        switch_on: &SwitchOn,
+        state: &mut Self::State,
+    ) -> (f32, Flags) {
+        self.power_on_after(settings, switch_on, state)
+    }
+
     /// The drift since switch-on (°/s, excluding the initial bias) at `since_power_on_ms`, for the
     /// current temperature (°C) and its rise since switch-on (°C), with envelope flags.
     /// May return a non-finite value only for corrupt tables; the corrector then holds and flags.

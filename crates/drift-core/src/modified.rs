@@ -162,6 +162,43 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
         switch_on: &SwitchOn,
         state: &mut Self::State,
     ) -> (f32, Flags) {
+        self.start(settings, switch_on, switch_on.switch_on_celsius, state)
+    }
+
+    fn power_on_at_ambient(
+        &self,
+        settings: &Settings,
+        switch_on: &SwitchOn,
+        state: &mut Self::State,
+    ) -> (f32, Flags) {
+        self.start(settings, switch_on, switch_on.ambient_celsius, state)
+    }
+
+    #[inline(always)]
+    fn drift(
+        &self,
+        settings: &Settings,
+        state: &mut Self::State,
+        since_power_on_ms: u32,
+        _temperature_celsius: f32,
+        rise_celsius: f32,
+    ) -> (f32, Flags) {
+        let (k, flags) = self.correlation(settings, state, since_power_on_ms, rise_celsius);
+        (k * rise_celsius, flags)
+    }
+}
+
+impl<const R: usize, const A: usize, const C: usize> AxisTable<R, A, C> {
+    /// The switch-on: stage 2's position, stage 3's history and the initial bias. `paper_celsius`
+    /// is where a table keyed by rise reads its ambient and the cold start's bias: the switch-on
+    /// temperature, as the paper does, or an ambient the instrument measured.
+    fn start(
+        &self,
+        settings: &Settings,
+        switch_on: &SwitchOn,
+        paper_celsius: f32,
+        state: &mut ModifiedAxisState,
+    ) -> (f32, Flags) {
         let by_history = self.keyed_by_history();
         let margin = settings.ambient_margin_celsius;
         let locate = |celsius| {
@@ -181,10 +218,7 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
             let history = self.locate_history(&ambient, heat, settings.rise_margin_celsius);
             (ambient, history)
         } else {
-            (
-                locate(switch_on.switch_on_celsius),
-                AmbientPosition::default(),
-            )
+            (locate(paper_celsius), AmbientPosition::default())
         };
         *state = ModifiedAxisState::new(&ambient);
         let mut flags = if ambient.out_of_range {
@@ -220,27 +254,15 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for AxisTable<R, 
             }
             return (self.initial_bias(&at_ambient, heat), flags);
         }
-        // The paper's: the cold start's bias at the switch-on temperature (a table keyed by rise
-        // located the ambient there already: one search per switch-on, not two).
-        let at_switch_on = if by_history {
-            locate(switch_on.switch_on_celsius)
+        // The paper's: the cold start's bias at the switch-on temperature or the measured
+        // ambient (a table keyed by rise located the ambient there already: one search per
+        // switch-on, not two).
+        let at_paper = if by_history {
+            locate(paper_celsius)
         } else {
             ambient
         };
-        (self.initial_bias(&at_switch_on, 0.0), flags)
-    }
-
-    #[inline(always)]
-    fn drift(
-        &self,
-        settings: &Settings,
-        state: &mut Self::State,
-        since_power_on_ms: u32,
-        _temperature_celsius: f32,
-        rise_celsius: f32,
-    ) -> (f32, Flags) {
-        let (k, flags) = self.correlation(settings, state, since_power_on_ms, rise_celsius);
-        (k * rise_celsius, flags)
+        (self.initial_bias(&at_paper, 0.0), flags)
     }
 }
 

@@ -148,6 +148,19 @@ impl<const R: usize, const A: usize, const C: usize> AxisModel for RecommendedAx
         (bias, table_flags | flags)
     }
 
+    /// The table places stage 2 at the measured ambient; the turn-on bias stays a function of the
+    /// switch-on temperature, with the measured residual heat.
+    fn power_on_at_ambient(
+        &self,
+        settings: &Settings,
+        switch_on: &SwitchOn,
+        state: &mut Self::State,
+    ) -> (f32, Flags) {
+        let (_, table_flags) = self.table.power_on_at_ambient(settings, switch_on, state);
+        let (bias, flags) = self.turn_on.bias(settings, switch_on);
+        (bias, table_flags | flags)
+    }
+
     #[inline(always)]
     fn drift(
         &self,

@@ -39,12 +39,13 @@ use crate::keying::Keying;
 use crate::permutation::{Level, Null, Scored};
 use crate::statistics::one_sided_mean_test;
 use crate::switch_on_rate::start_rates;
-use drift_evaluate::evaluate::{correct_segment_after, spread, switch_on_raw};
+use drift_evaluate::evaluate::{
+    correct_segment_after, correct_segment_at_ambient, spread, switch_on_raw,
+};
 use drift_fit::error::FitError;
 use drift_fit::fit::{reference_indices, FittedUnit};
 use drift_fit::lowpass::centred_moving_average;
 use drift_fit::settings::FitSettings;
-use drift_recording::TEMPERATURE_MISSING_RAW;
 
 /// Spacing of the diagnosis grid, ms: the residual and the candidates are 1-s means, so two
 /// points per window keep what least squares on them needs, at a fifth of a 10-Hz grid's cost.
@@ -256,43 +257,19 @@ impl Diagnoser {
     }
 }
 
-/// The paper's prediction with stage 2 read at the chamber air logged at switch-on (or the set
-/// point channel without one), less its prediction read at the switch-on temperature, per axis and
-/// sample, °/s; `None` without either. The temperatures are shifted so that the switch-on reads the air: the time since switch-on
-/// and the rise, the tables' other inputs, stay as they were.
-fn ambient_term(
+/// The paper's prediction with stage 2 and the initial bias read at the chamber air logged at
+/// switch-on (or the set point channel without one), less its prediction read at the switch-on
+/// temperature, per axis and sample, °/s; `None` without either. The air is given to drift-core's
+/// switch-on (`power_on_at_ambient`), the firmware option for an instrument that measures its
+/// ambient: the time since switch-on and the rise, the tables' other inputs, stay as they were.
+pub fn ambient_term(
     paper: &drift_core::ModifiedTables,
     segment: &Segment,
     switch_on: [f32; 3],
 ) -> Option<[Vec<f32>; 3]> {
-    // The chamber air where the bench logged it; otherwise the set point channel, which a field
-    // recording logs as the ambient it went through and a chamber holds to within its ripple.
-    let logged = segment
-        .aux
-        .get(AMBIENT_CHANNEL)
-        .or_else(|| segment.aux.get(SET_POINT_CHANNEL))?;
-    let air = f64::from(*logged.values.first()?);
-    if !air.is_finite() {
-        return None;
-    }
-    let core = paper.settings;
-    let shift: [f64; 3] = switch_on.map(|raw| {
-        let on = f64::from(core.celsius(raw));
-        ((on - air) * f64::from(core.raw_per_celsius)).round()
-    });
-    if shift.iter().any(|s| !s.is_finite()) {
-        return None;
-    }
-    let mut at_air = segment.clone();
-    for (raw, s) in at_air.temperature_raw.iter_mut().zip(shift) {
-        for r in raw.iter_mut().filter(|r| **r != TEMPERATURE_MISSING_RAW) {
-            let shifted = (f64::from(*r) - s).clamp(f64::from(i16::MIN + 1), f64::from(i16::MAX));
-            *r = shifted as i16;
-        }
-    }
-    let on_at_air: [f32; 3] = std::array::from_fn(|a| switch_on[a] - shift[a] as f32);
+    let air = logged_ambient(segment)?;
     let (paper_rates, _) = correct_segment_after(paper, segment, switch_on, None);
-    let (air_rates, _) = correct_segment_after(paper, &at_air, on_at_air, None);
+    let (air_rates, _) = correct_segment_at_ambient(paper, segment, switch_on, air, None);
     // Corrected = rate − prediction: the difference of the corrections is the difference of the
     // predictions, the other way round.
     Some(std::array::from_fn(|a| {
@@ -302,6 +279,17 @@ fn ambient_term(
             .map(|(p, q)| p - q)
             .collect()
     }))
+}
+
+/// The ambient the bench logged at `segment`'s switch-on, °C: the chamber air where it was
+/// logged; otherwise the set point channel, which a field recording logs as the ambient it went
+/// through and a chamber holds to within its ripple. `None` without either, or not finite.
+pub fn logged_ambient(segment: &Segment) -> Option<f32> {
+    let logged = segment
+        .aux
+        .get(AMBIENT_CHANNEL)
+        .or_else(|| segment.aux.get(SET_POINT_CHANNEL))?;
+    logged.values.first().copied().filter(|air| air.is_finite())
 }
 
 /// One quantity per axis and sample.

@@ -36,6 +36,11 @@ pub enum ModelKind {
     /// The recommended model: the paper's drift after switch-on with the turn-on bias fitted on
     /// every calibration activation, fed what firmware would have kept of the previous activation.
     Recommended,
+    /// The paper's modified method started at the ambient the instrument measured at switch-on
+    /// (a logged channel, `drift_core`'s `power_on_at_ambient`): stage 2 and the initial bias read
+    /// there, not at the switch-on temperature. Evaluated only where that channel is named
+    /// ([`evaluate_at`]); not in [`ModelKind::ALL`].
+    AtAmbient,
 }
 
 impl ModelKind {
@@ -71,6 +76,7 @@ impl ModelKind {
             Self::Modified => "modified",
             Self::ByHistory => "by-history",
             Self::Recommended => "recommended",
+            Self::AtAmbient => "modified-at-ambient",
         }
     }
 }
@@ -299,12 +305,46 @@ pub fn correct_segment_after<M: Model>(
     (corrected, flags)
 }
 
+/// [`correct_segment_after`] started at the ambient the instrument measured at switch-on
+/// (`power_on_at_ambient`, or `power_on_after_at_ambient` when `previous` is given): the paper's
+/// stage 2 and initial bias read there, not at the switch-on temperature.
+pub fn correct_segment_at_ambient<M: Model>(
+    model: &M,
+    segment: &Segment,
+    switch_on: [f32; 3],
+    ambient_celsius: f32,
+    previous: Option<&[Previous; 3]>,
+) -> ([Vec<f32>; 3], [u16; 3]) {
+    let (corrected, flags, _) = correct_started(
+        model,
+        segment,
+        switch_on,
+        previous,
+        Some(ambient_celsius),
+        drift_core::Flags::NONE,
+    );
+    (corrected, flags)
+}
+
 /// [`correct_segment_after`] that also counts, per axis, the samples any of `counted` flags.
 pub fn correct_segment_counting<M: Model>(
     model: &M,
     segment: &Segment,
     switch_on: [f32; 3],
     previous: Option<&[Previous; 3]>,
+    counted: drift_core::Flags,
+) -> ([Vec<f32>; 3], [u16; 3], [usize; 3]) {
+    correct_started(model, segment, switch_on, previous, None, counted)
+}
+
+/// One activation through the corrector, started with `previous` and at `ambient_celsius` where
+/// they are given, counting the samples any of `counted` flags.
+fn correct_started<M: Model>(
+    model: &M,
+    segment: &Segment,
+    switch_on: [f32; 3],
+    previous: Option<&[Previous; 3]>,
+    ambient_celsius: Option<f32>,
     counted: drift_core::Flags,
 ) -> ([Vec<f32>; 3], [u16; 3], [usize; 3]) {
     let n = segment.len();
@@ -322,9 +362,13 @@ pub fn correct_segment_counting<M: Model>(
             count,
         );
     };
-    let started = match previous {
-        Some(previous) => corrector.power_on_after(switch_on, &mut previous.clone()),
-        None => corrector.power_on(switch_on),
+    let started = match (previous, ambient_celsius) {
+        (Some(previous), None) => corrector.power_on_after(switch_on, &mut previous.clone()),
+        (None, None) => corrector.power_on(switch_on),
+        (Some(previous), Some(ambient)) => {
+            corrector.power_on_after_at_ambient(switch_on, ambient, &mut previous.clone())
+        }
+        (None, Some(ambient)) => corrector.power_on_at_ambient(switch_on, ambient),
     };
     if started.is_err() {
         return (
@@ -426,10 +470,25 @@ pub fn evaluate_after(
     settings: &FitSettings,
     previous: &[Previous; 3],
 ) -> ActivationResult {
+    evaluate_at(fitted, segment, settings, previous, None)
+}
+
+/// [`evaluate_after`], and with `ambient_celsius` (the ambient the instrument measured at
+/// switch-on, °C) also the paper's tables started there ([`ModelKind::AtAmbient`], after every
+/// model of [`ModelKind::ALL`]).
+pub fn evaluate_at(
+    fitted: &FittedUnit,
+    segment: &Segment,
+    settings: &FitSettings,
+    previous: &[Previous; 3],
+    ambient_celsius: Option<f32>,
+) -> ActivationResult {
     let window = settings.lowpass_window(segment.sample_rate_hz);
     let switch_on = switch_on_raw(segment, settings);
+    let at_ambient = ambient_celsius.map(|_| ModelKind::AtAmbient);
     let models = ModelKind::ALL
         .iter()
+        .chain(&at_ambient)
         .map(|&model| {
             let (rates, flags) = match model {
                 ModelKind::Uncorrected => (segment.rate_dps.clone(), [0; 3]),
@@ -446,6 +505,13 @@ pub fn evaluate_after(
                 ModelKind::Recommended => {
                     correct_segment_after(&fitted.recommended, segment, switch_on, Some(previous))
                 }
+                ModelKind::AtAmbient => correct_segment_at_ambient(
+                    &fitted.modified,
+                    segment,
+                    switch_on,
+                    ambient_celsius.unwrap_or(f32::NAN),
+                    None,
+                ),
             };
             let (drift_dps, residual_rms_dps) = metric(&rates, window);
             ModelResult {

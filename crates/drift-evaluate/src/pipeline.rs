@@ -20,7 +20,7 @@ use drift_recording::{
 use rayon::prelude::*;
 
 use crate::coverage::{self, UnitCoverage};
-use crate::evaluate::{evaluate_after, kept_before, ActivationResult};
+use crate::evaluate::{evaluate_at, kept_before, ActivationResult};
 use crate::summary::Split;
 use crate::uncertainty::{self, Residuals, UnitUncertainty};
 use drift_fit::analyse::{analyse, Analysed};
@@ -125,6 +125,19 @@ pub enum PipelineError {
         /// The tables' raw reading at 0 °C.
         tables_at_zero: f32,
     },
+    /// An activation to evaluate lacks the channel named for the ambient at switch-on, or has no
+    /// finite value of it there.
+    #[error("{path}: {activation}: no finite `{channel}` value at switch-on, which --switch-on-ambient reads as the ambient (channels logged: {found}); name a channel every evaluated recording logs")]
+    NoSwitchOnAmbient {
+        /// The recording.
+        path: PathBuf,
+        /// The activation: unit, nominal set point, series kind, series and index.
+        activation: String,
+        /// The channel named.
+        channel: String,
+        /// The auxiliary channels it has, comma-separated, or `none`.
+        found: String,
+    },
     /// None of the recordings has protocol activations at the calibration set points.
     #[error("no protocol activations at the calibration set points {set_points:?} °C in {files} recordings")]
     NoCalibration {
@@ -165,6 +178,10 @@ pub struct Options {
     pub held_out_repeats: bool,
     /// Run the evaluation pass at all (`false`: fit only; nothing else is read).
     pub evaluate: bool,
+    /// A logged channel that holds the ambient the instrument measured, read at each evaluated
+    /// activation's switch-on: the paper's tables are also evaluated started there
+    /// ([`crate::evaluate::ModelKind::AtAmbient`]). Every evaluated activation must log it.
+    pub switch_on_ambient: Option<String>,
 }
 
 impl Default for Options {
@@ -177,6 +194,7 @@ impl Default for Options {
             fit: FitSettings::default(),
             held_out_repeats: true,
             evaluate: true,
+            switch_on_ambient: None,
         }
     }
 }
@@ -324,16 +342,23 @@ pub fn run_separate(
     let started = Instant::now();
     let mut evaluated_units = BTreeSet::new();
     let fitted = &outcome.fitted;
-    let results = evaluate_files(evaluation, &options.fit, progress, |unit, segment| {
-        evaluated_units.insert(unit.to_owned());
-        let model = fitted.iter().find(|f| f.unit_id == unit)?;
-        let split = if segment.labels.series_kind == SeriesKind::Field {
-            Split::Field
-        } else {
-            Split::Validation
-        };
-        Some((split, model))
-    })?;
+    let ambient = options.switch_on_ambient.as_deref();
+    let results = evaluate_files(
+        evaluation,
+        &options.fit,
+        ambient,
+        progress,
+        |unit, segment| {
+            evaluated_units.insert(unit.to_owned());
+            let model = fitted.iter().find(|f| f.unit_id == unit)?;
+            let split = if segment.labels.series_kind == SeriesKind::Field {
+                Split::Field
+            } else {
+                Split::Validation
+            };
+            Some((split, model))
+        },
+    )?;
     if results.is_empty() && !evaluated_units.is_empty() {
         return Err(PipelineError::NoFittedUnit {
             evaluated: evaluated_units.into_iter().collect::<Vec<_>>().join(", "),
@@ -387,18 +412,25 @@ fn add_noise_floor(
     };
     let started = Instant::now();
     let mut missing = None;
-    let results = evaluate_files(noise_files, &options.fit, progress, |unit, segment| {
-        let model = noise
-            .fitted
-            .iter()
-            .chain(&outcome.fitted)
-            .find(|f| f.unit_id == unit);
-        if model.is_none() {
-            missing.get_or_insert_with(|| unit.to_owned());
-        }
-        is_one_of(segment.labels.nominal_set_point_celsius(), set_points)
-            .then_some((Split::NoiseFloor, model?))
-    })?;
+    let ambient = options.switch_on_ambient.as_deref();
+    let results = evaluate_files(
+        noise_files,
+        &options.fit,
+        ambient,
+        progress,
+        |unit, segment| {
+            let model = noise
+                .fitted
+                .iter()
+                .chain(&outcome.fitted)
+                .find(|f| f.unit_id == unit);
+            if model.is_none() {
+                missing.get_or_insert_with(|| unit.to_owned());
+            }
+            is_one_of(segment.labels.nominal_set_point_celsius(), set_points)
+                .then_some((Split::NoiseFloor, model?))
+        },
+    )?;
     if let Some(unit) = missing {
         return Err(PipelineError::NoiseFloorUnfitted {
             unit,
@@ -431,6 +463,7 @@ fn add_noise_floor(
 fn evaluate_files<'a>(
     files: &[PathBuf],
     settings: &FitSettings,
+    ambient_channel: Option<&str>,
     progress: Progress<'_>,
     mut choose: impl FnMut(&str, &Segment) -> Option<(Split, &'a FittedUnit)>,
 ) -> Result<Vec<(Split, ActivationResult)>, PipelineError> {
@@ -453,9 +486,18 @@ fn evaluate_files<'a>(
         else {
             continue;
         };
+        let mut ambients = Vec::with_capacity(chosen.len());
         for (segment, chosen) in recording.segments.iter().zip(&chosen) {
             if let Some((_, fitted)) = chosen {
                 same_scale(&recording, segment, fitted)?;
+                ambients.push(switch_on_ambient(
+                    path,
+                    &recording,
+                    segment,
+                    ambient_channel,
+                )?);
+            } else {
+                ambients.push(None);
             }
         }
         let segments: Vec<&Segment> = recording.segments.iter().collect();
@@ -464,16 +506,58 @@ fn evaluate_files<'a>(
             .segments
             .par_iter()
             .zip(kept.par_iter())
-            .zip(chosen.par_iter())
-            .filter_map(|((segment, previous), chosen)| {
+            .zip(chosen.par_iter().zip(ambients.par_iter()))
+            .filter_map(|((segment, previous), (chosen, &ambient))| {
                 let (split, model) = (*chosen)?;
-                Some((split, evaluate_after(model, segment, settings, previous)))
+                let result = evaluate_at(model, segment, settings, previous, ambient);
+                Some((split, result))
             })
             .collect();
         out.extend(results);
     }
     progress.check(EVALUATE_STEP, total, total)?;
     Ok(out)
+}
+
+/// The ambient `segment` (of the recording at `path`) logged on `channel` at switch-on, °C (its
+/// first value); `None` without a channel named, an error naming the activation without a finite
+/// value.
+fn switch_on_ambient(
+    path: &Path,
+    recording: &Recording,
+    segment: &Segment,
+    channel: Option<&str>,
+) -> Result<Option<f32>, PipelineError> {
+    let Some(channel) = channel else {
+        return Ok(None);
+    };
+    let value = segment
+        .aux
+        .get(channel)
+        .and_then(|c| c.values.first().copied())
+        .filter(|v| v.is_finite());
+    if let Some(value) = value {
+        return Ok(Some(value));
+    }
+    let labels = &segment.labels;
+    let found: Vec<&str> = segment.aux.keys().map(String::as_str).collect();
+    Err(PipelineError::NoSwitchOnAmbient {
+        path: path.to_path_buf(),
+        activation: format!(
+            "unit {}, set point {:+} °C, {} series {} activation {}",
+            recording.unit_id,
+            labels.nominal_set_point_celsius(),
+            labels.series_kind.as_str(),
+            labels.series,
+            labels.activation
+        ),
+        channel: channel.to_owned(),
+        found: if found.is_empty() {
+            "none".into()
+        } else {
+            found.join(", ")
+        },
+    })
 }
 
 /// Refuses `segment` (of `recording`) when its temperature scale is not the one `fitted`'s tables
@@ -923,41 +1007,56 @@ fn run_at(
         for segment in &recording.segments {
             same_scale(&recording, segment, fitted)?;
         }
+        let choose = |segment: &Segment| -> Option<(Split, &FittedUnit)> {
+            let labels = &segment.labels;
+            // The set point the activation belongs to: in a field session whose ambient
+            // ramps, the switch-on label is the ambient of the moment (31.7, 35.2 … in a
+            // +33 °C session), almost never a validation set point.
+            let validation = is_one_of(
+                labels.nominal_set_point_celsius(),
+                &options.validation_set_points,
+            );
+            let (split, model) = if noise_floor {
+                // The noise floor is measured where the other units are validated: every
+                // activation of the twin's sessions at a validation set point.
+                if !validation {
+                    return None;
+                }
+                (Split::NoiseFloor, fitted)
+            } else if labels.series_kind == SeriesKind::Field {
+                (Split::Field, fitted)
+            } else if validation {
+                (Split::Validation, fitted)
+            } else if calibration_segment(segment, options) {
+                (
+                    Split::HeldOutRepeat,
+                    held_out.get(&(recording.unit_id.clone(), labels.repeat))?,
+                )
+            } else {
+                return None;
+            };
+            Some((split, model))
+        };
+        let chosen: Vec<Option<(Split, &FittedUnit)>> =
+            recording.segments.iter().map(choose).collect();
+        let mut ambients = Vec::with_capacity(chosen.len());
+        for (segment, chosen) in recording.segments.iter().zip(&chosen) {
+            let channel = options
+                .switch_on_ambient
+                .as_deref()
+                .filter(|_| chosen.is_some());
+            ambients.push(switch_on_ambient(path, &recording, segment, channel)?);
+        }
         let segments: Vec<&Segment> = recording.segments.iter().collect();
         let kept = kept_before(&segments, settings, &fitted.by_history.settings, true);
         let results: Vec<Evaluated> = recording
             .segments
             .par_iter()
             .zip(kept.par_iter())
-            .filter_map(|(segment, previous)| {
-                let labels = &segment.labels;
-                // The set point the activation belongs to: in a field session whose ambient
-                // ramps, the switch-on label is the ambient of the moment (31.7, 35.2 … in a
-                // +33 °C session), almost never a validation set point.
-                let validation = is_one_of(
-                    labels.nominal_set_point_celsius(),
-                    &options.validation_set_points,
-                );
-                let (split, model) = if noise_floor {
-                    // The noise floor is measured where the other units are validated: every
-                    // activation of the twin's sessions at a validation set point.
-                    if !validation {
-                        return None;
-                    }
-                    (Split::NoiseFloor, fitted)
-                } else if labels.series_kind == SeriesKind::Field {
-                    (Split::Field, fitted)
-                } else if validation {
-                    (Split::Validation, fitted)
-                } else if calibration_segment(segment, options) {
-                    (
-                        Split::HeldOutRepeat,
-                        held_out.get(&(recording.unit_id.clone(), labels.repeat))?,
-                    )
-                } else {
-                    return None;
-                };
-                let result = evaluate_after(model, segment, settings, previous);
+            .zip(chosen.par_iter().zip(ambients.par_iter()))
+            .filter_map(|((segment, previous), (chosen, &ambient))| {
+                let (split, model) = (*chosen)?;
+                let result = evaluate_at(model, segment, settings, previous, ambient);
                 // σ(t) is fitted on the held-out repeats and checked on what no fit saw.
                 let residual = (split != Split::NoiseFloor).then(|| {
                     uncertainty::residuals(&model.recommended, segment, settings, previous)

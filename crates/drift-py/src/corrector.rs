@@ -159,26 +159,41 @@ fn correct_all<M, S>(
     }
 }
 
-impl Engine {
-    fn power_on(&mut self, raw: [f32; 3]) -> Result<[Flags; 3], drift_core::Error> {
-        match self {
-            Self::Modified(model, state) => state.power_on(&**model, raw),
-            Self::Polynomial(model, state) => state.power_on(&**model, raw),
-            Self::Relative(model, state) => state.power_on(&**model, raw),
-            Self::Recommended(model, state) => state.power_on(&**model, raw),
-        }
+/// One of the corrector's switch-ons, by what is given: what was kept, a measured ambient.
+fn start<M>(
+    state: &mut CorrectorState<<M::Axis as AxisModel>::State>,
+    model: &M,
+    raw: [f32; 3],
+    previous: Option<&mut [Previous; 3]>,
+    ambient_celsius: Option<f32>,
+) -> Result<[Flags; 3], drift_core::Error>
+where
+    M: Model,
+{
+    match (previous, ambient_celsius) {
+        (None, None) => state.power_on(model, raw),
+        (Some(kept), None) => state.power_on_after(model, raw, kept),
+        (None, Some(ambient)) => state.power_on_at_ambient(model, raw, ambient),
+        (Some(kept), Some(ambient)) => state.power_on_after_at_ambient(model, raw, ambient, kept),
     }
+}
 
-    fn power_on_after(
+impl Engine {
+    fn power_on(
         &mut self,
         raw: [f32; 3],
-        previous: &mut [Previous; 3],
+        previous: Option<&mut [Previous; 3]>,
+        ambient_celsius: Option<f32>,
     ) -> Result<[Flags; 3], drift_core::Error> {
         match self {
-            Self::Modified(model, state) => state.power_on_after(&**model, raw, previous),
-            Self::Polynomial(model, state) => state.power_on_after(&**model, raw, previous),
-            Self::Relative(model, state) => state.power_on_after(&**model, raw, previous),
-            Self::Recommended(model, state) => state.power_on_after(&**model, raw, previous),
+            Self::Modified(model, state) => start(state, &**model, raw, previous, ambient_celsius),
+            Self::Polynomial(model, state) => {
+                start(state, &**model, raw, previous, ambient_celsius)
+            }
+            Self::Relative(model, state) => start(state, &**model, raw, previous, ambient_celsius),
+            Self::Recommended(model, state) => {
+                start(state, &**model, raw, previous, ambient_celsius)
+            }
         }
     }
 
@@ -308,6 +323,18 @@ fn refuse_celsius(
     Ok(())
 }
 
+/// A refused switch-on's message: the input the corrector named.
+fn refused(raw: [f32; 3], ambient_celsius: Option<f32>, error: drift_core::Error) -> Error {
+    match ambient_celsius {
+        Some(ambient) if error.field == "ambient_celsius" => Error::Input(format!(
+            "`ambient_celsius` must be finite, got {ambient} ({error}); the state is unchanged"
+        )),
+        _ => Error::Input(format!(
+            "`switch_on_raw` must be finite on every axis, got {raw:?} ({error}); the state is unchanged"
+        )),
+    }
+}
+
 fn triple<T: Copy>(values: [T; 3]) -> (T, T, T) {
     let [x, y, z] = values;
     (x, y, z)
@@ -430,15 +457,20 @@ impl PyCorrector {
     }
 
     /// Starts an activation from the raw temperature readings at switch-on (X, Y, Z); returns the
-    /// flags that hold for the whole activation, per axis.
-    fn power_on(&mut self, switch_on_raw: &Bound<'_, PyAny>) -> Result<(u16, u16, u16), Error> {
+    /// flags that hold for the whole activation, per axis. With `ambient_celsius` (the ambient the
+    /// instrument measured, °C) the paper's stage 2 and initial bias are read there, not at the
+    /// switch-on temperature (drift-core's `power_on_at_ambient`).
+    #[pyo3(signature = (switch_on_raw, *, ambient_celsius = None))]
+    fn power_on(
+        &mut self,
+        switch_on_raw: &Bound<'_, PyAny>,
+        ambient_celsius: Option<f32>,
+    ) -> Result<(u16, u16, u16), Error> {
         let raw = args::per_axis("switch_on_raw", switch_on_raw)?;
         let mut trial = self.engine.clone();
-        let flags = trial.power_on(raw).map_err(|error| {
-            Error::Input(format!(
-                "`switch_on_raw` must be finite on every axis, got {raw:?} ({error}); the state is unchanged"
-            ))
-        })?;
+        let flags = trial
+            .power_on(raw, None, ambient_celsius)
+            .map_err(|error| refused(raw, ambient_celsius, error))?;
         refuse_celsius(raw, flags, trial.settings())?;
         self.engine = trial;
         Ok(triple(flags.map(|f| f.0)))
@@ -449,20 +481,22 @@ impl PyCorrector {
     /// history reads the activation's ambient and residual heat from it, other models ignore it.
     /// Returns the activation's flags and what to keep now (a new float32 `(3, 2)` array: this
     /// activation's ambient, switch-off NaN until `keep`); `previous` itself is not modified.
+    /// With `ambient_celsius`, as `power_on`'s: the measured ambient replaces the estimate and is
+    /// kept.
+    #[pyo3(signature = (switch_on_raw, previous, *, ambient_celsius = None))]
     fn power_on_after<'py>(
         &mut self,
         py: Python<'py>,
         switch_on_raw: &Bound<'py, PyAny>,
         previous: &Bound<'py, PyAny>,
+        ambient_celsius: Option<f32>,
     ) -> Result<Started<'py>, Error> {
         let raw = args::per_axis("switch_on_raw", switch_on_raw)?;
         let mut kept = previous_arg("previous", previous)?;
         let mut trial = self.engine.clone();
-        let flags = trial.power_on_after(raw, &mut kept).map_err(|error| {
-            Error::Input(format!(
-                "`switch_on_raw` must be finite on every axis, got {raw:?} ({error}); the state is unchanged"
-            ))
-        })?;
+        let flags = trial
+            .power_on(raw, Some(&mut kept), ambient_celsius)
+            .map_err(|error| refused(raw, ambient_celsius, error))?;
         refuse_celsius(raw, flags, trial.settings())?;
         self.engine = trial;
         Ok((triple(flags.map(|f| f.0)), previous_array(py, &kept)?))

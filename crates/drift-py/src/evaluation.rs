@@ -179,6 +179,7 @@ fn pipeline_inputs(
         fit: fit_settings::or_default(settings)?,
         held_out_repeats,
         evaluate: true,
+        switch_on_ambient: None,
     };
     Ok((files, noise_files, options))
 }

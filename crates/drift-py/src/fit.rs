@@ -104,6 +104,7 @@ pub fn fit_source(
                 fit: settings.clone(),
                 held_out_repeats: false,
                 evaluate: false,
+                switch_on_ambient: None,
             };
             interrupt::run(py, progress, |progress| {
                 pipeline::run(&files, &options, false, progress)

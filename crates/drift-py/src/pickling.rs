@@ -362,6 +362,7 @@ enum ModelKindDef {
     Modified,
     ByHistory,
     Recommended,
+    AtAmbient,
 }
 
 #[derive(Serialize, Deserialize)]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import gyrodrift
@@ -95,3 +96,26 @@ def test_corrector_exposes_its_model_and_state(models: dict[str, Model]) -> None
     out = corrector.correct(5, (0.25, 0.5, 1.0), (5400.0, 5400.0, 5400.0))
     assert out.corrected_dps == (0.25, 0.5, 1.0)
     assert all(f == gyrodrift.Flags.NOT_POWERED_ON for f in out.flags)
+
+
+def test_corrector_power_on_at_a_measured_ambient(modified: ModifiedTables) -> None:
+    raw = (6600.0, 6600.0, 6600.0)  # 33 °C
+    sample = (20_000, (0.5, 0.0, 0.0), (6700.0, 6700.0, 6700.0))
+
+    def bias(**start: float) -> tuple[float, float, float]:
+        corrector = gyrodrift.Corrector(modified)
+        corrector.power_on(raw, **start)
+        return corrector.correct(*sample).bias_dps
+
+    # At the switch-on temperature it is the paper's start; 3 °C of residual heat over the air
+    # moves stage 2 and the initial bias.
+    assert bias(ambient_celsius=33.0) == bias()
+    assert bias(ambient_celsius=30.0) != bias()
+    corrector = gyrodrift.Corrector(modified)
+    with pytest.raises(gyrodrift.InputError, match="`ambient_celsius` must be finite, got NaN"):
+        corrector.power_on(raw, ambient_celsius=float("nan"))
+    assert not corrector.is_powered_on
+    nothing = np.full((3, 2), np.nan, dtype=np.float32)
+    flags, kept = corrector.power_on_after(raw, nothing, ambient_celsius=30.0)
+    assert kept[:, 0].tolist() == [30.0, 30.0, 30.0]
+    assert flags == (0, 0, 0)

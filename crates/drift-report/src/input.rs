@@ -29,4 +29,7 @@ pub struct ReportInput<'a> {
     pub uncertainty: &'a [UnitUncertainty],
     /// The calibration's coverage map per unit (empty without a fit).
     pub coverage: &'a [UnitCoverage],
+    /// The channel the switch-on ambient was read from, where the paper's tables were also
+    /// evaluated started at it.
+    pub switch_on_ambient: Option<&'a str>,
 }

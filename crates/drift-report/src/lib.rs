@@ -3,6 +3,7 @@
 //! tables folder. `gyrodrift report`, `gyrodrift demo` and Python's `gyrodrift.report` all make it
 //! through [`make`], so the same inputs give the same bytes.
 
+mod at_ambient;
 mod coverage;
 pub mod diagnosis;
 mod evaluation_units;
@@ -95,6 +96,7 @@ fn write_outcome(
         timings: outcome.timings.clone(),
         uncertainty: &outcome.uncertainty,
         coverage: &outcome.coverage,
+        switch_on_ambient: options.switch_on_ambient.as_deref(),
     };
     let path = write_report(out, &input)?;
     Ok((path, outcome))
@@ -103,10 +105,21 @@ fn write_outcome(
 /// How the report's data were chosen, as its provenance line: the recordings as `source` names
 /// them, the calibration and validation set points.
 pub fn provenance(source: &str, options: &Options) -> Vec<String> {
-    vec![format!(
+    let mut lines = vec![format!(
         "Recordings: `{source}`; calibration {:?} °C, validation {:?} °C.",
         options.calibration_set_points, options.validation_set_points
-    )]
+    )];
+    lines.extend(ambient_provenance(options));
+    lines
+}
+
+/// The provenance line of a switch-on ambient read from a logged channel, if one was named.
+pub fn ambient_provenance(options: &Options) -> Option<String> {
+    options.switch_on_ambient.as_ref().map(|channel| {
+        format!(
+            "Switch-on ambient: the `{channel}` channel at each activation's switch-on; the paper's tables are also evaluated started there (*modified-at-ambient*)."
+        )
+    })
 }
 
 /// What a finished report says first, for printing: the headline table (Markdown), the
@@ -161,6 +174,11 @@ pub fn write_report(dir: &Path, input: &ReportInput<'_>) -> anyhow::Result<PathB
     md.push_str(&tables::field_table(&records, input.fitted));
     md.push_str(&tables::noise_floor(&records, input.noise_floor_units));
     md.push_str(&tables::residual_rms(&records, input.fitted));
+    md.push_str(&at_ambient::section(
+        &records,
+        input.switch_on_ambient,
+        input.noise_floor_units,
+    ));
     md.push_str(&tables::absolute_error(&cells));
     md.push_str(&uncertainty::section(input.uncertainty));
     md.push_str(&coverage::section(dir, input.coverage)?);

@@ -625,14 +625,19 @@ class Corrector:
     @property
     def initial_bias_dps(self) -> tuple[float, float, float]:
         """Initial (switch-on) bias located at the last switch-on, per axis, °/s."""
-    def power_on(self, switch_on_raw: _Floats3) -> tuple[int, int, int]:
+    def power_on(self, switch_on_raw: _Floats3, *, ambient_celsius: float | None = None) -> tuple[int, int, int]:
         """Starts an activation from the raw temperatures at switch-on (X, Y, Z).
 
         Returns the flags that hold for the whole activation, per axis. A NaN or infinite reading
-        raises `InputError` naming the axis, and the state is unchanged.
+        raises `InputError` naming the axis, and the state is unchanged. `ambient_celsius`: the
+        ambient the instrument measured at switch-on (an air or board thermistor), °C; the paper's
+        stage 2 and initial bias are then read there rather than at the switch-on temperature
+        (time since switch-on and the rise as always; AMBIENT_OUT_OF_RANGE outside the tables).
+        With it equal to the switch-on temperature the outputs are `power_on`'s. NaN or infinite
+        raises `InputError` naming `ambient_celsius`, and the state is unchanged.
         """
     def power_on_after(
-        self, switch_on_raw: _Floats3, previous: _Previous
+        self, switch_on_raw: _Floats3, previous: _Previous, *, ambient_celsius: float | None = None
     ) -> tuple[tuple[int, int, int], NDArray[np.float32]]:
         """`power_on` with what was kept of the previous activation across power-off.
 
@@ -644,7 +649,9 @@ class Corrector:
         new float32 (3, 2) array (this activation's ambient, switch-off NaN until `keep`).
         `previous` itself is not modified. A NaN or infinite `switch_on_raw` raises `InputError`
         and the state is unchanged; a wrong shape or dtype raises `InputError` (a `ValueError`)
-        naming `previous` and the shape expected.
+        naming `previous` and the shape expected. `ambient_celsius` as for `power_on`: the
+        measured ambient replaces the estimate (the residual heat is the switch-on temperature's
+        height above it) and is what is kept.
         """
     def keep(self, previous: _Previous) -> NDArray[np.float32]:
         """`previous` (as `power_on_after` returned it) with this activation's last good
