@@ -5,6 +5,7 @@ seconds, interrupted shortly after it starts (as Ctrl-C does: the interpreter's 
 from __future__ import annotations
 
 import _thread
+import signal
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -20,6 +21,10 @@ MANY = 2000
 
 def interrupted(call: Callable[[], Any], after_s: float = 0.3) -> None:
     """Runs `call`, sending the main thread SIGINT's KeyboardInterrupt `after_s` after it starts."""
+    # Python's own SIGINT handler, as in an interactive session: a process started in the
+    # background by a non-interactive shell (CI, nohup) inherits SIGINT ignored, and then
+    # `interrupt_main` does nothing.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(after_s, _thread.interrupt_main)
     timer.start()
     try:
@@ -28,6 +33,7 @@ def interrupted(call: Callable[[], Any], after_s: float = 0.3) -> None:
     finally:
         timer.cancel()
         timer.join()
+        signal.signal(signal.SIGINT, previous)
 
 
 @pytest.fixture(scope="module")
