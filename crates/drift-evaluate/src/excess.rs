@@ -25,10 +25,10 @@ pub fn excess_ratio(before: f64, after: f64, floor: f64) -> f64 {
 }
 
 /// [`excess_ratio`] for one bootstrap draw of a positive ratio, whose means can fall below the
-/// floor where the point figures are barely above it: a draw with no excess before has nothing to cut, so it counts as
-/// no change (1) when after has none either and as worse (0) when after has some. Without this, a
-/// numerator below zero over a denominator clamped to 1e-9 gave bounds like −8234× for a model that
-/// changed nothing.
+/// floor where the point figures are barely above it: a draw with no excess before has nothing to
+/// cut, so it counts as no change (1) when after has none either and as worse (0) when after has
+/// some. Without this, a numerator below zero over a denominator clamped to 1e-9 gave bounds like
+/// −8234× for a model that changed nothing.
 fn resampled_ratio(before: f64, after: f64, floor: f64) -> f64 {
     if before > floor {
         excess_ratio(before, after, floor)
