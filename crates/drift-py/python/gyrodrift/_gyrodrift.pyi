@@ -625,7 +625,9 @@ class Corrector:
     @property
     def initial_bias_dps(self) -> tuple[float, float, float]:
         """Initial (switch-on) bias located at the last switch-on, per axis, °/s."""
-    def power_on(self, switch_on_raw: _Floats3, *, ambient_celsius: float | None = None) -> tuple[int, int, int]:
+    def power_on(
+        self, switch_on_raw: _Floats3, *, ambient_celsius: float | None = None
+    ) -> tuple[int, int, int]:
         """Starts an activation from the raw temperatures at switch-on (X, Y, Z).
 
         Returns the flags that hold for the whole activation, per axis. A NaN or infinite reading
