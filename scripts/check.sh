@@ -75,7 +75,7 @@ python3 scripts/count-instructions.py --gate
 step "Python: drift-py in a fresh venv (pip install, pytest, stubtest, mypy, ruff, examples) and the mcap read test"
 ./scripts/check-python.sh
 
-step "main job: README's demo command"
-cargo run --release --locked -- demo --quiet
+step "main job: README's demo command (--force: a re-run replaces the earlier demo, so the script stays re-runnable)"
+cargo run --release --locked -- demo --quiet --force
 
 printf '\nAll checks passed.\n'
