@@ -285,11 +285,11 @@ pub fn ambient_term(
 /// logged; otherwise the set point channel, which a field recording logs as the ambient it went
 /// through and a chamber holds to within its ripple. `None` without either, or not finite.
 pub fn logged_ambient(segment: &Segment) -> Option<f32> {
-    let logged = segment
-        .aux
-        .get(AMBIENT_CHANNEL)
-        .or_else(|| segment.aux.get(SET_POINT_CHANNEL))?;
-    logged.values.first().copied().filter(|air| air.is_finite())
+    if segment.aux.contains_key(AMBIENT_CHANNEL) {
+        segment.aux_at_switch_on(AMBIENT_CHANNEL)
+    } else {
+        segment.aux_at_switch_on(SET_POINT_CHANNEL)
+    }
 }
 
 /// One quantity per axis and sample.

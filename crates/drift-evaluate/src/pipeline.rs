@@ -531,12 +531,7 @@ fn switch_on_ambient(
     let Some(channel) = channel else {
         return Ok(None);
     };
-    let value = segment
-        .aux
-        .get(channel)
-        .and_then(|c| c.values.first().copied())
-        .filter(|v| v.is_finite());
-    if let Some(value) = value {
+    if let Some(value) = segment.aux_at_switch_on(channel) {
         return Ok(Some(value));
     }
     let labels = &segment.labels;

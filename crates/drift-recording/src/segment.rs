@@ -205,6 +205,17 @@ pub struct Segment {
 }
 
 impl Segment {
+    /// The auxiliary channel `name`'s value at switch-on (its first), when it is logged and
+    /// finite: what a bench or an instrument read as the activation began.
+    pub fn aux_at_switch_on(&self, name: &str) -> Option<f32> {
+        self.aux
+            .get(name)?
+            .values
+            .first()
+            .copied()
+            .filter(|v| v.is_finite())
+    }
+
     /// Number of gyro samples.
     pub fn len(&self) -> usize {
         self.since_power_on.len()
