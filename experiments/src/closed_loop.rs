@@ -161,7 +161,10 @@ pub struct Row {
     pub axis: &'static str,
     /// The top candidate behind the paper's model: what it lacked (with ", significant" when so).
     pub paper_top: String,
-    /// The diagnosis's top candidate behind the loop's model: what is left.
+    /// The unit's own thermal response the diagnosis selected behind the loop's model.
+    pub thermal_response: Vec<String>,
+    /// The diagnosis's top effect behind the loop's model (the thermal response aside): what is
+    /// left.
     pub top: String,
     /// Whether it is significant.
     pub significant: bool,
@@ -571,7 +574,7 @@ pub fn run(
     Ok((0..3)
         .map(|a| {
             let axes = &closed.axes;
-            let top = axes[a].ranking.first();
+            let top = axes[a].ranking.iter().find(|c| !c.thermal_response);
             let paper_top = closed.paper_axes[a].ranking.first();
             Row {
                 paper_top: paper_top.map_or("–".into(), |c| {
@@ -584,6 +587,12 @@ pub fn run(
                 effect: effect.to_owned(),
                 seed,
                 axis: axes[a].axis,
+                thermal_response: axes[a]
+                    .selected
+                    .iter()
+                    .filter(|s| s.thermal_response)
+                    .map(|s| s.name.clone())
+                    .collect(),
                 top: top.map_or("–".into(), |c| c.name.clone()),
                 significant: top.is_some_and(|c| c.significant),
                 admitted: terms(axes[a].axis, true),

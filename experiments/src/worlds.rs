@@ -252,6 +252,11 @@ pub struct Ranked {
     pub family_p_value: f64,
     /// Out-of-sample share of the residual's variance it explains.
     pub explained: f64,
+    /// A term of the unit's own thermal response, fitted before any effect is sought
+    /// (`drift_diagnose::candidates::Kind::is_thermal_response`); every other candidate is an
+    /// effect.
+    #[serde(default)]
+    pub thermal_response: bool,
     /// One-sided p-value of the held-out improvement at its level.
     pub p_value: f64,
     /// The same on the whole residual.
@@ -267,7 +272,7 @@ pub struct Ranked {
 pub struct AxisOutcome {
     /// The best candidates behind the loop's model, best first.
     pub ranking: Vec<Ranked>,
-    /// Whether any candidate on the axis is significant.
+    /// Whether any effect on the axis is significant (the unit's own thermal response aside).
     pub any_significant: bool,
     /// The explained share a candidate had to exceed to be significant on this axis.
     pub detectable_share: f64,
@@ -355,9 +360,13 @@ pub fn close_blind(
                         whole_p_value: c.whole_p_value,
                         stable: c.stable,
                         coefficient: c.coefficient,
+                        thermal_response: c.thermal_response,
                     })
                     .collect(),
-                any_significant: diagnosis.ranking.iter().any(|c| c.significant),
+                any_significant: diagnosis
+                    .ranking
+                    .iter()
+                    .any(|c| c.significant && !c.thermal_response),
                 detectable_share: diagnosis.detectable_share,
                 admitted: closed
                     .extended
@@ -467,7 +476,8 @@ pub struct AxisScore {
     pub axis: &'static str,
     /// Whether the world's effect moves this axis.
     pub affected: bool,
-    /// The top candidate behind the loop's model ("–" when none).
+    /// The top effect behind the loop's model ("–" when none): the first candidate that is not
+    /// the unit's own thermal response.
     pub top: String,
     /// Whether it is significant.
     pub top_significant: bool,
@@ -475,8 +485,10 @@ pub struct AxisScore {
     pub right_family: bool,
     /// Whether a term naming the world's family was admitted on the axis.
     pub right_family_admitted: bool,
-    /// Whether anything on the axis is significant.
+    /// Whether any effect on the axis is significant.
     pub any_significant: bool,
+    /// The unit's own thermal response selected on the axis, in order.
+    pub thermal_response: Vec<String>,
     /// The explained share a candidate had to exceed to be significant on this axis.
     pub detectable_share: f64,
     /// Terms admitted on the axis.
@@ -565,7 +577,7 @@ pub fn score(
         .iter()
         .enumerate()
         .map(|(a, o)| {
-            let top = o.ranking.first();
+            let top = o.ranking.iter().find(|c| !c.thermal_response);
             let names = |c: &str| family.is_some_and(|f| names_family(c, &truth, f, a));
             AxisScore {
                 axis: AXES[a],
@@ -575,6 +587,12 @@ pub fn score(
                 right_family: top.is_some_and(|c| names(&c.name)),
                 right_family_admitted: o.admitted.iter().any(|c| names(c)),
                 any_significant: o.any_significant,
+                thermal_response: o
+                    .ranking
+                    .iter()
+                    .filter(|c| c.thermal_response && c.significant)
+                    .map(|c| c.name.clone())
+                    .collect(),
                 detectable_share: o.detectable_share,
                 admitted: o.admitted.clone(),
                 refused: o.refused.clone(),
@@ -831,12 +849,13 @@ pub fn world_lines(s: &WorldScore) -> Vec<String> {
         .iter()
         .map(|a| {
             format!(
-                "{} {} [{}] {}: affected {}, top {}{}, right family {}, admitted [{}], drift {:.4} → {:.4} (floor {:.4}) °/s, cut {}{}",
+                "{} {} [{}] {}: affected {}, thermal response [{}], top effect {}{}, right family {}, admitted [{}], drift {:.4} → {:.4} (floor {:.4}) °/s, cut {}{}",
                 s.kind,
                 s.seed,
                 s.forms.join(","),
                 a.axis,
                 a.affected,
+                a.thermal_response.join(", "),
                 a.top,
                 if a.top_significant { " (significant)" } else { "" },
                 a.right_family,

@@ -254,6 +254,16 @@ impl Kind {
         tau.strip_suffix(" s)")?.parse().ok()
     }
 
+    /// Whether a candidate's name is a term of the unit's own thermal response beyond the paper's
+    /// tables: its rise squared (a sensitivity that is not linear in temperature) and its own
+    /// axis's temperature rate, the sensor's or the element's behind it (gradients across the
+    /// capsule while it heats, the element's lag) — what a practitioner's thermal calibration
+    /// (T, T², a filtered dT/dt) holds. The diagnosis fits them before it looks for effects, so
+    /// that an effect is what the unit's heating, represented that well, does not explain.
+    pub fn is_thermal_response(name: &str) -> bool {
+        name.starts_with("rise² ") || Self::rate_time_constant_s(name).is_some()
+    }
+
     /// Whether a rate candidate's name is the element's rate (its filter starts without the
     /// heating) rather than the sensor's.
     pub fn is_element_rate(name: &str) -> bool {

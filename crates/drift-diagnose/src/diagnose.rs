@@ -331,6 +331,10 @@ pub struct CandidateScore {
     /// Where the effect shows: within activations (shape), between activations (offsets), or
     /// absorbed by the model.
     pub level: &'static str,
+    /// A term of the unit's own thermal response ([`Kind::is_thermal_response`]): selected
+    /// before the effects and scored over the baseline alone; every other candidate is an effect,
+    /// scored over the baseline and the thermal response selected.
+    pub thermal_response: bool,
 }
 
 /// The ranking on one axis.
@@ -347,8 +351,12 @@ pub struct AxisDiagnosis {
     /// threshold. An effect explaining less of the residual's variance beyond the baseline (out of
     /// sample) cannot be told from chance or from the paper model's own structure here.
     pub detectable_share: f64,
-    /// The size threshold for this many activations ([`size_threshold`]).
+    /// The size threshold an effect's gain must reach with this many activations
+    /// ([`effect_size_threshold`]).
     pub size_threshold: f64,
+    /// The size threshold of the unit's own thermal response with this many activations
+    /// ([`size_threshold`]).
+    pub response_size_threshold: f64,
     /// The baseline's columns, fitted before any candidate.
     pub baseline: Vec<String>,
     /// Share of the residual's variance within activations the baseline explains out of sample.
@@ -583,6 +591,22 @@ pub fn size_threshold(activations: usize) -> f64 {
         .map_or(1.0, |(_, tau)| *tau)
 }
 
+/// The size threshold an effect's gain must reach, by how many activations the axis is diagnosed
+/// on, once the unit's own thermal response is in the baseline: the 95th percentile of the
+/// per-axis top effect gain on null worlds of `drift_sim::world` with a diagnosis campaign shaped
+/// like an analyst's (experiments/README.md, *The size threshold*). Pairs as
+/// [`SIZE_THRESHOLDS`].
+pub const EFFECT_SIZE_THRESHOLDS: [(usize, f64); 2] = [(100, 0.10), (0, 0.14)];
+
+/// The size threshold for an effect on an axis diagnosed on `activations` activations
+/// ([`EFFECT_SIZE_THRESHOLDS`]).
+pub fn effect_size_threshold(activations: usize) -> f64 {
+    EFFECT_SIZE_THRESHOLDS
+        .iter()
+        .find(|(at_least, _)| activations >= *at_least)
+        .map_or(1.0, |(_, tau)| *tau)
+}
+
 /// One candidate selected into the baseline, in order.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Selected {
@@ -592,6 +616,9 @@ pub struct Selected {
     pub gain: f64,
     /// Its family-wise p-value in that round.
     pub family_p_value: f64,
+    /// Selected as part of the unit's own thermal response ([`Kind::is_thermal_response`]),
+    /// before any effect was sought, rather than as an effect.
+    pub thermal_response: bool,
 }
 
 /// Each activation's series as an index unique within its stratum (unit, nominal set point): what
@@ -649,6 +676,95 @@ fn partialled(
         .collect()
 }
 
+/// What every round of one axis's forward selection shares.
+struct Round<'a> {
+    activations: &'a [ActivationSeries],
+    axis: usize,
+    baseline: &'a [String],
+    residuals: &'a [&'a [f64]],
+    candidates: &'a [&'a BTreeMap<String, Vec<f64>>],
+    strata: &'a [usize],
+    series: &'a [usize],
+    fold_of: &'a [usize],
+    folds: usize,
+    alpha: f64,
+}
+
+impl Round<'_> {
+    /// Forward selection among `remaining` over the baseline and `selected` (which it extends,
+    /// up to [`MAX_SELECTED`] in all): each round scores what is left over both, and the best
+    /// candidate joins when it is significant (shuffles) and its gain reaches `threshold`.
+    /// Returns the first round's shuffle test (what the ranking reports).
+    fn select(
+        &self,
+        mut remaining: Vec<String>,
+        selected: &mut Vec<Selected>,
+        threshold: f64,
+        thermal_response: bool,
+    ) -> Null {
+        let axis = self.axis;
+        let mut first: Option<Null> = None;
+        while selected.len() < MAX_SELECTED && !remaining.is_empty() {
+            let columns: Vec<Vec<&[f64]>> = self
+                .activations
+                .iter()
+                .map(|a| {
+                    self.baseline
+                        .iter()
+                        .filter_map(|n| a.baseline[axis].get(n))
+                        .chain(
+                            selected
+                                .iter()
+                                .filter_map(|c| a.left_over[axis].get(&c.name)),
+                        )
+                        .map(Vec::as_slice)
+                        .collect()
+                })
+                .collect();
+            let null = Null::measure(
+                &Scored {
+                    residuals: self.residuals,
+                    baseline: &columns,
+                    candidates: self.candidates,
+                    strata: self.strata,
+                    series: self.series,
+                    fold_of: self.fold_of,
+                    folds: self.folds,
+                },
+                &remaining,
+                (axis + 3 * selected.len() + if thermal_response { 0 } else { 30 }) as u64,
+            );
+            let best = null
+                .observed
+                .iter()
+                .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+                .map(|(n, (gain, _))| (n.clone(), *gain));
+            let chosen = best.filter(|(_, gain)| {
+                *gain > 0.0 && *gain >= threshold && null.p_value(*gain) <= self.alpha
+            });
+            let p_value = chosen.as_ref().map(|(_, gain)| null.p_value(*gain));
+            if first.is_none() {
+                first = Some(null);
+            }
+            let (Some((name, gain)), Some(family_p_value)) = (chosen, p_value) else {
+                break;
+            };
+            remaining.retain(|n| *n != name);
+            selected.push(Selected {
+                family_p_value,
+                name,
+                gain,
+                thermal_response,
+            });
+        }
+        first.unwrap_or_else(|| Null {
+            observed: BTreeMap::new(),
+            maxima: Vec::new(),
+            baselines: Default::default(),
+        })
+    }
+}
+
 /// Scores every candidate on one axis of `activations` with `folds`-fold cross-validation by
 /// series ([`series_folds`]); `alpha` is the family-wise significance level for the axis, held by
 /// the shuffle test ([`crate::permutation`]).
@@ -701,7 +817,7 @@ pub fn diagnose_axis(
         .iter()
         .map(|n| (n, absorbed_share(activations, axis, n)))
         .collect();
-    let mut remaining: Vec<String> = names
+    let remaining: Vec<String> = names
         .iter()
         .filter(|n| absorbed.get(n).is_some_and(|&a| a <= ABSORBED))
         .cloned()
@@ -715,65 +831,40 @@ pub fn diagnose_axis(
     let strata = set_point_strata(activations);
     let series = series_index(activations);
     let threshold = size_threshold(activations.len());
-    // Forward selection: each round scores what is left over the baseline and the candidates
-    // selected so far.
+    let round = Round {
+        activations,
+        axis,
+        baseline: &baseline,
+        residuals: &residuals,
+        candidates: &candidates,
+        strata: &strata,
+        series: &series,
+        fold_of: &fold_of,
+        folds,
+        alpha,
+    };
+    // The unit's own thermal response first, then the effects over it: an effect is what is left
+    // once the unit's heating is represented as well as a thermal calibration would.
+    let (response, effects): (Vec<String>, Vec<String>) = remaining
+        .into_iter()
+        .partition(|n| Kind::is_thermal_response(n));
     let mut selected: Vec<Selected> = Vec::new();
-    let mut first: Option<Null> = None;
-    while selected.len() < MAX_SELECTED && !remaining.is_empty() {
-        let columns: Vec<Vec<&[f64]>> = activations
-            .iter()
-            .map(|a| {
-                baseline
-                    .iter()
-                    .filter_map(|n| a.baseline[axis].get(n))
-                    .chain(
-                        selected
-                            .iter()
-                            .filter_map(|c| a.left_over[axis].get(&c.name)),
-                    )
-                    .map(Vec::as_slice)
-                    .collect()
-            })
-            .collect();
-        let null = Null::measure(
-            &Scored {
-                residuals: &residuals,
-                baseline: &columns,
-                candidates: &candidates,
-                strata: &strata,
-                series: &series,
-                fold_of: &fold_of,
-                folds,
-            },
-            &remaining,
-            (axis + 3 * selected.len()) as u64,
-        );
-        let best = null
-            .observed
-            .iter()
-            .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
-            .map(|(n, (gain, _))| (n.clone(), *gain));
-        let round_first = first.is_none();
-        let chosen = best
-            .filter(|(_, gain)| *gain > 0.0 && *gain >= threshold && null.p_value(*gain) <= alpha);
-        if round_first {
-            first = Some(null.clone());
+    let response_first = round.select(response, &mut selected, threshold, true);
+    let effect_threshold = effect_size_threshold(activations.len());
+    let effect_first = round.select(effects, &mut selected, effect_threshold, false);
+    // What the baseline alone explains: the first round that was measured.
+    let baseline_alone = if response_first.observed.is_empty() {
+        &effect_first.baselines
+    } else {
+        &response_first.baselines
+    };
+    let first_round = |name: &str| {
+        if Kind::is_thermal_response(name) {
+            &response_first
+        } else {
+            &effect_first
         }
-        let Some((name, gain)) = chosen else {
-            break;
-        };
-        remaining.retain(|n| *n != name);
-        selected.push(Selected {
-            family_p_value: null.p_value(gain),
-            name,
-            gain,
-        });
-    }
-    let first = first.unwrap_or_else(|| Null {
-        observed: BTreeMap::new(),
-        maxima: Vec::new(),
-        baselines: Default::default(),
-    });
+    };
     // The per-activation tests and coefficients are read on what the baseline leaves of the
     // residual and of each candidate.
     let residual_left = partialled(activations, axis, &baseline, &|a| {
@@ -795,6 +886,7 @@ pub fn diagnose_axis(
                 stable: false,
                 absorbed_by_model: absorbed,
                 level: "",
+                thermal_response: false,
             };
             if absorbed > ABSORBED {
                 candidate.level = "absorbed by the model";
@@ -829,6 +921,7 @@ pub fn diagnose_axis(
             candidate.drift_p_value = within.drift_p_value;
             // The level and gain are the shuffle test's (first round); the p-value and coefficient
             // are read at that level.
+            let first = first_round(name);
             let (share, level) = first
                 .observed
                 .get(name)
@@ -843,6 +936,7 @@ pub fn diagnose_axis(
             candidate.family_p_value = first.p_value(share);
             (candidate.p_value, candidate.coefficient, candidate.level) =
                 (best.p_value, best.coefficient, level);
+            candidate.thermal_response = Kind::is_thermal_response(name);
             if let Some(s) = selected.iter().find(|s| s.name == *name) {
                 candidate.significant = true;
                 candidate.explained = s.gain;
@@ -863,11 +957,12 @@ pub fn diagnose_axis(
         axis: AXES[axis],
         activations: activations.len(),
         residual_rms_dps: rms,
-        detectable_share: first.detectable(alpha).max(threshold),
-        size_threshold: threshold,
+        detectable_share: effect_first.detectable(alpha).max(effect_threshold),
+        size_threshold: effect_threshold,
+        response_size_threshold: threshold,
         baseline,
-        baseline_explained_within: first.baselines.within_share,
-        baseline_explained_between: first.baselines.between_share,
+        baseline_explained_within: baseline_alone.within_share,
+        baseline_explained_between: baseline_alone.between_share,
         selected,
         ranking,
     }

@@ -1038,6 +1038,7 @@ mod tests {
             residual_rms_dps: 0.01,
             detectable_share: 0.2,
             size_threshold: 0.1,
+            response_size_threshold: 0.1,
             baseline: Vec::new(),
             baseline_explained_within: 0.0,
             baseline_explained_between: 0.0,
@@ -1056,6 +1057,7 @@ mod tests {
                     stable: true,
                     absorbed_by_model: 0.0,
                     level: "within activations",
+                    thermal_response: Kind::is_thermal_response(candidate),
                 })
                 .collect(),
         }

@@ -186,3 +186,88 @@ fn what_the_baseline_explains_is_no_discovery() {
     let d = diagnose_axis(&without, 0, 5, 0.05);
     assert_eq!(d.chosen().map(|c| c.name.as_str()), Some("aux:housing"));
 }
+
+/// The activations of [`run`] with the rate candidate named as the diagnosis names the sensor's
+/// own temperature rate: a term of the unit's thermal response.
+fn with_sensor_rate(
+    effect: impl Fn(f64, f64, f64) -> f64 + Copy,
+    seed: u64,
+) -> Vec<ActivationSeries> {
+    let mut noise = Lcg(seed);
+    (0..60)
+        .map(|i| {
+            let mut a = activation(i, effect, &mut noise);
+            for maps in [&mut a.candidates, &mut a.left_over] {
+                for map in maps.iter_mut() {
+                    if let Some(v) = map.remove("temperature rate") {
+                        map.insert("temperature rate X (τ 8 s)".to_owned(), v);
+                    }
+                }
+            }
+            a
+        })
+        .collect()
+}
+
+#[test]
+fn the_thermal_response_is_the_own_axis_rise_squared_and_rates() {
+    use drift_diagnose::candidates::Kind;
+    for name in [
+        "rise² X",
+        "temperature rate Y (τ 2 s)",
+        "element rate Z (τ 120 s)",
+    ] {
+        assert!(Kind::is_thermal_response(name), "{name}");
+    }
+    // A neighbour's heating, a channel, the time: effects.
+    for name in [
+        "element rate Y on X (τ 30 s)",
+        "rise Y",
+        "aux:supply_voltage × rise X",
+        "time since switch-on",
+        "temperature rate",
+    ] {
+        assert!(!Kind::is_thermal_response(name), "{name}");
+    }
+}
+
+#[test]
+fn the_thermal_response_is_selected_before_effects_and_is_not_one() {
+    // The unit's own rate response and a supply offset: the response first, flagged as such,
+    // then the supply as the effect over it.
+    let d = diagnose_axis(
+        &with_sensor_rate(|rate, offset, _| 0.05 * rate + 0.004 * offset, 3),
+        0,
+        5,
+        0.05,
+    );
+    let names: Vec<(&str, bool)> = d
+        .selected
+        .iter()
+        .map(|s| (s.name.as_str(), s.thermal_response))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            ("temperature rate X (τ 8 s)", true),
+            ("aux:supply_voltage", false)
+        ],
+        "{d:#?}"
+    );
+    let supply = d
+        .ranking
+        .iter()
+        .find(|c| c.name == "aux:supply_voltage")
+        .unwrap();
+    assert!(supply.significant && !supply.thermal_response);
+    assert!(d.size_threshold > 0.0 && d.response_size_threshold > 0.0);
+
+    // The response alone: selected, and no effect beyond it.
+    let d = diagnose_axis(&with_sensor_rate(|rate, _, _| 0.05 * rate, 4), 0, 5, 0.05);
+    assert_eq!(d.selected.len(), 1, "{:#?}", d.selected);
+    assert!(d.selected[0].thermal_response);
+    assert!(d
+        .ranking
+        .iter()
+        .all(|c| !c.significant || c.thermal_response));
+}

@@ -1099,15 +1099,18 @@ class Diagnosis:
     @property
     def ranking(self) -> list[dict[str, Any]]:
         """The ranking of every axis as records (axis, rank, candidate, level, explained,
-        family_p_value, p_value, whole_p_value, drift_p_value, significant, stable,
-        detectable_share, size_threshold, baseline_explained_within, baseline_explained_between,
-        coefficient, absorbed_by_model): a new list of dicts. `explained` is the candidate's
-        out-of-sample gain over the baseline (the paper model's ambient gap and the bench's context
-        channels, fitted first); `significant` marks the candidates selected forward: significant
-        family-wise (`family_p_value` ≤ 0.05, shuffles of whole series) and with a gain of at
-        least `size_threshold` (calibrated on null worlds). `detectable_share` is the gain a
-        candidate on that axis must exceed with these activations. The t-tests' p-values are
-        reported, not gated on."""
+        family_p_value, p_value, whole_p_value, drift_p_value, significant, thermal_response,
+        stable, detectable_share, size_threshold, baseline_explained_within,
+        baseline_explained_between, coefficient, absorbed_by_model): a new list of dicts.
+        `explained` is the candidate's out-of-sample gain over the baseline (the paper model's
+        ambient gap and the bench's context channels, fitted first); `significant` marks the
+        candidates selected forward: significant family-wise (`family_p_value` ≤ 0.05, shuffles of
+        whole series) and with a gain of at least the size threshold (calibrated on null worlds).
+        `thermal_response` marks the unit's own thermal response (its rise squared, its own
+        axis's temperature rate), selected before any effect; every other candidate is an effect, scored
+        over the baseline and the thermal response selected, against `size_threshold`.
+        `detectable_share` is the gain an effect on that axis must exceed with these activations.
+        The t-tests' p-values are reported, not gated on."""
     @property
     def paper_ranking(self) -> list[dict[str, Any]]:
         """The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's

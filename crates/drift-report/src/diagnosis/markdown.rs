@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use drift_diagnose::closing::{
     mean_profiles, profile_bin_labels, BeforeAfter, Closed, Profile, Stage3Choice,
 };
-use drift_diagnose::diagnose::AxisDiagnosis;
+use drift_diagnose::diagnose::{AxisDiagnosis, Selected};
 use drift_diagnose::warm_start::WarmStartChoice;
 use drift_fit::FittedUnit;
 
@@ -164,25 +164,18 @@ pub(super) fn profile_markdown(profiles: &[Profile]) -> String {
 
 /// The ranking as Markdown.
 pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
-    let mut md = String::from("## Diagnosis of the residual after the loop's model (stage 3 and the initial bias as chosen above)\n\nFirst the **baseline**, fitted before any candidate and never a discovery: the paper model's known ambient gap (the tables read at the chamber air logged at switch-on, less the paper's reading at the switch-on temperature) and the bench's context channels (the chamber air, alone and times the rise and the temperature). Then each candidate, stripped first of what the paper's model already accounts for (the paper's tables are fitted to the candidate itself on the calibration activations with the drift fit's reference times, and what they predict of it is taken out: “absorbed by the model”), is scored by its **gain**: the out-of-sample share of the residual's variance it explains beyond the baseline (cross-validated with whole series held out together, at the better of two levels: shapes within activations, offsets between them; 0 when the folds' coefficients disagree in sign). **Selection** is forward: the best candidate is selected when it is significant family-wise (α = 0.05: whole series' candidates are shuffled onto other series of the same unit and set point 99 times, and the best of all candidates reached its gain in at most 5 % of the shuffles: p family) **and** its gain reaches the size threshold τ (the 95th percentile of the top gain on null worlds for this many activations); it then joins the baseline and the rest are scored again, up to four. *Detectable*: the larger of chance's 5 % level and τ. The per-activation t-tests at the candidate's level (p) and on the whole residual (p whole), on what the baseline leaves, are shown, not gated on.\n\n");
+    let mut md = String::from("## Diagnosis of the residual after the loop's model (stage 3 and the initial bias as chosen above)\n\nFirst the **baseline**, fitted before any candidate and never a discovery: the paper model's known ambient gap (the tables read at the chamber air logged at switch-on, less the paper's reading at the switch-on temperature) and the bench's context channels (the chamber air, alone and times the rise and the temperature). Then each candidate, stripped first of what the paper's model already accounts for (the paper's tables are fitted to the candidate itself on the calibration activations with the drift fit's reference times, and what they predict of it is taken out: “absorbed by the model”), is scored by its **gain**: the out-of-sample share of the residual's variance it explains beyond the baseline (cross-validated with whole series held out together, at the better of two levels: shapes within activations, offsets between them; 0 when the folds' coefficients disagree in sign). **Selection** is forward, in two steps: first the unit's **own thermal response** beyond the tables (its rise squared and its own axis's temperature rate, the sensor's or the lagging element's: what a thermal calibration in T, T² and a filtered dT/dt holds), then the **effects** (every other candidate) over the baseline and the thermal response selected. In each step the best candidate is selected when it is significant family-wise (α = 0.05: whole series' candidates are shuffled onto other series of the same unit and set point 99 times, and the best of all candidates reached its gain in at most 5 % of the shuffles: p family) **and** its gain reaches the step's size threshold (the 95th percentile of the top gain on null worlds for this many activations: τ for effects, τ response for the thermal response); it then joins the baseline and the rest are scored again, up to four in all. *Detectable*: the larger of chance's 5 % level and τ, for an effect. The per-activation t-tests at the candidate's level (p) and on the whole residual (p whole), on what the baseline leaves, are shown, not gated on.\n\n");
     for axis in axes {
         let _ = writeln!(
             md,
-            "### Axis {} ({} activations, residual RMS {:.4} °/s, detectable gain {:.3}, τ {:.3}): {}\n",
+            "### Axis {} ({} activations, residual RMS {:.4} °/s, detectable gain {:.3}, τ {:.3}, τ response {:.3}): {}\n",
             axis.axis,
             axis.activations,
             axis.residual_rms_dps,
             axis.detectable_share,
             axis.size_threshold,
-            if axis.selected.is_empty() {
-                "nothing beyond the baseline and chance".to_owned()
-            } else {
-                axis.selected
-                    .iter()
-                    .map(|s| format!("**{}** (gain {:.3}, p family {:.2})", s.name, s.gain, s.family_p_value))
-                    .collect::<Vec<_>>()
-                    .join(", then ")
-            }
+            axis.response_size_threshold,
+            selections(axis, &|s| format!("**{}** (gain {:.3}, p family {:.2})", s.name, s.gain, s.family_p_value))
         );
         let _ = writeln!(
             md,
@@ -207,7 +200,11 @@ pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
                 c.family_p_value,
                 c.p_value,
                 c.whole_p_value,
-                if c.significant { "yes" } else { "" },
+                match (c.significant, c.thermal_response) {
+                    (true, true) => "thermal response",
+                    (true, false) => "effect",
+                    _ => "",
+                },
                 c.coefficient,
                 c.absorbed_by_model
             );
@@ -215,6 +212,29 @@ pub fn markdown(axes: &[AxisDiagnosis], top: usize) -> String {
         md.push('\n');
     }
     md
+}
+
+/// An axis's selections in words, the thermal response and the effects apart, each selection
+/// written by `one`.
+pub(super) fn selections(axis: &AxisDiagnosis, one: &dyn Fn(&Selected) -> String) -> String {
+    let list = |response: bool| {
+        let picked: Vec<String> = axis
+            .selected
+            .iter()
+            .filter(|s| s.thermal_response == response)
+            .map(one)
+            .collect();
+        picked.join(", then ")
+    };
+    let (response, effects) = (list(true), list(false));
+    match (response.is_empty(), effects.is_empty()) {
+        (true, true) => "nothing beyond the baseline and chance".to_owned(),
+        (false, true) => {
+            format!("the unit's own thermal response {response}; no effect beyond it and chance")
+        }
+        (true, false) => format!("effect {effects}"),
+        (false, false) => format!("the unit's own thermal response {response}; effect {effects}"),
+    }
 }
 
 /// The ranking behind the paper's own model, when the loop changed it: what the paper's model

@@ -206,19 +206,20 @@ pub fn unit_section(
                     100.0 * axis.detectable_share
                 )
         } else {
-            axis.selected
-                .iter()
-                .map(|c| {
-                    format!(
-                        "{} (gain {:.0} % over the baseline; τ {:.0} %, p family {:.2})",
-                        c.name,
-                        100.0 * c.gain,
-                        100.0 * axis.size_threshold,
-                        c.family_p_value
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join(", then ")
+            markdown::selections(axis, &|c| {
+                format!(
+                    "{} (gain {:.0} % over the baseline; τ {:.0} %, p family {:.2})",
+                    c.name,
+                    100.0 * c.gain,
+                    100.0
+                        * if c.thermal_response {
+                            axis.response_size_threshold
+                        } else {
+                            axis.size_threshold
+                        },
+                    c.family_p_value
+                )
+            })
         };
         let _ = writeln!(console, "  {}: {chosen}", axis.axis);
         for (i, c) in axis.ranking.iter().take(request.top).enumerate() {
