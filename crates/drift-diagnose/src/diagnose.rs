@@ -29,7 +29,7 @@
 use std::collections::BTreeMap;
 
 use drift_core::SwitchOnRate;
-use drift_recording::{Segment, SegmentLabels};
+use drift_recording::{Interrupted, Progress, Segment, SegmentLabels, Within};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -665,12 +665,15 @@ fn partialled(
 /// Selection is forward: the best candidate that is significant (shuffles) and large enough
 /// (gain ≥ [`size_threshold`]) joins the baseline and the rest are scored again over it, up to
 /// [`MAX_SELECTED`]. The ranking is the first round's; `significant` marks the selected.
+///
+/// `progress` is asked between shuffles whether to go on ([`Null::measure`]).
 pub fn diagnose_axis(
     activations: &[ActivationSeries],
     axis: usize,
     folds: usize,
     alpha: f64,
-) -> AxisDiagnosis {
+    progress: &dyn Progress,
+) -> Result<AxisDiagnosis, Interrupted> {
     let names: Vec<String> = activations
         .first()
         .map(|a| a.candidates[axis].keys().cloned().collect())
@@ -747,7 +750,8 @@ pub fn diagnose_axis(
             },
             &remaining,
             (axis + 3 * selected.len()) as u64,
-        );
+            progress,
+        )?;
         let best = null
             .observed
             .iter()
@@ -859,7 +863,7 @@ pub fn diagnose_axis(
         (None, Some(_)) => std::cmp::Ordering::Greater,
         (None, None) => b.explained.total_cmp(&a.explained),
     });
-    AxisDiagnosis {
+    Ok(AxisDiagnosis {
         axis: AXES[axis],
         activations: activations.len(),
         residual_rms_dps: rms,
@@ -870,12 +874,32 @@ pub fn diagnose_axis(
         baseline_explained_between: first.baselines.between_share,
         selected,
         ranking,
-    }
+    })
 }
 
-/// Diagnoses all three axes.
-pub fn diagnose(activations: &[ActivationSeries]) -> [AxisDiagnosis; 3] {
-    [0, 1, 2].map(|axis| diagnose_axis(activations, axis, 5, 0.05))
+/// The step [`diagnose`] reports: axes ranked of 3.
+pub const RANKING: &str = "ranking the candidates per axis";
+
+/// Diagnoses all three axes, telling `progress` the axes done ([`RANKING`]) and asking it between
+/// shuffles whether to go on.
+pub fn diagnose(
+    activations: &[ActivationSeries],
+    progress: &dyn Progress,
+) -> Result<[AxisDiagnosis; 3], Interrupted> {
+    let rank = |axis: usize| {
+        let done = axis as u64;
+        progress.check(RANKING, done, 3)?;
+        let within = Within {
+            outer: progress,
+            step: RANKING,
+            done,
+            total: 3,
+        };
+        diagnose_axis(activations, axis, 5, 0.05, &within)
+    };
+    let axes = [rank(0)?, rank(1)?, rank(2)?];
+    progress.check(RANKING, 3, 3)?;
+    Ok(axes)
 }
 
 #[cfg(test)]

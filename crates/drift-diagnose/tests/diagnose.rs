@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 
 use drift_diagnose::diagnose::{diagnose_axis, ActivationSeries};
-use drift_recording::{SegmentLabels, SeriesKind};
+use drift_recording::{SegmentLabels, SeriesKind, QUIET};
 
 /// Deterministic noise in [−1, 1).
 struct Lcg(u64);
@@ -79,7 +79,7 @@ fn run(
     let mut noise = Lcg(seed);
     let activations: Vec<ActivationSeries> =
         (0..60).map(|i| activation(i, effect, &mut noise)).collect();
-    diagnose_axis(&activations, 0, 5, 0.05)
+    diagnose_axis(&activations, 0, 5, 0.05, QUIET).expect("QUIET never stops")
 }
 
 #[test]
@@ -168,7 +168,7 @@ fn what_the_baseline_explains_is_no_discovery() {
             a
         })
         .collect();
-    let d = diagnose_axis(&activations, 0, 5, 0.05);
+    let d = diagnose_axis(&activations, 0, 5, 0.05, QUIET).expect("QUIET never stops");
     assert_eq!(d.baseline, ["ambient"]);
     assert!(d.baseline_explained_within > 0.5, "{d:?}");
     assert!(d.chosen().is_none(), "{:?}", d.chosen());
@@ -183,6 +183,6 @@ fn what_the_baseline_explains_is_no_discovery() {
             a
         })
         .collect();
-    let d = diagnose_axis(&without, 0, 5, 0.05);
+    let d = diagnose_axis(&without, 0, 5, 0.05, QUIET).expect("QUIET never stops");
     assert_eq!(d.chosen().map(|c| c.name.as_str()), Some("aux:housing"));
 }
