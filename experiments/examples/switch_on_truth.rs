@@ -136,7 +136,14 @@ fn main() -> anyhow::Result<()> {
         clock: plan.clock,
         ..LoopOptions::new(&plan.calibration)
     };
-    let closed = close(&fitted, &segments, &[], &options, &settings)?;
+    let closed = close(
+        &fitted,
+        &segments,
+        &[],
+        &options,
+        &settings,
+        drift_recording::QUIET,
+    )?;
     let core = &fitted.modified.settings;
     let fits = &closed.switch_on_rate;
     for fit in fits {

@@ -420,7 +420,7 @@ pub fn run(
         clock: plan_size.clock,
         ..LoopOptions::new(calibration)
     };
-    let closed = close(&base, &all, &[], &options, settings)?;
+    let closed = close(&base, &all, &[], &options, settings, drift_recording::QUIET)?;
     eprintln!(
         "  {} field activations at the calibration set points inside the calibrated ambient range, {} outside held out",
         closed.roles.training.len(),

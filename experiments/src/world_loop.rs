@@ -12,7 +12,7 @@ use drift_fit::{fit_unit, FitSettings};
 use drift_recording::paper::{
     CALIBRATION_SET_POINTS_CELSIUS as CALIBRATION, VALIDATION_SET_POINT_CELSIUS as VALIDATION,
 };
-use drift_recording::Segment;
+use drift_recording::{Segment, QUIET};
 
 /// Fits the paper's tables on `all`'s calibration protocol and closes the loop; `extend` builds and
 /// guards the extended model; `select_on_validation` ranks on the +33 °C protocol too.
@@ -39,9 +39,9 @@ pub fn fit_and_close<'a>(
         ..LoopOptions::new(&CALIBRATION)
     };
     let closed = if diagnosis.is_empty() {
-        close(&base, all, &[], &options, settings)?
+        close(&base, all, &[], &options, settings, QUIET)?
     } else {
-        close_both(&base, all, diagnosis, &options, settings)?
+        close_both(&base, all, diagnosis, &options, settings, QUIET)?
             .into_iter()
             .next()
             .context("the cross-fitted loop closed no half")?

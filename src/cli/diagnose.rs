@@ -9,7 +9,7 @@ use drift_diagnose::closing::{close_both, close_separate_both, Closed, LoopOptio
 use drift_evaluate::pipeline;
 use drift_fit::FittedUnit;
 use drift_recording::output_folder::{Owned, Writer};
-use drift_recording::Segment;
+use drift_recording::{Segment, Within};
 use drift_report::diagnosis::{self, Request};
 
 use super::campaign_args::CampaignArgs;
@@ -187,22 +187,33 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .bench_channels
         .extend(args.bench_channels.iter().cloned());
     let mut units: Vec<(String, Closed<'_>, &FittedUnit)> = Vec::new();
+    let unit_step = if args.extend {
+        "units: refitting on every candidate, shuffle test, guarding the extended model"
+    } else {
+        "units: refitting on every candidate, shuffle test (99 reshuffles per axis)"
+    };
     for (n, (unit, segments)) in recorded.iter().enumerate() {
-        steps.update(
-            if args.extend {
-                "units: refitting on every candidate, shuffle test, guarding the extended model"
-            } else {
-                "units: refitting on every candidate, shuffle test (99 reshuffles per axis)"
-            },
-            n as u64,
-            recorded.len() as u64,
-        );
+        // The bar counts units; the loop's own steps within one leave it where it is.
+        let within = Within {
+            outer: &steps,
+            step: unit_step,
+            done: n as u64,
+            total: recorded.len() as u64,
+        };
+        steps.update(unit_step, n as u64, recorded.len() as u64);
         let Some(fitted) = outcome.fitted.iter().find(|f| &f.unit_id == unit) else {
             continue;
         };
         let extra: Vec<&Segment> = diagnosis_data.get(unit).into_iter().flatten().collect();
         let halves = match &evaluation {
-            None => close_both(fitted, segments, &extra, &loop_options, &options.fit)?,
+            None => close_both(
+                fitted,
+                segments,
+                &extra,
+                &loop_options,
+                &options.fit,
+                &within,
+            )?,
             Some(evaluation) => {
                 let Some(judged) = evaluation.get(unit) else {
                     continue;
@@ -214,6 +225,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     &extra,
                     &loop_options,
                     &options.fit,
+                    &within,
                 )?
             }
         };

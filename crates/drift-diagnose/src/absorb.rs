@@ -10,6 +10,13 @@
 //! paper's model fitted to `rate` less `β` times the tables fitted to `c`: the left-over part is
 //! exactly what a term `β·c` adds to the paper's model, which is what the diagnosis must score and
 //! what the extension's coefficients must be fitted on.
+//!
+//! The same linearity lets the tables be fitted to `c / s` and their left-over scaled back by `s`.
+//! The tables and the corrector are a gyro's: they refuse or hold what is implausible in °/s (a
+//! `k` beyond 100 (°/s)/°C standing for a drift beyond 100 °/s, a bias beyond 10⁴ °/s), and a
+//! quantity in a unit of its own can be far larger — an air pressure near 1000 hPa times a rise of
+//! 10 °C asks for `k` near 1000. Each axis's quantity is therefore scaled by the power of two that
+//! brings its largest calibration value to within [½, 1], which is exact in floating point.
 
 use drift_core::ModifiedTables;
 use drift_recording::Segment;
@@ -25,6 +32,8 @@ use drift_fit::settings::FitSettings;
 #[derive(Debug, Clone)]
 pub struct Absorber {
     tables: Box<ModifiedTables>,
+    /// Per axis, what the quantity was divided by before the tables were fitted to it.
+    scale: [f32; 3],
 }
 
 /// `segment` with its rates replaced by `values`.
@@ -33,6 +42,31 @@ fn carrying(segment: &Segment, values: [Vec<f32>; 3]) -> Segment {
         rate_dps: values,
         ..segment.clone()
     }
+}
+
+/// The power of two at or above the largest finite |value| (1 when there is none): dividing by it
+/// brings the values within [−1, 1] without rounding.
+fn power_of_two_scale<'v>(values: impl IntoIterator<Item = &'v f32>) -> f32 {
+    let largest = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f32, |m, v| m.max(v.abs()));
+    if largest > 0.0 && largest.is_normal() {
+        // Within the normal range both ways, so that the reciprocal is exact too.
+        2f32.powi((largest.log2().ceil() as i32).clamp(-126, 126))
+    } else {
+        1.0
+    }
+}
+
+/// `values` with each axis multiplied by `factor[axis]`.
+fn scaled(mut values: [Vec<f32>; 3], factor: [f32; 3]) -> [Vec<f32>; 3] {
+    for (axis, factor) in values.iter_mut().zip(factor) {
+        for v in axis.iter_mut() {
+            *v *= factor;
+        }
+    }
+    values
 }
 
 impl Absorber {
@@ -52,16 +86,29 @@ impl Absorber {
         keying: &Keying,
         references: &[Vec<usize>; 3],
     ) -> Result<Option<Self>, FitError> {
-        let analysed = calibration
+        let carried: Vec<(&Segment, [Vec<f32>; 3])> = calibration
             .par_iter()
-            .filter_map(|segment| values(segment).map(|v| analyse(&carrying(segment, v), settings)))
-            .collect::<Result<Vec<_>, _>>()?;
-        if analysed.is_empty() {
+            .filter_map(|segment| values(segment).map(|v| (*segment, v)))
+            .collect();
+        if carried.is_empty() {
             return Ok(None);
         }
+        let scale: [f32; 3] = std::array::from_fn(|axis| {
+            power_of_two_scale(carried.iter().flat_map(|(_, v)| &v[axis]))
+        });
+        let analysed = carried
+            .into_par_iter()
+            .map(|(segment, v)| {
+                analyse(
+                    &carrying(segment, scaled(v, scale.map(|s| 1.0 / s))),
+                    settings,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         let fitted = fit_unit_at(&analysed, settings, Some(references))?;
         Ok(Some(Self {
             tables: keying.tables(&fitted.modified, &fitted.by_history),
+            scale,
         }))
     }
 
@@ -75,9 +122,11 @@ impl Absorber {
         switch_on: [f32; 3],
         keying: &Keying,
     ) -> [Vec<f32>; 3] {
-        keying
+        let values = scaled(values, self.scale.map(|s| 1.0 / s));
+        let left = keying
             .correct(&self.tables, &carrying(segment, values), switch_on)
-            .0
+            .0;
+        scaled(left, self.scale)
     }
 }
 
@@ -88,6 +137,23 @@ mod tests {
     use drift_recording::{SegmentLabels, SeriesKind};
 
     use super::*;
+
+    #[test]
+    fn the_scale_is_the_power_of_two_at_or_above_the_largest_finite_value() {
+        assert_eq!(power_of_two_scale(&[999.0, -1000.0, f32::NAN]), 1024.0);
+        assert_eq!(power_of_two_scale(&[0.5, 0.25]), 0.5);
+        assert_eq!(power_of_two_scale(&[0.0, f32::INFINITY]), 1.0);
+        assert_eq!(power_of_two_scale(&[]), 1.0);
+        let largest = power_of_two_scale(&[f32::MAX]);
+        assert!(largest.is_finite() && (1.0 / largest).is_normal());
+        let values = [vec![999.7f32, -1000.1], vec![0.3], vec![]];
+        let there = scaled(values.clone(), [1.0 / 1024.0, 2.0, 1.0]);
+        assert_eq!(
+            scaled(there, [1024.0, 0.5, 1.0]),
+            values,
+            "a power of two scales exactly"
+        );
+    }
 
     /// A quantity no calibration activation carries (an empty auxiliary channel, the residual heat
     /// without a chamber set point) has nothing to absorb: no absorber, and no error that would

@@ -8,11 +8,11 @@
 use std::collections::HashMap;
 
 use drift_core::{Previous, SwitchOn};
-use drift_recording::Segment;
+use drift_recording::{Progress, Segment};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, Diagnoser};
+use crate::diagnose::{diagnose, ActivationSeries, AxisDiagnosis, Diagnoser, RANKING};
 use crate::extend::{correct_with_terms, extend, Extended, TermPlan};
 use crate::keying::Keying;
 use crate::roles::Roles;
@@ -334,12 +334,16 @@ fn roles_of<'a>(
 ///
 /// With diagnosis data (`options.diagnose_on` or `diagnosis_data`) this is the loop of the half
 /// `options.half`; [`close_both`] runs both halves at the cost of little more than one.
+///
+/// `progress` is told the axes ranked ([`RANKING`], over every ranking the loop makes) and asked
+/// between the ranking's shuffles whether to go on; [`FitError::Interrupted`] when it asks to stop.
 pub fn close<'a>(
     fitted: &FittedUnit,
     segments: impl IntoIterator<Item = &'a Segment>,
     diagnosis_data: &[&'a Segment],
     options: &LoopOptions,
     settings: &FitSettings,
+    progress: &dyn Progress,
 ) -> Result<Closed<'a>, FitError> {
     let source: Vec<&Segment> = segments.into_iter().collect();
     first_of(
@@ -351,6 +355,7 @@ pub fn close<'a>(
             options,
             settings,
             &[options.half],
+            progress,
         )?,
     )
 }
@@ -363,6 +368,7 @@ pub fn close_both<'a>(
     diagnosis_data: &[&'a Segment],
     options: &LoopOptions,
     settings: &FitSettings,
+    progress: &dyn Progress,
 ) -> Result<Vec<Closed<'a>>, FitError> {
     let source: Vec<&Segment> = segments.into_iter().collect();
     close_each(
@@ -372,6 +378,7 @@ pub fn close_both<'a>(
         options,
         settings,
         halves(options, diagnosis_data),
+        progress,
     )
 }
 
@@ -401,6 +408,7 @@ fn close_each<'a>(
     options: &LoopOptions,
     settings: &FitSettings,
     halves: &[usize],
+    progress: &dyn Progress,
 ) -> Result<Vec<Closed<'a>>, FitError> {
     let roles = halves
         .iter()
@@ -411,7 +419,7 @@ fn close_each<'a>(
     let mut life: Vec<&Segment> = source.iter().chain(diagnosis_data).copied().collect();
     life.sort_by_key(|s| s.power_on_ns);
     let kept = kept_before(&life, settings, &fitted.by_history.settings, options.clock);
-    close_halves(fitted, roles, &life, &kept, settings, options)
+    close_halves(fitted, roles, &life, &kept, settings, options, progress)
 }
 
 /// [`close`] with the judging on a separate source: the roles, stage 3's and the initial bias's
@@ -431,6 +439,7 @@ pub fn close_separate<'a>(
     diagnosis_data: &[&'a Segment],
     options: &LoopOptions,
     settings: &FitSettings,
+    progress: &dyn Progress,
 ) -> Result<Closed<'a>, FitError> {
     let closed = close_separate_each(
         fitted,
@@ -440,6 +449,7 @@ pub fn close_separate<'a>(
         options,
         settings,
         &[options.half],
+        progress,
     )?;
     first_of(fitted, closed)
 }
@@ -452,6 +462,7 @@ pub fn close_separate_both<'a>(
     diagnosis_data: &[&'a Segment],
     options: &LoopOptions,
     settings: &FitSettings,
+    progress: &dyn Progress,
 ) -> Result<Vec<Closed<'a>>, FitError> {
     close_separate_each(
         fitted,
@@ -461,9 +472,11 @@ pub fn close_separate_both<'a>(
         options,
         settings,
         halves(options, diagnosis_data),
+        progress,
     )
 }
 
+#[allow(clippy::too_many_arguments)]
 fn close_separate_each<'a>(
     fitted: &FittedUnit,
     calibration_source: impl IntoIterator<Item = &'a Segment>,
@@ -472,6 +485,7 @@ fn close_separate_each<'a>(
     options: &LoopOptions,
     settings: &FitSettings,
     halves: &[usize],
+    progress: &dyn Progress,
 ) -> Result<Vec<Closed<'a>>, FitError> {
     let source: Vec<&Segment> = calibration_source.into_iter().collect();
     let evaluation: Vec<&Segment> = evaluation.into_iter().collect();
@@ -505,7 +519,21 @@ fn close_separate_each<'a>(
     let core = &fitted.by_history.settings;
     let mut kept = kept_before(&own, settings, core, options.clock);
     kept.extend(kept_before(&evaluation, settings, core, options.clock));
-    close_halves(fitted, roles, &life, &kept, settings, options)
+    close_halves(fitted, roles, &life, &kept, settings, options, progress)
+}
+
+/// One of a loop's rankings as [`RANKING`] over all of them: `before` axes were ranked by the
+/// rankings before it, of `total`.
+struct Ranked<'p> {
+    outer: &'p dyn Progress,
+    before: u64,
+    total: u64,
+}
+
+impl Progress for Ranked<'_> {
+    fn report(&self, _: &str, done: u64, _: u64) -> std::ops::ControlFlow<()> {
+        self.outer.report(RANKING, self.before + done, self.total)
+    }
 }
 
 /// The loop from its roles on, for each of `halves` (one, or two when the analyst's diagnosis
@@ -520,6 +548,7 @@ fn close_halves<'a>(
     kept: &[[Previous; 3]],
     settings: &FitSettings,
     options: &LoopOptions,
+    progress: &dyn Progress,
 ) -> Result<Vec<Closed<'a>>, FitError> {
     let Some(first) = halves.first() else {
         return Ok(Vec::new());
@@ -592,14 +621,22 @@ fn close_halves<'a>(
                 .collect()
         };
     let cross_fitted = halves.len() > 1;
+    let per_half = if paper_grid.is_some() { 2 } else { 1 };
+    let rankings = 3 * per_half * halves.len() as u64;
+    let ranked = |k: u64| Ranked {
+        outer: progress,
+        before: 3 * k,
+        total: rankings,
+    };
     halves
         .into_iter()
         .enumerate()
         .map(|(half, roles)| {
             let series = pick(&loop_grid, &roles);
-            let axes = diagnose(&series);
+            let first_ranking = per_half * half as u64;
+            let axes = diagnose(&series, &ranked(first_ranking))?;
             let paper_axes = match &paper_grid {
-                Some(grid) => diagnose(&pick(grid, &roles)),
+                Some(grid) => diagnose(&pick(grid, &roles), &ranked(first_ranking + 1))?,
                 None => axes.clone(),
             };
             let proposed = TermPlan::choose(&axes);

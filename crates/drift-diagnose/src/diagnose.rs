@@ -29,7 +29,7 @@
 use std::collections::BTreeMap;
 
 use drift_core::SwitchOnRate;
-use drift_recording::{Segment, SegmentLabels};
+use drift_recording::{Interrupted, Progress, Segment, SegmentLabels, Within};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -688,6 +688,7 @@ struct Round<'a> {
     fold_of: &'a [usize],
     folds: usize,
     alpha: f64,
+    progress: &'a dyn Progress,
 }
 
 impl Round<'_> {
@@ -701,7 +702,7 @@ impl Round<'_> {
         selected: &mut Vec<Selected>,
         threshold: f64,
         thermal_response: bool,
-    ) -> Null {
+    ) -> Result<Null, Interrupted> {
         let axis = self.axis;
         let mut first: Option<Null> = None;
         while selected.len() < MAX_SELECTED && !remaining.is_empty() {
@@ -733,7 +734,8 @@ impl Round<'_> {
                 },
                 &remaining,
                 (axis + 3 * selected.len() + if thermal_response { 0 } else { 30 }) as u64,
-            );
+                self.progress,
+            )?;
             let best = null
                 .observed
                 .iter()
@@ -757,11 +759,11 @@ impl Round<'_> {
                 thermal_response,
             });
         }
-        first.unwrap_or_else(|| Null {
+        Ok(first.unwrap_or_else(|| Null {
             observed: BTreeMap::new(),
             maxima: Vec::new(),
             baselines: Default::default(),
-        })
+        }))
     }
 }
 
@@ -781,12 +783,15 @@ impl Round<'_> {
 /// Selection is forward: the best candidate that is significant (shuffles) and large enough
 /// (gain ≥ [`size_threshold`]) joins the baseline and the rest are scored again over it, up to
 /// [`MAX_SELECTED`]. The ranking is the first round's; `significant` marks the selected.
+///
+/// `progress` is asked between shuffles whether to go on ([`Null::measure`]).
 pub fn diagnose_axis(
     activations: &[ActivationSeries],
     axis: usize,
     folds: usize,
     alpha: f64,
-) -> AxisDiagnosis {
+    progress: &dyn Progress,
+) -> Result<AxisDiagnosis, Interrupted> {
     let names: Vec<String> = activations
         .first()
         .map(|a| a.candidates[axis].keys().cloned().collect())
@@ -842,6 +847,7 @@ pub fn diagnose_axis(
         fold_of: &fold_of,
         folds,
         alpha,
+        progress,
     };
     // The unit's own thermal response first, then the effects over it: an effect is what is left
     // once the unit's heating is represented as well as a thermal calibration would.
@@ -849,9 +855,9 @@ pub fn diagnose_axis(
         .into_iter()
         .partition(|n| Kind::is_thermal_response(n));
     let mut selected: Vec<Selected> = Vec::new();
-    let response_first = round.select(response, &mut selected, threshold, true);
+    let response_first = round.select(response, &mut selected, threshold, true)?;
     let effect_threshold = effect_size_threshold(activations.len());
-    let effect_first = round.select(effects, &mut selected, effect_threshold, false);
+    let effect_first = round.select(effects, &mut selected, effect_threshold, false)?;
     // What the baseline alone explains: the first round that was measured.
     let baseline_alone = if response_first.observed.is_empty() {
         &effect_first.baselines
@@ -953,7 +959,7 @@ pub fn diagnose_axis(
         (None, Some(_)) => std::cmp::Ordering::Greater,
         (None, None) => b.explained.total_cmp(&a.explained),
     });
-    AxisDiagnosis {
+    Ok(AxisDiagnosis {
         axis: AXES[axis],
         activations: activations.len(),
         residual_rms_dps: rms,
@@ -965,12 +971,32 @@ pub fn diagnose_axis(
         baseline_explained_between: baseline_alone.between_share,
         selected,
         ranking,
-    }
+    })
 }
 
-/// Diagnoses all three axes.
-pub fn diagnose(activations: &[ActivationSeries]) -> [AxisDiagnosis; 3] {
-    [0, 1, 2].map(|axis| diagnose_axis(activations, axis, 5, 0.05))
+/// The step [`diagnose`] reports: axes ranked of 3.
+pub const RANKING: &str = "ranking the candidates per axis";
+
+/// Diagnoses all three axes, telling `progress` the axes done ([`RANKING`]) and asking it between
+/// shuffles whether to go on.
+pub fn diagnose(
+    activations: &[ActivationSeries],
+    progress: &dyn Progress,
+) -> Result<[AxisDiagnosis; 3], Interrupted> {
+    let rank = |axis: usize| {
+        let done = axis as u64;
+        progress.check(RANKING, done, 3)?;
+        let within = Within {
+            outer: progress,
+            step: RANKING,
+            done,
+            total: 3,
+        };
+        diagnose_axis(activations, axis, 5, 0.05, &within)
+    };
+    let axes = [rank(0)?, rank(1)?, rank(2)?];
+    progress.check(RANKING, 3, 3)?;
+    Ok(axes)
 }
 
 #[cfg(test)]

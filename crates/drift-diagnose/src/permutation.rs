@@ -19,6 +19,8 @@
 
 use std::collections::BTreeMap;
 
+use drift_recording::{Interrupted, Progress};
+
 use nalgebra::DMatrix;
 use rand::rngs::ChaCha8Rng;
 use rand::seq::SliceRandom;
@@ -29,6 +31,9 @@ use crate::gram::{cross_validate, Block};
 
 /// Shuffles per axis: the smallest p-value they can give is 1 / (SHUFFLES + 1) = 0.01.
 pub const SHUFFLES: usize = 99;
+
+/// The step [`Null::measure`] reports: shuffles done of [`SHUFFLES`].
+pub const SHUFFLING: &str = "shuffling the candidates";
 
 /// What is scored on one axis: per activation, its residual, its baseline columns (the paper
 /// model's known gaps and the bench's context, [`crate::diagnose`]), its candidates by name, and
@@ -230,8 +235,16 @@ pub struct Null {
 
 impl Null {
     /// Scores `names` as recorded and under [`SHUFFLES`] shuffles of the candidates within each
-    /// stratum. Deterministic: the shuffles are seeded by `seed` and their number.
-    pub fn measure(scored: &Scored, names: &[String], seed: u64) -> Self {
+    /// stratum. Deterministic: the shuffles are seeded by `seed` and their number. `progress` is
+    /// asked before each shuffle (`done` of [`SHUFFLES`]) whether to go on: a shuffle scores every
+    /// name once, milliseconds of work.
+    pub fn measure(
+        scored: &Scored,
+        names: &[String],
+        seed: u64,
+        progress: &dyn Progress,
+    ) -> Result<Self, Interrupted> {
+        progress.check(SHUFFLING, 0, SHUFFLES as u64)?;
         let identity: Vec<usize> = (0..scored.residuals.len()).collect();
         let own = scored.own();
         let baselines = scored.baselines(&own);
@@ -260,6 +273,7 @@ impl Null {
         let mut maxima: Vec<f64> = (0..SHUFFLES)
             .into_par_iter()
             .map(|k| {
+                progress.check(SHUFFLING, k as u64, SHUFFLES as u64)?;
                 let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(1 << 20) ^ k as u64);
                 let mut pairing = identity.clone();
                 for series in strata.values() {
@@ -282,18 +296,18 @@ impl Null {
                         }
                     }
                 }
-                names
+                Ok(names
                     .iter()
                     .map(|n| scored.statistic(&own, &baselines, n, &pairing).0)
-                    .fold(0.0, f64::max)
+                    .fold(0.0, f64::max))
             })
-            .collect();
+            .collect::<Result<_, Interrupted>>()?;
         maxima.sort_by(f64::total_cmp);
-        Self {
+        Ok(Self {
             observed,
             maxima,
             baselines,
-        }
+        })
     }
 
     /// Share of shuffles whose best candidate reached `share` (with the data as recorded counted
@@ -322,6 +336,8 @@ impl Null {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::ops::ControlFlow;
+    use std::sync::atomic::{AtomicU64, Ordering};
 
     /// Groups whose relation flips sign between folds count nothing: fold 0's groups run steeply
     /// the other way, so every fold trained with them has a negative slope and the one trained
@@ -372,7 +388,7 @@ mod tests {
         let series: Vec<usize> = (0..n as usize).map(|a| a / 3).collect();
         let fold_of: Vec<usize> = series.iter().map(|s| s % 5).collect();
         let names = ["shape".to_owned()];
-        let measure = |baseline: &[Vec<&[f64]>]| {
+        let measure = |baseline: &[Vec<&[f64]>], progress: &dyn Progress| {
             Null::measure(
                 &Scored {
                     residuals: &residual_refs,
@@ -385,10 +401,11 @@ mod tests {
                 },
                 &names,
                 1,
+                progress,
             )
         };
         let none: Vec<Vec<&[f64]>> = vec![Vec::new(); n as usize];
-        let found = measure(&none);
+        let found = measure(&none, drift_recording::QUIET).expect("QUIET never stops");
         let (share, _) = found.observed["shape"];
         assert!(share > 0.9, "{share}");
         assert!(
@@ -398,9 +415,27 @@ mod tests {
         );
         let explained_already: Vec<Vec<&[f64]>> =
             shapes.iter().map(|s| vec![s.as_slice()]).collect();
-        let known = measure(&explained_already);
+        let known = measure(&explained_already, drift_recording::QUIET).expect("QUIET never stops");
         assert!(known.observed["shape"].0 < 1e-6, "{:?}", known.observed);
         assert!(known.baselines.within_share > 0.9);
+        // Told to stop, it stops after a shuffle or so per thread, not at the end.
+        let stop = StopAfter(AtomicU64::new(0), 5);
+        assert_eq!(measure(&none, &stop), Err(Interrupted));
+        let asked = stop.0.load(Ordering::Relaxed);
+        assert!(asked < SHUFFLES as u64 / 2, "{asked}");
+    }
+
+    /// Asks to stop from its `n`-th report on, counting them.
+    struct StopAfter(AtomicU64, u64);
+
+    impl Progress for StopAfter {
+        fn report(&self, _: &str, _: u64, _: u64) -> ControlFlow<()> {
+            if self.0.fetch_add(1, Ordering::Relaxed) >= self.1 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        }
     }
 
     #[test]

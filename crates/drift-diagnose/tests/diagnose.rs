@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 
 use drift_diagnose::diagnose::{diagnose_axis, ActivationSeries};
-use drift_recording::{SegmentLabels, SeriesKind};
+use drift_recording::{SegmentLabels, SeriesKind, QUIET};
 
 /// Deterministic noise in [−1, 1).
 struct Lcg(u64);
@@ -79,7 +79,7 @@ fn run(
     let mut noise = Lcg(seed);
     let activations: Vec<ActivationSeries> =
         (0..60).map(|i| activation(i, effect, &mut noise)).collect();
-    diagnose_axis(&activations, 0, 5, 0.05)
+    diagnose_axis(&activations, 0, 5, 0.05, QUIET).expect("QUIET never stops")
 }
 
 #[test]
@@ -168,7 +168,7 @@ fn what_the_baseline_explains_is_no_discovery() {
             a
         })
         .collect();
-    let d = diagnose_axis(&activations, 0, 5, 0.05);
+    let d = diagnose_axis(&activations, 0, 5, 0.05, QUIET).expect("QUIET never stops");
     assert_eq!(d.baseline, ["ambient"]);
     assert!(d.baseline_explained_within > 0.5, "{d:?}");
     assert!(d.chosen().is_none(), "{:?}", d.chosen());
@@ -183,7 +183,7 @@ fn what_the_baseline_explains_is_no_discovery() {
             a
         })
         .collect();
-    let d = diagnose_axis(&without, 0, 5, 0.05);
+    let d = diagnose_axis(&without, 0, 5, 0.05, QUIET).expect("QUIET never stops");
     assert_eq!(d.chosen().map(|c| c.name.as_str()), Some("aux:housing"));
 }
 
@@ -240,7 +240,9 @@ fn the_thermal_response_is_selected_before_effects_and_is_not_one() {
         0,
         5,
         0.05,
-    );
+        QUIET,
+    )
+    .expect("QUIET never stops");
     let names: Vec<(&str, bool)> = d
         .selected
         .iter()
@@ -263,7 +265,14 @@ fn the_thermal_response_is_selected_before_effects_and_is_not_one() {
     assert!(d.size_threshold > 0.0 && d.response_size_threshold > 0.0);
 
     // The response alone: selected, and no effect beyond it.
-    let d = diagnose_axis(&with_sensor_rate(|rate, _, _| 0.05 * rate, 4), 0, 5, 0.05);
+    let d = diagnose_axis(
+        &with_sensor_rate(|rate, _, _| 0.05 * rate, 4),
+        0,
+        5,
+        0.05,
+        QUIET,
+    )
+    .expect("QUIET never stops");
     assert_eq!(d.selected.len(), 1, "{:#?}", d.selected);
     assert!(d.selected[0].thermal_response);
     assert!(d

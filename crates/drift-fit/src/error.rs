@@ -51,6 +51,9 @@ pub enum FitError {
         /// drift-core's validation error, naming the field.
         source: drift_core::Error,
     },
+    /// The caller's [`drift_recording::Progress`] asked the call to stop.
+    #[error(transparent)]
+    Interrupted(#[from] drift_recording::Interrupted),
     /// Settings out of range.
     #[error("fit setting `{field}`: {problem}")]
     Settings {

@@ -243,7 +243,7 @@ fn run_loop(
         options
             .bench_channels
             .extend(asked.bench_channels.iter().cloned());
-        let closed = close(unit, own, &[], &options, settings)?;
+        let closed = close(unit, own, &[], &options, settings, progress)?;
         step(2)?;
         if closed.series.is_empty() {
             return Err(Error::Input(format!(

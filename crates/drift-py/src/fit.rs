@@ -326,8 +326,9 @@ impl PyFittedUnit {
     /// loop ranks and fits on, the other half judges. `bench_channels` are context, never ranked
     /// (the chamber's set point and air always are). Like the command line, the loop works on the
     /// activations' 0.1-s block means and refits this unit's paper tables on its calibration
-    /// protocol among them. The GIL is released; Ctrl-C stops the loop within a second of reading
-    /// and between its steps, and `progress(step, done, total)` is told how far it got.
+    /// protocol among them. The GIL is released; Ctrl-C stops the loop within a second while it
+    /// reads or ranks and between its steps, and `progress(step, done, total)` is told how far it
+    /// got.
     #[pyo3(signature = (segments, *, calibration = None, extend = false, diagnose_on = Vec::new(), half = 0, bench_channels = Vec::new(), progress = None))]
     #[allow(clippy::too_many_arguments)]
     fn diagnose(

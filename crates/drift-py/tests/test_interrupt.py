@@ -7,6 +7,7 @@ from __future__ import annotations
 import _thread
 import signal
 import threading
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -89,6 +90,36 @@ def test_reading_and_diagnosing_stop(
     interrupted(lambda: unit.diagnose(segments * MANY))
     interrupted(lambda: unit.diagnose(many_files))
     interrupted(lambda: unit.evaluate_series(segments * MANY))
+
+
+def test_diagnosing_stops_within_a_second_while_it_ranks(
+    segments: list[gyrodrift.Segment], evaluation: gyrodrift.Evaluation
+) -> None:
+    """The ranking's shuffle tests are seconds of work on ten copies of the small campaign; Ctrl-C
+    sent when `progress` first hears of them stops the call well before they end."""
+    (unit,) = evaluation.fitted
+    ranking = "ranking the candidates per axis"
+    calls: list[tuple[str, int, int]] = []
+    sent: list[float] = []
+
+    def progress(step: str, done: int, total: int) -> None:
+        calls.append((step, done, total))
+        if step == ranking and not sent:
+            sent.append(time.monotonic())
+            _thread.interrupt_main()
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            unit.diagnose(segments * 10, progress=progress)
+        stopped = time.monotonic()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert sent, f"the ranking was never reported: {calls}"
+    assert stopped - sent[0] < 1.0, f"{stopped - sent[0]:.2f} s after the signal"
+    step, done, total = calls[-1]
+    assert step == ranking and done < total, calls
+    monotonic(calls)
 
 
 def test_after_an_interruption_the_same_call_runs_whole(

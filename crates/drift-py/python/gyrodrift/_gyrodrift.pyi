@@ -1261,8 +1261,8 @@ class FittedUnit:
         `gyrodrift diagnose --diagnose-on` does). `bench_channels` describe the bench and are never
         ranked (the chamber's set point and air always are). Like the command line, the loop
         works on the activations' 0.1-s block means and refits this unit's paper tables on its
-        calibration protocol among them. The GIL is released; Ctrl-C stops it while it reads and
-        between its steps, and `progress` is told the steps. Raises `InputError` (no activation
+        calibration protocol among them. The GIL is released; Ctrl-C stops it within a second while
+        it reads or ranks and between its steps, and `progress` is told the steps. Raises `InputError` (no activation
         of this unit to diagnose, `half` not 0 or 1) or `FitError`."""
     def save(self, folder: _Path) -> Path:
         """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} through
