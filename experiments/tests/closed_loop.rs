@@ -153,10 +153,17 @@ fn a_hidden_thermal_lag_is_closed_by_the_warm_starts_initial_bias() {
         assert!(r.after.1 < 0.85 * r.before.1, "{r:#?}");
     }
     assert!(rows.iter().any(|r| r.excess_cut() >= 2.0), "{rows:#?}");
-    // What is left is the rate's to explain (its own or a neighbour's), the capsule's slow rise,
-    // or a neighbour's rise (the axes heat together, and a neighbour's rise and rate carry the
-    // lagged heating the tables leave), when anything significant is left at all — never a
-    // channel — and only the element's rate is admitted.
+    // The element's rate is the unit's thermal response, selected first. What is left is the
+    // rate's to explain (its own or a neighbour's), the capsule's slow rise, or a neighbour's rise
+    // (the axes heat together, and a neighbour's rise and rate carry the lagged heating the
+    // tables leave), when anything significant is left at all, and only the element's rate is
+    // admitted. A channel times the rise, which is the rise scaled per activation, can reach
+    // significance over a response this large (4×, three sessions); the guard refuses it.
+    let channel_times_rise_refused = |r: &Row| {
+        r.top.starts_with("aux:")
+            && r.top.contains(" × rise ")
+            && !r.admitted.iter().any(|t| t.starts_with("aux:"))
+    };
     let neighbours_rise = |name: &str| {
         name.strip_prefix("rise ")
             .is_some_and(|axis| ["X", "Y", "Z"].contains(&axis))
@@ -167,7 +174,8 @@ fn a_hidden_thermal_lag_is_closed_by_the_warm_starts_initial_bias() {
             && (!r.significant
                 || drift_diagnose::candidates::Kind::rate_time_constant_s(&r.top).is_some()
                 || slow_shape(&r.top)
-                || neighbours_rise(&r.top))),
+                || neighbours_rise(&r.top)
+                || channel_times_rise_refused(r))),
         "{rows:#?}"
     );
     // Where the guard admitted the element's rate (on its drift test), the held-out drift fell.
