@@ -21,8 +21,11 @@ def load(path):
 
 
 def top_stable(axis):
-    """The best fold-stable candidate with a positive explained share, or None."""
+    """The best fold-stable effect (the unit's own thermal response aside) with a positive
+    explained share, or None."""
     for ranked, right in axis["ranking"]:
+        if ranked.get("thermal_response"):
+            continue
         if ranked["stable"] and ranked["explained"] > 0:
             return ranked, right
     return None

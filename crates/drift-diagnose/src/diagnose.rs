@@ -592,10 +592,11 @@ pub fn size_threshold(activations: usize) -> f64 {
 }
 
 /// The size threshold an effect's gain must reach, by how many activations the axis is diagnosed
-/// on, once the unit's own thermal response is in the baseline: the 95th percentile of the
-/// per-axis top effect gain on null worlds of `drift_sim::world` with a diagnosis campaign shaped
-/// like an analyst's (experiments/README.md, *The size threshold*). Pairs as
-/// [`SIZE_THRESHOLDS`].
+/// on, once the unit's own thermal response is in the baseline. Pairs as [`SIZE_THRESHOLDS`], and
+/// the same values: the independent simulator's. On null worlds of `drift_sim::world` with a
+/// diagnosis campaign shaped like an analyst's they leave 4 of 60 axes with a significant effect
+/// (experiments/README.md, *Full size, the unit's own thermal response selected first*); those
+/// worlds judged the values and did not set them.
 pub const EFFECT_SIZE_THRESHOLDS: [(usize, f64); 2] = [(100, 0.10), (0, 0.14)];
 
 /// The size threshold for an effect on an axis diagnosed on `activations` activations

@@ -362,12 +362,12 @@ impl PyDiagnosis {
     /// `explained` is the candidate's out-of-sample gain over the baseline (the paper model's
     /// ambient gap and the bench's context channels, fitted first); `significant` marks the
     /// candidates selected forward: significant family-wise (`family_p_value` ≤ 0.05, shuffles of
-    /// whole series) and with a gain of at least the size threshold (calibrated on null worlds).
-    /// `thermal_response` marks the unit's own thermal response (its rise squared, its own
-    /// axis's temperature rate), selected before any effect; every other candidate is an effect, scored
-    /// over the baseline and the thermal response selected, against `size_threshold`.
-    /// `detectable_share` is the gain an effect on that axis must exceed with these activations.
-    /// The t-tests' p-values are reported, not gated on.
+    /// whole series) and with a gain of at least `size_threshold` (its step's, from null worlds).
+    /// `thermal_response` marks the unit's own thermal response (its rise squared, its own axis's
+    /// temperature rate), selected before any effect; every other candidate is an effect, scored
+    /// over the baseline and the thermal response selected. `detectable_share` is the gain an
+    /// effect on that axis must exceed with these activations. The t-tests' p-values are
+    /// reported, not gated on.
     #[getter]
     fn ranking<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         to_python(py, &self.ranking)
@@ -547,7 +547,11 @@ fn records(axes: &[AxisDiagnosis; 3]) -> Vec<RankRecord<'_>> {
                 thermal_response: c.thermal_response,
                 stable: c.stable,
                 detectable_share: axis.detectable_share,
-                size_threshold: axis.size_threshold,
+                size_threshold: if c.thermal_response {
+                    axis.response_size_threshold
+                } else {
+                    axis.size_threshold
+                },
                 baseline_explained_within: axis.baseline_explained_within,
                 baseline_explained_between: axis.baseline_explained_between,
                 coefficient: c.coefficient,

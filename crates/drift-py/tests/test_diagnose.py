@@ -116,6 +116,7 @@ def test_the_ranking_is_records_with_every_axis(diagnosis: gyrodrift.Diagnosis) 
         "detectable_share",
         "drift_p_value",
         "significant",
+        "thermal_response",
         "absorbed_by_model",
         "size_threshold",
         "baseline_explained_within",
@@ -128,6 +129,12 @@ def test_the_ranking_is_records_with_every_axis(diagnosis: gyrodrift.Diagnosis) 
         for r in records
         if r["significant"]
     )
+    # The unit's own thermal response is selected before the effects, so on an axis every
+    # selected response ranks above every selected effect.
+    for axis in "XYZ":
+        ranked = sorted((r for r in records if r["axis"] == axis), key=lambda r: r["rank"])
+        kinds = [r["thermal_response"] for r in ranked if r["significant"]]
+        assert kinds == sorted(kinds, reverse=True), ranked[:4]
     assert all(0.0 <= r["baseline_explained_within"] <= 1.0 for r in records)
     assert all(0.0 <= r["detectable_share"] < 1.0 for r in records)
     counts = dict(diagnosis.activations)

@@ -1105,12 +1105,12 @@ class Diagnosis:
         `explained` is the candidate's out-of-sample gain over the baseline (the paper model's
         ambient gap and the bench's context channels, fitted first); `significant` marks the
         candidates selected forward: significant family-wise (`family_p_value` ≤ 0.05, shuffles of
-        whole series) and with a gain of at least the size threshold (calibrated on null worlds).
-        `thermal_response` marks the unit's own thermal response (its rise squared, its own
-        axis's temperature rate), selected before any effect; every other candidate is an effect, scored
-        over the baseline and the thermal response selected, against `size_threshold`.
-        `detectable_share` is the gain an effect on that axis must exceed with these activations.
-        The t-tests' p-values are reported, not gated on."""
+        whole series) and with a gain of at least `size_threshold` (its step's, from null worlds).
+        `thermal_response` marks the unit's own thermal response (its rise squared, its own axis's
+        temperature rate), selected before any effect; every other candidate is an effect, scored
+        over the baseline and the thermal response selected. `detectable_share` is the gain an
+        effect on that axis must exceed with these activations. The t-tests' p-values are
+        reported, not gated on."""
     @property
     def paper_ranking(self) -> list[dict[str, Any]]:
         """The same diagnosis behind the paper's own model (stage 3 keyed by rise, the paper's
@@ -1262,8 +1262,8 @@ class FittedUnit:
         ranked (the chamber's set point and air always are). Like the command line, the loop
         works on the activations' 0.1-s block means and refits this unit's paper tables on its
         calibration protocol among them. The GIL is released; Ctrl-C stops it within a second while
-        it reads or ranks and between its steps, and `progress` is told the steps. Raises `InputError` (no activation
-        of this unit to diagnose, `half` not 0 or 1) or `FitError`."""
+        it reads or ranks and between its steps, and `progress` is told the steps. Raises
+        `InputError` (no activation of this unit to diagnose, `half` not 0 or 1) or `FitError`."""
     def save(self, folder: _Path) -> Path:
         """Writes <folder>/<unit_id>/{modified,by_history,standard,third_order}.{json,bin} through
         the command line's own writer (the same bytes as `gyrodrift fit`); returns the unit's
