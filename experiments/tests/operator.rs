@@ -39,9 +39,13 @@ fn calibration() -> Vec<Segment> {
         .collect()
 }
 
-/// A candidate that is no function of the tables' inputs alone: a slow wobble per activation
-/// times the rise, with an offset that differs from one activation to the next.
-fn candidate(segment: &Segment, settings: &FitSettings) -> [Vec<f32>; 3] {
+/// A quantity per sample and axis: `value(rise °C, seconds since switch-on, phase)`, where the
+/// phase differs from one activation to the next.
+fn per_sample(
+    segment: &Segment,
+    settings: &FitSettings,
+    value: impl Fn(f64, f64, f64) -> f64,
+) -> [Vec<f32>; 3] {
     let on = switch_on_raw(segment, settings);
     let phase = f64::from(segment.labels.activation) + 0.3 * f64::from(segment.labels.series);
     std::array::from_fn(|a| {
@@ -51,9 +55,17 @@ fn candidate(segment: &Segment, settings: &FitSettings) -> [Vec<f32>; 3] {
             .map(|(i, &t)| {
                 let s = i as f64 / f64::from(segment.sample_rate_hz);
                 let rise = (f64::from(t) - f64::from(on[a])) / 200.0;
-                (rise * (0.05 * s + phase).sin() + 0.2 * phase.cos()) as f32
+                value(rise, s, phase) as f32
             })
             .collect()
+    })
+}
+
+/// A candidate that is no function of the tables' inputs alone: a slow wobble per activation
+/// times the rise, with an offset that differs from one activation to the next.
+fn candidate(segment: &Segment, settings: &FitSettings) -> [Vec<f32>; 3] {
+    per_sample(segment, settings, |rise, s, phase| {
+        rise * (0.05 * s + phase).sin() + 0.2 * phase.cos()
     })
 }
 
@@ -157,19 +169,9 @@ fn the_tables_leave_of_g_plus_cx_what_they_leave_of_g_plus_c_times_x_less_lx() {
 #[test]
 fn a_quantity_near_a_thousand_units_times_the_rise_is_absorbed_as_the_tables_would() {
     let pressure_times_rise = |segment: &Segment, settings: &FitSettings| -> [Vec<f32>; 3] {
-        let on = switch_on_raw(segment, settings);
-        let phase = f64::from(segment.labels.activation) + 0.3 * f64::from(segment.labels.series);
-        std::array::from_fn(|a| {
-            segment.temperature_raw[a]
-                .iter()
-                .enumerate()
-                .map(|(i, &t)| {
-                    let s = i as f64 / f64::from(segment.sample_rate_hz);
-                    let rise = (f64::from(t) - f64::from(on[a])) / 200.0;
-                    let hpa = 1000.0 + 3.0 * (0.05 * s + phase).sin() + 2.0 * phase.cos();
-                    (hpa * rise) as f32
-                })
-                .collect()
+        per_sample(segment, settings, |rise, s, phase| {
+            let hpa = 1000.0 + 3.0 * (0.05 * s + phase).sin() + 2.0 * phase.cos();
+            hpa * rise
         })
     };
     // 2·10⁻⁴ (°/s)/(hPa·°C): about 2 °/s of drift at a rise of 10 °C, nearly all of it the

@@ -585,7 +585,12 @@ pub const SIZE_THRESHOLDS: [(usize, f64); 2] = [(100, 0.10), (0, 0.14)];
 
 /// The size threshold for an axis diagnosed on `activations` activations ([`SIZE_THRESHOLDS`]).
 pub fn size_threshold(activations: usize) -> f64 {
-    SIZE_THRESHOLDS
+    threshold_at(&SIZE_THRESHOLDS, activations)
+}
+
+/// The threshold of a table of (at least this many activations, threshold) pairs, descending.
+fn threshold_at(table: &[(usize, f64)], activations: usize) -> f64 {
+    table
         .iter()
         .find(|(at_least, _)| activations >= *at_least)
         .map_or(1.0, |(_, tau)| *tau)
@@ -602,10 +607,7 @@ pub const EFFECT_SIZE_THRESHOLDS: [(usize, f64); 2] = [(100, 0.10), (0, 0.14)];
 /// The size threshold for an effect on an axis diagnosed on `activations` activations
 /// ([`EFFECT_SIZE_THRESHOLDS`]).
 pub fn effect_size_threshold(activations: usize) -> f64 {
-    EFFECT_SIZE_THRESHOLDS
-        .iter()
-        .find(|(at_least, _)| activations >= *at_least)
-        .map_or(1.0, |(_, tau)| *tau)
+    threshold_at(&EFFECT_SIZE_THRESHOLDS, activations)
 }
 
 /// One candidate selected into the baseline, in order.
