@@ -736,6 +736,8 @@ impl Round<'_> {
                     folds: self.folds,
                 },
                 &remaining,
+                // The effect step draws its own shuffles: after a response step that selected
+                // nothing it would otherwise replay that step's draws.
                 (axis + 3 * selected.len() + if thermal_response { 0 } else { 30 }) as u64,
                 self.progress,
             )?;
@@ -783,9 +785,13 @@ impl Round<'_> {
 /// switch-on to the next, e.g. supply voltage or orientation). The better level is reported; the
 /// shuffles' winners are the best of both levels of every candidate, so the test covers both.
 ///
-/// Selection is forward: the best candidate that is significant (shuffles) and large enough
-/// (gain ≥ [`size_threshold`]) joins the baseline and the rest are scored again over it, up to
-/// [`MAX_SELECTED`]. The ranking is the first round's; `significant` marks the selected.
+/// Selection is forward, in two steps: first among the unit's own thermal response
+/// ([`Kind::is_thermal_response`]), then among every other candidate (the effects) over the
+/// baseline and the response selected. In each, the best candidate that is significant
+/// (shuffles) and large enough (gain ≥ [`size_threshold`], for an effect
+/// [`effect_size_threshold`]) joins the baseline and the rest are scored again over it, up to
+/// [`MAX_SELECTED`] in all. Each candidate's ranking figures are its step's first round;
+/// `significant` marks the selected.
 ///
 /// `progress` is asked between shuffles whether to go on ([`Null::measure`]).
 pub fn diagnose_axis(
