@@ -36,7 +36,8 @@ use serde::Serialize;
 use crate::absorb::Absorber;
 use crate::candidates::{Kind, AMBIENT_CHANNEL, SET_POINT_CHANNEL};
 use crate::keying::Keying;
-use crate::permutation::{Level, Null, Scored};
+use crate::permutation::Level;
+use crate::selection::{effect_size_threshold, size_threshold, Round, Selected};
 use crate::statistics::one_sided_mean_test;
 use crate::switch_on_rate::start_rates;
 use drift_evaluate::evaluate::{
@@ -569,61 +570,6 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     sum / n.max(1) as f64
 }
 
-/// At most this many candidates are selected per axis, one after the other into the baseline
-/// (drift-core's `MAX_TERMS`).
-pub const MAX_SELECTED: usize = drift_core::MAX_TERMS;
-
-/// The practical size a candidate's gain must reach besides its shuffle test, by how many
-/// activations the axis is diagnosed on: the 95th percentile of the per-axis top gain over the
-/// baseline on null worlds (no effect drawn) of an independent simulator of the unit, where the
-/// shuffle test alone is liberal on a structured residual (`../shared/design/closed-loop.md`:
-/// ≈ 0.10 on ~100 activations, ≈ 0.14 on half as many). Pairs (at least this many activations,
-/// threshold), descending by size. On this repository's own drawn worlds the same percentile is
-/// larger (experiments/README.md, *The size threshold*): their units' thermal structure is
-/// more than the paper's model represents.
-pub const SIZE_THRESHOLDS: [(usize, f64); 2] = [(100, 0.10), (0, 0.14)];
-
-/// The size threshold for an axis diagnosed on `activations` activations ([`SIZE_THRESHOLDS`]).
-pub fn size_threshold(activations: usize) -> f64 {
-    threshold_at(&SIZE_THRESHOLDS, activations)
-}
-
-/// The threshold of a table of (at least this many activations, threshold) pairs, descending.
-fn threshold_at(table: &[(usize, f64)], activations: usize) -> f64 {
-    table
-        .iter()
-        .find(|(at_least, _)| activations >= *at_least)
-        .map_or(1.0, |(_, tau)| *tau)
-}
-
-/// The size threshold an effect's gain must reach, by how many activations the axis is diagnosed
-/// on, once the unit's own thermal response is in the baseline. Pairs as [`SIZE_THRESHOLDS`], and
-/// the same values: the independent simulator's. On null worlds of `drift_sim::world` with a
-/// diagnosis campaign shaped like an analyst's they leave 4 of 60 axes with a significant effect
-/// (experiments/README.md, *Full size, the unit's own thermal response selected first*); those
-/// worlds judged the values and did not set them.
-pub const EFFECT_SIZE_THRESHOLDS: [(usize, f64); 2] = [(100, 0.10), (0, 0.14)];
-
-/// The size threshold for an effect on an axis diagnosed on `activations` activations
-/// ([`EFFECT_SIZE_THRESHOLDS`]).
-pub fn effect_size_threshold(activations: usize) -> f64 {
-    threshold_at(&EFFECT_SIZE_THRESHOLDS, activations)
-}
-
-/// One candidate selected into the baseline, in order.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Selected {
-    /// Its name.
-    pub name: String,
-    /// Its cross-validated gain over the baseline and the candidates selected before it.
-    pub gain: f64,
-    /// Its family-wise p-value in that round.
-    pub family_p_value: f64,
-    /// Selected as part of the unit's own thermal response ([`Kind::is_thermal_response`]),
-    /// before any effect was sought, rather than as an effect.
-    pub thermal_response: bool,
-}
-
 /// Each activation's series as an index unique within its stratum (unit, nominal set point): what
 /// the shuffles move whole.
 fn series_index(activations: &[ActivationSeries]) -> Vec<usize> {
@@ -679,99 +625,6 @@ fn partialled(
         .collect()
 }
 
-/// What every round of one axis's forward selection shares.
-struct Round<'a> {
-    activations: &'a [ActivationSeries],
-    axis: usize,
-    baseline: &'a [String],
-    residuals: &'a [&'a [f64]],
-    candidates: &'a [&'a BTreeMap<String, Vec<f64>>],
-    strata: &'a [usize],
-    series: &'a [usize],
-    fold_of: &'a [usize],
-    folds: usize,
-    alpha: f64,
-    progress: &'a dyn Progress,
-}
-
-impl Round<'_> {
-    /// Forward selection among `remaining` over the baseline and `selected` (which it extends,
-    /// up to [`MAX_SELECTED`] in all): each round scores what is left over both, and the best
-    /// candidate joins when it is significant (shuffles) and its gain reaches `threshold`.
-    /// Returns the first round's shuffle test (what the ranking reports).
-    fn select(
-        &self,
-        mut remaining: Vec<String>,
-        selected: &mut Vec<Selected>,
-        threshold: f64,
-        thermal_response: bool,
-    ) -> Result<Null, Interrupted> {
-        let axis = self.axis;
-        let mut first: Option<Null> = None;
-        while selected.len() < MAX_SELECTED && !remaining.is_empty() {
-            let columns: Vec<Vec<&[f64]>> = self
-                .activations
-                .iter()
-                .map(|a| {
-                    self.baseline
-                        .iter()
-                        .filter_map(|n| a.baseline[axis].get(n))
-                        .chain(
-                            selected
-                                .iter()
-                                .filter_map(|c| a.left_over[axis].get(&c.name)),
-                        )
-                        .map(Vec::as_slice)
-                        .collect()
-                })
-                .collect();
-            let null = Null::measure(
-                &Scored {
-                    residuals: self.residuals,
-                    baseline: &columns,
-                    candidates: self.candidates,
-                    strata: self.strata,
-                    series: self.series,
-                    fold_of: self.fold_of,
-                    folds: self.folds,
-                },
-                &remaining,
-                // The effect step draws its own shuffles: after a response step that selected
-                // nothing it would otherwise replay that step's draws.
-                (axis + 3 * selected.len() + if thermal_response { 0 } else { 30 }) as u64,
-                self.progress,
-            )?;
-            let best = null
-                .observed
-                .iter()
-                .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
-                .map(|(n, (gain, _))| (n.clone(), *gain));
-            let chosen = best.filter(|(_, gain)| {
-                *gain > 0.0 && *gain >= threshold && null.p_value(*gain) <= self.alpha
-            });
-            let p_value = chosen.as_ref().map(|(_, gain)| null.p_value(*gain));
-            if first.is_none() {
-                first = Some(null);
-            }
-            let (Some((name, gain)), Some(family_p_value)) = (chosen, p_value) else {
-                break;
-            };
-            remaining.retain(|n| *n != name);
-            selected.push(Selected {
-                family_p_value,
-                name,
-                gain,
-                thermal_response,
-            });
-        }
-        Ok(first.unwrap_or_else(|| Null {
-            observed: BTreeMap::new(),
-            maxima: Vec::new(),
-            baselines: Default::default(),
-        }))
-    }
-}
-
 /// Scores every candidate on one axis of `activations` with `folds`-fold cross-validation by
 /// series ([`series_folds`]); `alpha` is the family-wise significance level for the axis, held by
 /// the shuffle test ([`crate::permutation`]).
@@ -790,10 +643,10 @@ impl Round<'_> {
 /// baseline and the response selected. In each, the best candidate that is significant
 /// (shuffles) and large enough (gain ≥ [`size_threshold`], for an effect
 /// [`effect_size_threshold`]) joins the baseline and the rest are scored again over it, up to
-/// [`MAX_SELECTED`] in all. Each candidate's ranking figures are its step's first round;
+/// [`MAX_SELECTED`](crate::selection::MAX_SELECTED) in all. Each candidate's ranking figures are its step's first round;
 /// `significant` marks the selected.
 ///
-/// `progress` is asked between shuffles whether to go on ([`Null::measure`]).
+/// `progress` is asked between shuffles whether to go on ([`Null::measure`](crate::permutation::Null::measure)).
 pub fn diagnose_axis(
     activations: &[ActivationSeries],
     axis: usize,
@@ -845,10 +698,12 @@ pub fn diagnose_axis(
     let strata = set_point_strata(activations);
     let series = series_index(activations);
     let threshold = size_threshold(activations.len());
+    let baselines: Vec<&BTreeMap<String, Vec<f64>>> =
+        activations.iter().map(|a| &a.baseline[axis]).collect();
     let round = Round {
-        activations,
         axis,
         baseline: &baseline,
+        baselines: &baselines,
         residuals: &residuals,
         candidates: &candidates,
         strata: &strata,

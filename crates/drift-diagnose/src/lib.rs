@@ -4,7 +4,8 @@
 //!
 //! One way through, for one unit ([`closing::close`]): activations by role ([`roles`]) → stage 3's
 //! lookup and the initial bias chosen per axis ([`keying`], [`warm_start`]) → the diagnosis of the
-//! residual ([`diagnose`], over [`candidates`] with what the tables absorb taken out, [`absorb`]) →
+//! residual ([`diagnose`], over [`candidates`] with what the tables absorb taken out, [`absorb`],
+//! selected forward by [`selection`]) →
 //! extra terms ([`extend`], with the temperature-rate filter's start from [`switch_on_rate`]) →
 //! the error before and after on held-out activations.
 
@@ -19,6 +20,7 @@ pub mod gram;
 pub mod keying;
 pub mod permutation;
 pub mod roles;
+pub mod selection;
 pub mod statistics;
 pub mod switch_on_rate;
 pub mod warm_start;

@@ -6,7 +6,8 @@ use std::fmt::Write as _;
 use drift_diagnose::closing::{
     mean_profiles, profile_bin_labels, BeforeAfter, Closed, Profile, Stage3Choice,
 };
-use drift_diagnose::diagnose::{AxisDiagnosis, Selected};
+use drift_diagnose::diagnose::AxisDiagnosis;
+use drift_diagnose::selection::Selected;
 use drift_diagnose::warm_start::WarmStartChoice;
 use drift_fit::FittedUnit;
 
