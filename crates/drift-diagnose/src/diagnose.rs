@@ -372,9 +372,13 @@ pub struct AxisDiagnosis {
 }
 
 impl AxisDiagnosis {
-    /// The winning candidate, if any is significant.
+    /// The winning effect, if any is significant: the first effect selected (the unit's own
+    /// thermal response, selected before it, is no finding).
     pub fn chosen(&self) -> Option<&CandidateScore> {
-        self.ranking.first().filter(|c| c.significant)
+        self.ranking
+            .iter()
+            .find(|c| !c.thermal_response)
+            .filter(|c| c.significant)
     }
 }
 

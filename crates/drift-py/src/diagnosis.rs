@@ -392,8 +392,8 @@ impl PyDiagnosis {
         pandas.call_method1("DataFrame", (to_python(py, &self.ranking)?,))
     }
 
-    /// Per axis ("X", "Y", "Z"), the significant winner's name, or None when no significant
-    /// systematic effect is left.
+    /// Per axis ("X", "Y", "Z"), the significant winning effect's name, or None when no
+    /// significant systematic effect is left beyond the unit's own thermal response.
     #[getter]
     fn chosen(&self) -> Vec<(String, Option<String>)> {
         self.chosen.clone()

@@ -1121,8 +1121,8 @@ class Diagnosis:
         """The ranking as a pandas DataFrame (needs pandas; raises ImportError without it)."""
     @property
     def chosen(self) -> list[tuple[str, str | None]]:
-        """Per axis ("X", "Y", "Z"), the significant winner's name, or None when no significant
-        systematic effect is left."""
+        """Per axis ("X", "Y", "Z"), the significant winning effect's name, or None when no
+        significant systematic effect is left beyond the unit's own thermal response."""
     @property
     def proposed_terms(self) -> list[str]:
         """The terms proposed for the extended model: the diagnosis's significant candidates that

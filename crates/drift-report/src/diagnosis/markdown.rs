@@ -272,12 +272,12 @@ pub(super) fn paper_markdown(axes: &[AxisDiagnosis], top: usize) -> String {
     md
 }
 
-/// Per axis, the significant winner and the admitted terms of one half's loop.
+/// Per axis, the significant winning effect and the admitted terms of one half's loop.
 fn findings(closed: &Closed<'_>) -> [(String, Vec<String>); 3] {
     std::array::from_fn(|axis| {
         let winner = closed.axes[axis]
             .chosen()
-            .map_or_else(|| "nothing significant".to_owned(), |c| c.name.clone());
+            .map_or_else(|| "no effect significant".to_owned(), |c| c.name.clone());
         let admitted = closed
             .extended
             .iter()
