@@ -133,19 +133,18 @@ impl Round<'_> {
                 (axis + 3 * selected.len() + if thermal_response { 0 } else { 30 }) as u64,
                 self.progress,
             )?;
-            let best = null
+            let chosen = null
                 .observed
                 .iter()
                 .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
-                .map(|(n, (gain, _))| (n.clone(), *gain));
-            let chosen = best.filter(|(_, gain)| {
-                *gain > 0.0 && *gain >= threshold && null.p_value(*gain) <= self.alpha
-            });
-            let p_value = chosen.as_ref().map(|(_, gain)| null.p_value(*gain));
+                .map(|(n, (gain, _))| (n.clone(), *gain, null.p_value(*gain)))
+                .filter(|&(_, gain, p_value)| {
+                    gain > 0.0 && gain >= threshold && p_value <= self.alpha
+                });
             if first.is_none() {
                 first = Some(null);
             }
-            let (Some((name, gain)), Some(family_p_value)) = (chosen, p_value) else {
+            let Some((name, gain, family_p_value)) = chosen else {
                 break;
             };
             remaining.retain(|n| *n != name);
