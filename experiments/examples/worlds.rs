@@ -122,6 +122,7 @@ fn one_world(
             &paths.dir.display().to_string(),
             &diagnosis_text,
             &paths.oracle_dir.display().to_string(),
+            &paths.floor_dir.display().to_string(),
             select_flag,
         ])
         .map(Some),
@@ -139,7 +140,8 @@ fn one_world(
 /// A child's part: `--child-record <kind> <seed> <work> <small: yes|no> <diagnosis series>`
 /// records one world; `--child-loop <world dir> <floor dir> <small: yes|no> <select on +33 °C:
 /// yes|no> <diagnosis dir or ->` closes the loop on the recordings folders; `--child-oracle
-/// <world dir> <diagnosis dir or -> <oracle dir> <select: yes|no>` scores the true regressor.
+/// <world dir> <diagnosis dir or -> <oracle dir> <floor dir> <select: yes|no>` closes it again
+/// with the true regressor among the candidates.
 fn child_part(args: &[String]) -> anyhow::Result<()> {
     let small = |i: usize| args.get(i).is_some_and(|s| s == "yes");
     let arg = |i: usize| args.get(i).context("missing a child argument");
@@ -156,8 +158,9 @@ fn child_part(args: &[String]) -> anyhow::Result<()> {
             Path::new(arg(1)?),
             (diagnosis != "-").then(|| Path::new(diagnosis)),
             Path::new(arg(3)?),
+            Path::new(arg(4)?),
             &fit_settings(),
-            small(4),
+            small(5),
         )?)?
     } else {
         // Sees the two recordings folders and nothing else.

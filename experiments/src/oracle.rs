@@ -4,7 +4,9 @@
 //! the loop's own diagnosis — the same fit, baseline, folds, shuffles and size threshold as the
 //! blind run — scores it beside the candidates. Its gain on its own axis is what the effect itself
 //! explains beyond the baseline: an axis where even the true regressor stays under the detectable
-//! share cannot have the effect found by any regressor built from the recordings.
+//! share cannot have the effect found by any regressor built from the recordings. The oracle's
+//! loop extends the model as the blind one does, so its held-out drift excess cut is what an
+//! analysis that knows the truth cuts on the same activations.
 //!
 //! Run after the blind loop, in a process of its own (it reads the truth).
 
@@ -13,6 +15,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use drift_diagnose::activations::at_diagnosis_rate;
+use drift_evaluate::excess::{excess_cut, ExcessCut};
 use drift_fit::FitSettings;
 use drift_recording::{read_recording, AuxChannel, Segment, RECORDINGS_DIR, TRUTH_EXTENSION};
 use drift_sim::truth::read_truth;
@@ -20,6 +23,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::memory::peak_rss_mb;
 use crate::world_loop::fit_and_close;
+use crate::worlds::judged_axes;
+
+/// How a candidate or term built on a truth channel is named.
+const ORACLE_TERM: &str = "aux:oracle_";
 
 /// The recorded channel that carries the truth on axis `axis`.
 pub fn oracle_channel(axis: usize) -> String {
@@ -88,6 +95,14 @@ pub struct OracleAxis {
     pub absorbed_by_model: f64,
     /// Where it shows (within or between activations, or absorbed).
     pub level: String,
+    /// Whether the guard admitted a term of the truth (this axis's or another's: a channel's
+    /// effect moves every axis alike) into the extended model on the axis.
+    pub admitted: bool,
+    /// Every term the oracle's loop admitted on the axis (the unit's thermal response included).
+    pub terms: Vec<String>,
+    /// The held-out drift excess cut of the oracle's extended model, as the blind loop's is
+    /// measured (the same activations and floor).
+    pub cut: ExcessCut,
 }
 
 impl OracleAxis {
@@ -109,13 +124,14 @@ pub struct OracleOutcome {
     pub peak_rss_mb: f64,
 }
 
-/// The oracle's run: the blind loop's diagnosis (same options, no extension) on recordings that
-/// carry the truth as channels. `oracle_dir` holds the sidecars of `dir` (`world/`) and of
-/// `diagnosis_dir` (`diagnosis/`).
+/// The oracle's run: the blind loop (same options, extended model on) on recordings that carry
+/// the truth as channels, judged beside the twin in `floor_dir`. `oracle_dir` holds the sidecars
+/// of `dir` (`world/`) and of `diagnosis_dir` (`diagnosis/`).
 pub fn close_oracle(
     dir: &Path,
     diagnosis_dir: Option<&Path>,
     oracle_dir: &Path,
+    floor_dir: &Path,
     settings: &FitSettings,
     select_on_validation: bool,
 ) -> anyhow::Result<OracleOutcome> {
@@ -126,10 +142,12 @@ pub fn close_oracle(
         None => Vec::new(),
     };
     let diagnosis: Vec<&Segment> = diagnosis.iter().collect();
-    let (_, closed) = fit_and_close(&all, &diagnosis, false, select_on_validation, settings)?;
+    let (base, closed) = fit_and_close(&all, &diagnosis, true, select_on_validation, settings)?;
+    let judged = judged_axes(&base, &closed, floor_dir, settings)?;
     let axes = (0..3)
         .map(|a| {
             let d = &closed.axes[a];
+            let j = &judged[a];
             let name = format!("aux:{}", oracle_channel(a));
             d.ranking.iter().position(|c| c.name == name).map(|rank| {
                 let c = &d.ranking[rank];
@@ -141,6 +159,9 @@ pub fn close_oracle(
                     rank: rank + 1,
                     absorbed_by_model: c.absorbed_by_model,
                     level: c.level.to_owned(),
+                    admitted: j.admitted.iter().any(|t| t.starts_with(ORACLE_TERM)),
+                    terms: j.admitted.clone(),
+                    cut: excess_cut(&j.before_dps, &j.after_dps, &j.floor_dps),
                 }
             })
         })

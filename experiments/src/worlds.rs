@@ -18,8 +18,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
+use drift_diagnose::closing::Closed;
 use drift_evaluate::evaluate;
 use drift_evaluate::excess::{excess_cut, ExcessCut};
+use drift_fit::fit::FittedUnit;
 use drift_fit::FitSettings;
 use drift_recording::{paper, Segment, SeriesKind, RECORDINGS_DIR, TRUTH_DIR};
 use drift_sim::world::effects::{EffectFamily, Source};
@@ -330,8 +332,26 @@ pub fn close_blind(
     };
     let diagnosis: Vec<&Segment> = diagnosis.iter().collect();
     let (base, closed) = fit_and_close(&all, &diagnosis, true, select_on_validation, settings)?;
+    let axes = judged_axes(&base, &closed, floor_dir, settings)?;
+    Ok(Outcome {
+        axes,
+        training_activations: closed.roles.training.len(),
+        seconds: started.elapsed().as_secs_f64(),
+        peak_rss_mb: peak_rss_mb(),
+    })
+}
+
+/// What the closed loop said on each axis, and the drift of every held-out +33 °C field
+/// activation before (the paper's tables, `base`) and after (the loop's model) beside the
+/// twin's in `floor_dir` (the noise floor).
+pub fn judged_axes(
+    base: &FittedUnit,
+    closed: &Closed,
+    floor_dir: &Path,
+    settings: &FitSettings,
+) -> anyhow::Result<Vec<AxisOutcome>> {
     let measured: Vec<_> = closed
-        .before_after(&base, settings)
+        .before_after(base, settings)
         .into_iter()
         .filter(|r| r.series_kind == "field" && is(VALIDATION, r.set_point_celsius))
         .collect();
@@ -344,7 +364,22 @@ pub fn close_blind(
         })
         .collect();
     let floor = evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_s);
-    let axes = (0..3)
+    let on_axis = |a: usize, admitted: bool| -> Vec<String> {
+        closed
+            .extended
+            .iter()
+            .flat_map(|e| &e.admissions)
+            .filter(|x| x.axis == AXES[a] && x.admitted == admitted)
+            .map(|x| {
+                if admitted {
+                    x.candidate.clone()
+                } else {
+                    format!("{}: {}", x.candidate, x.reason)
+                }
+            })
+            .collect()
+    };
+    Ok((0..3)
         .map(|a| {
             let diagnosis = &closed.axes[a];
             AxisOutcome {
@@ -368,32 +403,14 @@ pub fn close_blind(
                     .iter()
                     .any(|c| c.significant && !c.thermal_response),
                 detectable_share: diagnosis.detectable_share,
-                admitted: closed
-                    .extended
-                    .iter()
-                    .flat_map(|e| &e.admissions)
-                    .filter(|x| x.axis == AXES[a] && x.admitted)
-                    .map(|x| x.candidate.clone())
-                    .collect(),
-                refused: closed
-                    .extended
-                    .iter()
-                    .flat_map(|e| &e.admissions)
-                    .filter(|x| x.axis == AXES[a] && !x.admitted)
-                    .map(|x| format!("{}: {}", x.candidate, x.reason))
-                    .collect(),
+                admitted: on_axis(a, true),
+                refused: on_axis(a, false),
                 before_dps: measured.iter().map(|r| r.drift_dps[a].0).collect(),
                 after_dps: measured.iter().map(|r| r.drift_dps[a].1).collect(),
                 floor_dps: floor.iter().map(|p| p[a].0).collect(),
             }
         })
-        .collect();
-    Ok(Outcome {
-        axes,
-        training_activations: closed.roles.training.len(),
-        seconds: started.elapsed().as_secs_f64(),
-        peak_rss_mb: peak_rss_mb(),
-    })
+        .collect())
 }
 
 /// The families a candidate's name points at (what "the right family" means). The auxiliary
@@ -645,6 +662,7 @@ pub fn run_world(
             &paths.dir,
             None,
             &paths.oracle_dir,
+            &paths.floor_dir,
             &fit_settings(),
             false,
         )),
@@ -707,6 +725,19 @@ fn median(sorted: &[f64]) -> f64 {
     }
 }
 
+/// "median (lowest–highest)" of sorted cuts, "–" for none.
+fn cut_range(sorted: &[f64]) -> String {
+    match (sorted.first(), sorted.last()) {
+        (Some(&low), Some(&high)) => format!(
+            "{} ({}–{})",
+            ratio_text(median(sorted)),
+            ratio_text(low),
+            ratio_text(high)
+        ),
+        _ => "–".to_owned(),
+    }
+}
+
 /// The cuts of axes with an excess to cut (before above the floor), sorted.
 fn cuts(axes: &[&AxisScore]) -> Vec<f64> {
     let mut v: Vec<f64> = axes
@@ -733,8 +764,8 @@ pub struct Failure {
 /// the worlds that failed, which no other row counts).
 pub fn table(scores: &[WorldScore], failures: &[Failure], kinds: &[Kind]) -> String {
     let mut out = String::new();
-    out.push_str("| family | worlds | affected axes | oracle: true regressor's gain, median (range) | oracle-detectable axes | right family first and significant among them | right family ranked first and significant | right family first (any significance) | right family admitted | drift excess cut, median (range) | axes surely worse than 0.9× |\n");
-    out.push_str("|---|---:|---:|---|---:|---|---|---|---|---|---:|\n");
+    out.push_str("| family | worlds | affected axes | oracle: true regressor's gain, median (range) | oracle-detectable axes | right family first and significant among them | right family ranked first and significant | right family first (any significance) | right family admitted | drift excess cut, median (range) | oracle: drift excess cut where it admitted a term, median (range) | axes surely worse than 0.9× |\n");
+    out.push_str("|---|---:|---:|---|---:|---|---|---|---|---|---|---:|\n");
     for kind in kinds.iter().filter(|k| **k != Kind::Null) {
         let worlds: Vec<&WorldScore> = scores.iter().filter(|s| s.kind == kind.name()).collect();
         let affected: Vec<&AxisScore> = worlds
@@ -744,17 +775,15 @@ pub fn table(scores: &[WorldScore], failures: &[Failure], kinds: &[Kind]) -> Str
             .collect();
         let n = affected.len();
         let count = |f: &dyn Fn(&AxisScore) -> bool| affected.iter().filter(|a| f(a)).count();
-        let c = cuts(&affected);
-        let cut = if c.is_empty() {
-            "–".to_owned()
-        } else {
-            format!(
-                "{} ({}–{})",
-                ratio_text(median(&c)),
-                ratio_text(c[0]),
-                ratio_text(c[c.len() - 1])
-            )
-        };
+        let cut = cut_range(&cuts(&affected));
+        let mut oracle_cuts: Vec<f64> = affected
+            .iter()
+            .filter_map(|a| a.oracle.as_ref())
+            .filter(|o| !o.terms.is_empty() && o.cut.ratio > 0.0)
+            .map(|o| o.cut.ratio)
+            .collect();
+        oracle_cuts.sort_by(f64::total_cmp);
+        let oracle_cut = cut_range(&oracle_cuts);
         let mut gains: Vec<f64> = affected
             .iter()
             .filter_map(|a| a.oracle.as_ref().map(|o| o.gain))
@@ -772,7 +801,7 @@ pub fn table(scores: &[WorldScore], failures: &[Failure], kinds: &[Kind]) -> Str
         };
         let detectable = count(&AxisScore::oracle_detectable);
         out.push_str(&format!(
-            "| {} | {} | {} | {gain} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {gain} | {} | {} | {} | {} | {} | {} | {oracle_cut} | {} |\n",
             kind.name(),
             worlds.len(),
             n,
@@ -865,8 +894,14 @@ pub fn world_lines(s: &WorldScore) -> Vec<String> {
                 a.drift.2,
                 a.cut,
                 a.oracle.as_ref().map_or(String::new(), |o| format!(
-                    ", oracle gain {:.3} (detectable from {:.3}, rank {}, {}, absorbed {:.2})",
-                    o.gain, o.detectable_share, o.rank, o.level, o.absorbed_by_model
+                    ", oracle gain {:.3} (detectable from {:.3}, rank {}, {}, absorbed {:.2}), oracle admitted [{}], cut {}",
+                    o.gain,
+                    o.detectable_share,
+                    o.rank,
+                    o.level,
+                    o.absorbed_by_model,
+                    o.terms.join(", "),
+                    o.cut
                 )),
             )
         })

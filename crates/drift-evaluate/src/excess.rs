@@ -8,7 +8,7 @@
 
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Bootstrap resamples per interval. From one seed of the resampling to another the bounds move by
 /// 0.01 (low) to 0.03 (high) on a 1.7–2.9× interval over 48 activations (sd over 50 seeds, a
@@ -40,7 +40,7 @@ fn resampled_ratio(before: f64, after: f64, floor: f64) -> f64 {
 }
 
 /// An excess cut with its 95 % bootstrap interval.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ExcessCut {
     /// The ratio of the means ([`excess_ratio`]).
     pub ratio: f64,
