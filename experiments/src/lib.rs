@@ -3,6 +3,7 @@
 //! (after the fact, never inside the fit) compare with the simulator's truth. See the README.
 
 pub mod closed_loop;
+pub mod judged;
 pub mod memory;
 pub mod oracle;
 pub mod world_loop;

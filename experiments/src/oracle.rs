@@ -21,9 +21,9 @@ use drift_recording::{read_recording, AuxChannel, Segment, RECORDINGS_DIR, TRUTH
 use drift_sim::truth::read_truth;
 use serde::{Deserialize, Serialize};
 
+use crate::judged::judged_axes;
 use crate::memory::peak_rss_mb;
 use crate::world_loop::fit_and_close;
-use crate::worlds::judged_axes;
 
 /// How a candidate or term built on a truth channel is named.
 const ORACLE_TERM: &str = "aux:oracle_";
