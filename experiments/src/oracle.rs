@@ -100,6 +100,8 @@ pub struct OracleAxis {
     pub admitted: bool,
     /// Every term the oracle's loop admitted on the axis (the unit's thermal response included).
     pub terms: Vec<String>,
+    /// Terms the oracle's guard left out on the axis, each with its reason.
+    pub refused: Vec<String>,
     /// The held-out drift excess cut of the oracle's extended model, as the blind loop's is
     /// measured (the same activations and floor).
     pub cut: ExcessCut,
@@ -161,6 +163,7 @@ pub fn close_oracle(
                     level: c.level.to_owned(),
                     admitted: j.admitted.iter().any(|t| t.starts_with(ORACLE_TERM)),
                     terms: j.admitted.clone(),
+                    refused: j.refused.clone(),
                     cut: excess_cut(&j.before_dps, &j.after_dps, &j.floor_dps),
                 }
             })

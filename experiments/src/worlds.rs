@@ -767,13 +767,14 @@ pub fn world_lines(s: &WorldScore) -> Vec<String> {
                 a.drift.2,
                 a.cut,
                 a.oracle.as_ref().map_or(String::new(), |o| format!(
-                    ", oracle gain {:.3} (detectable from {:.3}, rank {}, {}, absorbed {:.2}), oracle admitted [{}], cut {}",
+                    ", oracle gain {:.3} (detectable from {:.3}, rank {}, {}, absorbed {:.2}), oracle admitted [{}], refused [{}], cut {}",
                     o.gain,
                     o.detectable_share,
                     o.rank,
                     o.level,
                     o.absorbed_by_model,
                     o.terms.join(", "),
+                    o.refused.join("; "),
                     o.cut
                 )),
             )

@@ -296,6 +296,11 @@ pub fn logged_ambient(segment: &Segment) -> Option<f32> {
 /// One quantity per axis and sample.
 type Axes = [Vec<f32>; 3];
 
+/// [`CandidateScore::level`] of a candidate whose gain shows in the shape within activations.
+pub const WITHIN_ACTIVATIONS: &str = "within activations";
+/// [`CandidateScore::level`] of a candidate whose gain shows in the offsets between activations.
+pub const BETWEEN_ACTIVATIONS: &str = "between activations";
+
 /// One candidate's score on one axis.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CandidateScore {
@@ -802,8 +807,8 @@ pub fn diagnose_axis(
                 .copied()
                 .unwrap_or((0.0, Level::Within));
             let (best, level) = match level {
-                Level::Within => (within, "within activations"),
-                Level::Between => (between, "between activations"),
+                Level::Within => (within, WITHIN_ACTIVATIONS),
+                Level::Between => (between, BETWEEN_ACTIVATIONS),
             };
             candidate.stable = best.stable;
             candidate.explained = share;

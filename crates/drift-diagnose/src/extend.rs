@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use crate::absorb::Absorber;
 use crate::candidates::{Kind, SET_POINT_CHANNEL};
-use crate::diagnose::AxisDiagnosis;
+use crate::diagnose::{AxisDiagnosis, WITHIN_ACTIVATIONS};
 use crate::keying::Keying;
 use crate::switch_on_rate::{switch_ons, without_heating, SwitchOnRateFit};
 use drift_evaluate::evaluate::{metric, sample_at, switch_on_raw};
@@ -54,6 +54,14 @@ pub struct ChosenTerm {
     /// channel and the other axes were not): there the term is admitted unless it makes the
     /// held-out data worse; elsewhere it must show a held-out gain of its own.
     pub found_on: [bool; 3],
+    /// Fitted and judged as a shape within activations (by the drift), not as offsets between
+    /// them (by the squared residual): every kind but an auxiliary input, and an auxiliary input
+    /// whose diagnosis found it within activations. A channel that moves within an activation
+    /// (humidity through a housing's lag, or the simulator's truth of an effect × rise) fitted on
+    /// the offsets between activations took its coefficient from the switch-on offsets' scatter:
+    /// given a world's true effect as a channel, the loop refused it for raising the held-out
+    /// drift by 0.0045 °/s.
+    pub shape: bool,
 }
 
 /// The extra terms and which recorded auxiliary channel feeds each auxiliary input.
@@ -187,10 +195,12 @@ impl TermPlan {
                     };
                     let axis_index = AXIS_NAMES.iter().position(|a| *a == axis.axis);
                     let found_here = name == candidate.name;
+                    let found_within = found_here && candidate.level == WITHIN_ACTIVATIONS;
                     if let Some(known) = plan.terms.iter_mut().find(|t| t.term == term) {
                         if let (Some(a), true) = (axis_index, found_here) {
                             known.found_on[a] = true;
                         }
+                        known.shape |= found_within;
                         continue;
                     }
                     let mut found_on = [false; 3];
@@ -201,6 +211,7 @@ impl TermPlan {
                         candidate: describe(term, &name),
                         term,
                         found_on,
+                        shape: changes_shape(term) || found_within,
                     });
                 }
             }
@@ -615,7 +626,7 @@ fn coefficients(
     admitted: &[Vec<usize>; 3],
 ) -> Vec<[f32; 3]> {
     let mut coefficient = vec![[0.0f32; 3]; plan.terms.len()];
-    let shapes = |t: &usize| plan.terms.get(*t).is_some_and(|c| changes_shape(c.term));
+    let shapes = |t: &usize| plan.terms.get(*t).is_some_and(|c| c.shape);
     for (axis, chosen) in admitted.iter().enumerate() {
         let (shape, offset): (Vec<usize>, Vec<usize>) = chosen.iter().copied().partition(shapes);
         let none: Vec<Vec<f64>> = vec![Vec::new(); series.len()];
@@ -684,7 +695,8 @@ struct HeldOutGain {
 }
 
 /// Whether a term's kind changes the shape within an activation (judged by the drift) rather than
-/// the offsets between activations (judged by the squared residual).
+/// the offsets between activations (judged by the squared residual), whatever its channel does:
+/// every kind but an auxiliary input ([`ChosenTerm::shape`]).
 fn changes_shape(term: Term) -> bool {
     !matches!(term, Term::Aux { .. })
 }
@@ -870,7 +882,7 @@ pub fn extend(
             let drift_worse =
                 drift_gain < -0.01 * drift_before && 1.0 - drift_p_value < ADMIT_ALPHA;
             let (admit, reason) = if chosen.found_on[axis] {
-                let (own_gain, own_metric) = if changes_shape(chosen.term) {
+                let (own_gain, own_metric) = if chosen.shape {
                     (drift_gain, "drift")
                 } else {
                     (improvement, "squared residual")
@@ -904,7 +916,7 @@ pub fn extend(
                 (admit, reason)
             } else {
                 not_found_admission(
-                    changes_shape(chosen.term),
+                    chosen.shape,
                     (improvement, p_value, squared_worse),
                     (drift_gain, drift_p_value, drift_worse),
                     level,
@@ -1029,7 +1041,7 @@ fn without_terms(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::CandidateScore;
+    use crate::diagnose::{CandidateScore, BETWEEN_ACTIVATIONS, WITHIN_ACTIVATIONS};
 
     fn axis(name: &'static str, ranking: &[(&str, bool)]) -> AxisDiagnosis {
         AxisDiagnosis {
@@ -1056,7 +1068,13 @@ mod tests {
                     coefficient: 0.01,
                     stable: true,
                     absorbed_by_model: 0.0,
-                    level: "within activations",
+                    // A channel's offsets, the temperatures' shapes, as the diagnosis mostly
+                    // finds them.
+                    level: if candidate.starts_with("aux:") {
+                        BETWEEN_ACTIVATIONS
+                    } else {
+                        WITHIN_ACTIVATIONS
+                    },
                     thermal_response: Kind::is_thermal_response(candidate),
                 })
                 .collect(),
@@ -1161,7 +1179,7 @@ mod tests {
             "X",
             &[("element rate X (τ 30 s)", true), ("aux:supply", true)],
         )]);
-        assert!(changes_shape(plan.terms[0].term) && !changes_shape(plan.terms[1].term));
+        assert!(plan.terms[0].shape && !plan.terms[1].shape);
         let series: Vec<TrainingSeries> = (0..10)
             .map(|a| {
                 let m = if a % 2 == 0 { 1.0 } else { -1.0 };
@@ -1242,6 +1260,40 @@ mod tests {
         assert_eq!(plan.aux_inputs, ["a", "b", "c", "d"]);
         // The guard judges a shape by the drift and an auxiliary input by the squared residual.
         assert!(changes_shape(Term::RiseSquared));
-        assert!(!changes_shape(plan.terms[0].term));
+        assert!(!changes_shape(plan.terms[0].term) && !plan.terms[0].shape);
+    }
+
+    #[test]
+    fn an_input_found_within_activations_is_fitted_and_judged_as_a_shape() {
+        // The residual is 2 × a channel's variation within each activation, plus offsets between
+        // activations that go against the channel's mean (the switch-on offsets' scatter, which
+        // the initial bias answers). Found within activations, the channel is a shape term and
+        // gets 2; fitted on the offsets it would take its coefficient from them.
+        let mut found = axis("X", &[("aux:humidity", true)]);
+        found.ranking[0].level = WITHIN_ACTIVATIONS;
+        let plan = TermPlan::choose(&[found]);
+        assert!(plan.terms[0].shape && !changes_shape(plan.terms[0].term));
+        let series: Vec<TrainingSeries> = (0..10)
+            .map(|a| {
+                let m = f64::from(a) - 4.5;
+                let shape: Vec<f64> = (0..50).map(|i| f64::from(i) / 50.0 - 0.49).collect();
+                let channel: Vec<f64> = shape.iter().map(|s| m + s).collect();
+                let residual: Vec<f64> = shape.iter().map(|s| 2.0 * s - 5.0 * m).collect();
+                let same = |values: Vec<f64>| [values.clone(), values.clone(), values];
+                TrainingSeries {
+                    residual: same(residual),
+                    terms: vec![same(channel)],
+                    raw_sum: Vec::new(),
+                }
+            })
+            .collect();
+        let all: Vec<&TrainingSeries> = series.iter().collect();
+        let c = coefficients(&plan, &all, &[vec![0], vec![], vec![]]);
+        assert!((c[0][0] - 2.0).abs() < 1e-4, "{c:?}");
+        // The same channel found between activations is an offset, fitted on them.
+        let offset = TermPlan::choose(&[axis("X", &[("aux:humidity", true)])]);
+        assert!(!offset.terms[0].shape);
+        let c = coefficients(&offset, &all, &[vec![0], vec![], vec![]]);
+        assert!(c[0][0] < 0.0, "{c:?}");
     }
 }
