@@ -602,6 +602,57 @@ fn a_header_clock_that_restarts_is_refused_pointing_to_log_times() {
     assert_eq!(r.segments[0].len(), 300);
 }
 
+/// Header stamps and log times that both go back, at one message or at two: refused by either
+/// clock, saying neither increases, and sending the user to neither `--timestamps` (the other
+/// clock fails too, even where it goes back only after this clock did).
+#[test]
+fn a_bag_whose_two_clocks_go_back_sends_the_user_to_neither() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let original = simulate(d);
+    let s = &original.segments[0];
+    let out = d.join("out");
+    let back = 30_000_000_000;
+    let together = d.join("together.mcap");
+    write_bag(
+        &together,
+        s,
+        0..300,
+        Bag {
+            header_back: (150, back),
+            log_back: (150, back),
+            ..STANDARD
+        },
+    );
+    let apart = d.join("apart.mcap");
+    write_bag(
+        &apart,
+        s,
+        0..300,
+        Bag {
+            header_back: (200, back),
+            log_back: (100, back),
+            ..STANDARD
+        },
+    );
+    for (bag, clock, at) in [
+        (&together, "header", "message #150: header.stamp"),
+        (&together, "log", "message #150: log time"),
+        (&apart, "header", "message #200: header.stamp"),
+        (&apart, "log", "message #100: log time"),
+    ] {
+        let text = import_fails(bag, &out, &["--timestamps", clock]);
+        assert!(
+            text.contains(&format!("topic /imu/data, {at} "))
+                && text.contains(
+                    "neither the header stamps nor the recorder's log times increase here"
+                )
+                && !text.contains("--timestamps"),
+            "{clock}: {text}"
+        );
+    }
+}
+
 #[test]
 fn an_exported_recording_has_a_message_per_sample_and_imports_back() {
     let dir = tempfile::tempdir().unwrap();
