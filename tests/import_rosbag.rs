@@ -30,6 +30,10 @@ struct Bag<'a> {
     receive_delay_ns: u64,
     /// Swap the header stamps of samples 5 and 6.
     swap_stamps: bool,
+    /// From sample `.0` on, header stamps this much earlier, ns (a driver clock set back).
+    header_back: (usize, u64),
+    /// From sample `.0` on, log times this much earlier, ns (a bag merged out of order).
+    log_back: (usize, u64),
     /// `angular_velocity_covariance[0]`.
     rate_covariance: f64,
     /// Odd gyro messages from a second sensor (`header.frame_id` `imu2_link`).
@@ -43,6 +47,8 @@ const STANDARD: Bag<'static> = Bag {
     imu_encodings: ("ros2msg", "cdr"),
     receive_delay_ns: 3_000_000,
     swap_stamps: false,
+    header_back: (usize::MAX, 0),
+    log_back: (usize::MAX, 0),
     rate_covariance: 0.001,
     two_frames: false,
     temperature_frame: "imu_link",
@@ -127,7 +133,10 @@ fn write_bag(path: &Path, s: &Segment, range: std::ops::Range<usize>, how: Bag<'
                 stamp - period
             };
         }
-        let log = EPOCH_NS + s.power_on_ns + i as u64 * period + how.receive_delay_ns;
+        let back = |(from, ns): (usize, u64)| if i >= from { ns } else { 0 };
+        stamp -= back(how.header_back);
+        let log = EPOCH_NS + s.power_on_ns + i as u64 * period + how.receive_delay_ns
+            - back(how.log_back);
         let header = |channel_id: u16, sequence: u32| mcap::records::MessageHeader {
             channel_id,
             sequence,
@@ -551,6 +560,97 @@ fn bags_that_are_not_what_the_options_say_are_refused_by_file_topic_and_message(
             && !text.contains("row"),
         "{text}"
     );
+}
+
+/// A header clock set back by more than a second mid-bag (a driver that restarted at boot) while
+/// the recorder's log times increase: refused, naming the restart and `--timestamps log`, by which
+/// the bag imports whole.
+#[test]
+fn a_header_clock_that_restarts_is_refused_pointing_to_log_times() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let original = simulate(d);
+    let s = &original.segments[0];
+    let out = d.join("out");
+    let bag = d.join("restart.mcap");
+    write_bag(
+        &bag,
+        s,
+        0..300,
+        Bag {
+            header_back: (150, 30_000_000_000),
+            ..STANDARD
+        },
+    );
+    let text = import_fails(&bag, &out, &[]);
+    assert!(
+        text.contains("restart.mcap: topic /imu/data, message #150: header.stamp 1700003571.500000000 s is not after the previous message's (1700003601.490000000 s)")
+            && text.contains("the driver's clock went back (it restarts at boot, or was set): import with `--timestamps log`"),
+        "{text}"
+    );
+    ok(&[
+        "import",
+        "rosbag",
+        bag.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--timestamps",
+        "log",
+    ]);
+    let r = read_recording(&out.join("recordings/ros2.mcap")).unwrap();
+    assert_eq!(r.segments.len(), 1);
+    assert_eq!(r.segments[0].len(), 300);
+}
+
+/// Header stamps and log times that both go back, at one message or at two: refused by either
+/// clock, saying neither increases, and sending the user to neither `--timestamps` (the other
+/// clock fails too, even where it goes back only after this clock did).
+#[test]
+fn a_bag_whose_two_clocks_go_back_sends_the_user_to_neither() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let original = simulate(d);
+    let s = &original.segments[0];
+    let out = d.join("out");
+    let back = 30_000_000_000;
+    let together = d.join("together.mcap");
+    write_bag(
+        &together,
+        s,
+        0..300,
+        Bag {
+            header_back: (150, back),
+            log_back: (150, back),
+            ..STANDARD
+        },
+    );
+    let apart = d.join("apart.mcap");
+    write_bag(
+        &apart,
+        s,
+        0..300,
+        Bag {
+            header_back: (200, back),
+            log_back: (100, back),
+            ..STANDARD
+        },
+    );
+    for (bag, clock, at) in [
+        (&together, "header", "message #150: header.stamp"),
+        (&together, "log", "message #150: log time"),
+        (&apart, "header", "message #200: header.stamp"),
+        (&apart, "log", "message #100: log time"),
+    ] {
+        let text = import_fails(bag, &out, &["--timestamps", clock]);
+        assert!(
+            text.contains(&format!("topic /imu/data, {at} "))
+                && text.contains(
+                    "neither the header stamps nor the recorder's log times increase here"
+                )
+                && !text.contains("--timestamps"),
+            "{clock}: {text}"
+        );
+    }
 }
 
 #[test]

@@ -47,6 +47,8 @@ pub struct PyDiagnosis {
     warm_start: String,
     before_after: String,
     extended: Option<Box<ModifiedTables>>,
+    /// The command line's line on the extended model; None without `extend`.
+    extended_verdict: Option<String>,
     aux_inputs: Vec<String>,
     profiles: Vec<ProfileRow>,
     counts: Vec<(String, usize)>,
@@ -312,6 +314,8 @@ fn run_loop(
                 .collect(),
             admissions: json(&admissions)?,
             extended: changed.then(|| closed.model(unit)),
+            extended_verdict: extend
+                .then(|| drift_report::diagnosis::extended_verdict(unit, &closed)),
             stage3: json(&closed.stage3)?,
             warm_start: json(&closed.warm_start)?,
             aux_inputs: admitted
@@ -439,6 +443,15 @@ impl PyDiagnosis {
         self.extended
             .clone()
             .map(|m| PyModifiedTables(Arc::from(m)))
+    }
+
+    /// What became of the extended model, as `gyrodrift diagnose --extend` prints it: why nothing
+    /// was extended (e.g. "no term proposed (nothing significant maps to a term the firmware can
+    /// compute); the paper's model unchanged") or which terms were admitted; None unless
+    /// `extend=True`.
+    #[getter]
+    fn extended_verdict(&self) -> Option<String> {
+        self.extended_verdict.clone()
     }
 
     /// The recorded channels the firmware passes as the extended model's auxiliary inputs 0..,

@@ -65,6 +65,10 @@ def test_the_hidden_supply_effect_is_found_admitted_and_lowers_the_held_out_erro
                 assert (a["drift_p_value"] if shape else a["p_value"]) < 0.05, a
     extended = diagnosis.extended
     assert extended is not None and len(extended.extension) >= 1
+    verdict = diagnosis.extended_verdict
+    assert verdict is not None and verdict.startswith("admitted "), verdict
+    assert all(f"{c} on {axis}" in verdict for c, axis in admitted), verdict
+    assert verdict.endswith(f"(firmware image `extended-{diagnosis.unit_id}.bin`)"), verdict
     # The error before/after on the held-out +33 °C field activations, per axis where it was found.
     field33 = [
         r for r in diagnosis.before_after if r["series_kind"] == "field" and r["set_point_celsius"] == 33.0
@@ -229,3 +233,39 @@ def test_save_writes_the_command_lines_report_of_the_unit(
         image = tmp_path / "out" / f"extended-{diagnosis.unit_id}.bin"
         assert image.stat().st_size > 0
         assert f"extended-{diagnosis.unit_id}.bin" in text
+
+
+# The paper's model is exact for this unit and no hidden effect is on: nothing to extend.
+PLAIN = """
+name = "py-diagnose-plain"
+seed = 3
+units = 1
+unit_model = "paper_exact"
+set_points_celsius = [30.0, 40.0, 33.0]
+[protocol]
+intervals_min = [1.0, 30.0]
+repeats = 2
+activation_s = 60.0
+[field]
+sessions = 2
+ambient_ramp_c_per_min = 0.0
+carry_probability = 0.0
+"""
+
+
+def test_when_nothing_is_extended_the_reason_is_given_and_saved(tmp_path: Path) -> None:
+    campaign = tmp_path / "plain"
+    gyrodrift.simulate(campaign, PLAIN)
+    (unit,) = gyrodrift.fit(campaign)
+    diagnosis = unit.diagnose(gyrodrift.load_campaign(campaign), extend=True)
+    assert diagnosis.proposed_terms == [] and diagnosis.admissions == []
+    assert diagnosis.extended is None
+    assert diagnosis.extended_verdict == (
+        "no term proposed (nothing significant maps to a term the firmware can compute); "
+        "the paper's model unchanged"
+    )
+    text = diagnosis.save(tmp_path / "out").read_text()
+    section = text[text.index(f"## Extended model of unit {diagnosis.unit_id}") :]
+    assert "Nothing significant maps to a term the firmware can compute" in section
+    assert "The paper's model is kept unchanged." in section
+    assert not list((tmp_path / "out").glob("extended-*"))

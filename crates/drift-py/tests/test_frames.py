@@ -186,6 +186,42 @@ def test_results_as_a_frame_indexed_by_activation(evaluation: gyrodrift.Evaluati
     )
 
 
+def test_a_model_named_either_way_finds_its_frame_column_record_and_fitted_tables(
+    evaluation: gyrodrift.Evaluation, tmp_path: Path
+) -> None:
+    unit = evaluation.fitted[0]
+    frame = gyrodrift.results_frame(evaluation)
+    frame_models = list(dict.fromkeys(frame.columns.get_level_values("model")))
+    # Every name the frame uses has an identifier that names it back.
+    for name in frame_models:
+        assert gyrodrift.model_name(name) == name
+        assert gyrodrift.model_name(gyrodrift.model_attribute(name)) == name
+    # Frame and record names → the fitted unit's tables and the files `save` writes.
+    assert getattr(unit, gyrodrift.model_attribute("3rd-order")) == unit.third_order
+    assert getattr(unit, gyrodrift.model_attribute("by-history")) == unit.by_history
+    saved = unit.save(tmp_path)
+    for name in {r["model"] for r in evaluation.records} & {"3rd-order", "by-history", "modified"}:
+        assert (saved / f"{gyrodrift.model_attribute(name)}.json").is_file()
+    # Every fitted model's attribute → its frame column, record and per-activation dict key.
+    attributes = ("modified", "by_history", "standard", "third_order", "relative", "recommended")
+    for attribute in attributes:
+        assert type(getattr(unit, attribute)).__name__.endswith("Tables")
+        name = gyrodrift.model_name(attribute)
+        assert name in frame_models
+        assert name in evaluation.results[0].drift_dps
+    assert frame[gyrodrift.model_name("third_order")].equals(frame["3rd-order"])
+    records = evaluation.records
+    assert gyrodrift.paper_table(records, models=["third_order", "by_history"]) == gyrodrift.paper_table(
+        records, models=["3rd-order", "by-history"]
+    )
+    assert "| 3rd-order |" in gyrodrift.paper_table(records, models=["third_order"])
+    valid = r"the models are uncorrected, standard, 3rd-order \(third_order\), .*by-history \(by_history\)"
+    with pytest.raises(gyrodrift.InputError, match=r"unknown model name 'third-order': " + valid):
+        gyrodrift.model_attribute("third-order")
+    with pytest.raises(gyrodrift.InputError, match=r"unknown model name '3rd_order': " + valid):
+        gyrodrift.paper_table(records, models=["3rd_order"])
+
+
 def test_a_series_passed_as_an_array_is_told_to_use_to_numpy(models: dict[str, object]) -> None:
     corrector = gyrodrift.Corrector(models["modified"])  # type: ignore[arg-type]
     times = pd.Series(np.arange(5, dtype=np.uint32))

@@ -21,20 +21,29 @@ MANY = 2000
 
 
 def interrupted(call: Callable[[], Any], after_s: float = 0.3) -> None:
-    """Runs `call`, sending the main thread SIGINT's KeyboardInterrupt `after_s` after it starts."""
+    """Runs `call`, sending the main thread SIGINT's KeyboardInterrupt `after_s` after it starts;
+    the call must stop within a second of the signal."""
+    sent: list[float] = []
+
+    def send() -> None:
+        sent.append(time.monotonic())
+        _thread.interrupt_main()
+
     # Python's own SIGINT handler, as in an interactive session: a process started in the
     # background by a non-interactive shell (CI, nohup) inherits SIGINT ignored, and then
     # `interrupt_main` does nothing.
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    timer = threading.Timer(after_s, _thread.interrupt_main)
+    timer = threading.Timer(after_s, send)
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
             call()
+        stopped = time.monotonic()
     finally:
         timer.cancel()
         timer.join()
         signal.signal(signal.SIGINT, previous)
+    assert stopped - sent[0] < 1.0, f"stopped {stopped - sent[0]:.2f} s after the signal"
 
 
 @pytest.fixture(scope="module")

@@ -61,6 +61,7 @@ from ._gyrodrift import (
     summarise,
 )
 from .frames import correct_frame, results_frame
+from .models import model_attribute, model_name
 from .tables import paper_table
 
 __all__ = [
@@ -102,6 +103,8 @@ __all__ = [
     "excess_cut",
     "fit",
     "load_campaign",
+    "model_attribute",
+    "model_name",
     "paper_table",
     "report",
     "resolve_campaign",

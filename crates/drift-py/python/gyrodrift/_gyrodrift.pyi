@@ -1148,6 +1148,12 @@ class Diagnosis:
         """The loop's model (stage 3 keyed as chosen, the refitted tables with the admitted terms),
         or None when it is the paper's unchanged. History-keyed axes need `power_on_after`."""
     @property
+    def extended_verdict(self) -> str | None:
+        """What became of the extended model, as `gyrodrift diagnose --extend` prints it: why nothing
+        was extended (e.g. "no term proposed (nothing significant maps to a term the firmware can
+        compute); the paper's model unchanged") or which terms were admitted; None unless
+        `extend=True`."""
+    @property
     def aux_inputs(self) -> list[str]:
         """The recorded channels the firmware passes as the extended model's auxiliary inputs 0..,
         in order."""

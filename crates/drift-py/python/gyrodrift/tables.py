@@ -5,6 +5,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
+from .models import model_name
+
 AXES = ("X", "Y", "Z")
 MODELS = ("standard", "3rd-order", "relative", "modified")
 """The rows: the three standard baselines and the paper's model; add "by-history" or "uncorrected"."""
@@ -31,7 +33,10 @@ def _rows(records: Sequence[Mapping[str, Any]]) -> list[tuple[float, str]]:
 def paper_table(records: Iterable[Mapping[str, Any]], *, models: Sequence[str] = MODELS) -> str:
     """The paper's Table as Markdown: rows model × set point, columns unit × axis, mean drift in °/s,
     then per set point the best standard baseline / modified ratio, naming the baseline (as
-    `report.md`'s "Drift per unit and axis"). Noise-floor units and field sessions are left out."""
+    `report.md`'s "Drift per unit and axis"). Noise-floor units and field sessions are left out.
+    `models` may spell a model either way (`"3rd-order"` or `"third_order"`); an unknown name raises
+    `InputError`."""
+    models = [model_name(m) for m in models]
     records = [r for r in records if not str(r["unit"]).startswith("noise:")]
     units = sorted({str(r["unit"]) for r in records})
     index = {

@@ -318,6 +318,17 @@ struct TopicReader {
     other: (Option<i64>, bool),
     /// The first message's `header.frame_id` and the frame of every message after it.
     frame: Option<String>,
+    /// The first message whose time does not increase. Its error waits for the rest of the topic:
+    /// whether the fix is the other clock depends on that clock increasing over all of it.
+    backstep: Option<Backstep>,
+}
+
+/// Where a topic's time first fails to increase.
+struct Backstep {
+    path: PathBuf,
+    index: usize,
+    t_ns: i64,
+    last_ns: i64,
 }
 
 impl TopicReader {
@@ -330,17 +341,18 @@ impl TopicReader {
             last_ns: None,
             other: (None, true),
             frame: None,
+            backstep: None,
         }
     }
 
-    /// Checks the channel (once per schema text), the message's time on `clock` (`t_ns`; the
-    /// other clock's time is `other_ns`) and its frame; returns its index.
+    /// Checks the channel (once per schema text) and the message's frame, and notes whether its
+    /// time on the import's clock (`t_ns`; the other clock's time is `other_ns`) increases (see
+    /// [`Self::backstep_error`]); returns its index.
     fn next(
         &mut self,
         path: &Path,
         channel: &ChannelInfo,
         (t_ns, other_ns): (i64, i64),
-        clock: BagClock,
         frame: &str,
     ) -> Result<usize, BagError> {
         let index = self.count;
@@ -374,35 +386,61 @@ impl TopicReader {
             Some(_) => {}
         }
         let other_increasing = self.other.1 && self.other.0.is_none_or(|last| other_ns > last);
-        if let Some(last) = self.last_ns.filter(|&last| t_ns <= last) {
-            let (what, fix) = match clock {
-                BagClock::Header if t_ns < last - 1_000_000_000 && other_increasing => (
-                    "header.stamp",
-                    "the driver's clock went back (it restarts at boot, or was set): import with `--timestamps log` to use the recorder's receive times, which increase here".to_owned(),
-                ),
-                BagClock::Header if other_increasing => (
-                    "header.stamp",
-                    "import with `--timestamps log` to use the recorder's receive times, which increase here".to_owned(),
-                ),
-                BagClock::Log if other_increasing => (
-                    "log time",
-                    "the recorder wrote messages out of order; import with `--timestamps header`, whose stamps increase here".to_owned(),
-                ),
-                _ => (
-                    if clock == BagClock::Header { "header.stamp" } else { "log time" },
-                    "neither the header stamps nor the recorder's log times increase here: the topic mixes messages of different sources or the bag was merged out of order; split or reorder it (e.g. `ros2 bag convert`) before importing".to_owned(),
-                ),
-            };
-            return Err(message_error(format!(
-                "{what} {} is not after the previous message's ({}): the times must increase; {fix}",
-                seconds(t_ns),
-                seconds(last)
-            )));
-        }
         self.other = (Some(other_ns), other_increasing);
+        if let Some(last_ns) = self
+            .last_ns
+            .filter(|&last| t_ns <= last && self.backstep.is_none())
+        {
+            self.backstep = Some(Backstep {
+                path: path.to_path_buf(),
+                index,
+                t_ns,
+                last_ns,
+            });
+        }
         self.last_ns = Some(t_ns);
         self.count += 1;
         Ok(index)
+    }
+
+    /// The error of the topic's first time that does not increase, if any, with the fix the other
+    /// clock allows over the topic read so far (all of it unless reading stopped early).
+    fn backstep_error(&self, clock: BagClock) -> Option<BagError> {
+        let Backstep {
+            path,
+            index,
+            t_ns,
+            last_ns,
+        } = self.backstep.as_ref()?;
+        let other_increasing = self.other.1;
+        let (what, fix) = match clock {
+            BagClock::Header if *t_ns < last_ns - 1_000_000_000 && other_increasing => (
+                "header.stamp",
+                "the driver's clock went back (it restarts at boot, or was set): import with `--timestamps log` to use the recorder's receive times, which increase here",
+            ),
+            BagClock::Header if other_increasing => (
+                "header.stamp",
+                "import with `--timestamps log` to use the recorder's receive times, which increase here",
+            ),
+            BagClock::Log if other_increasing => (
+                "log time",
+                "the recorder wrote messages out of order; import with `--timestamps header`, whose stamps increase here",
+            ),
+            _ => (
+                if clock == BagClock::Header { "header.stamp" } else { "log time" },
+                "neither the header stamps nor the recorder's log times increase here: the topic mixes messages of different sources or the bag was merged out of order; split or reorder it (e.g. `ros2 bag convert`) before importing",
+            ),
+        };
+        Some(BagError::Message {
+            path: path.clone(),
+            topic: self.topic.clone(),
+            index: *index,
+            reason: format!(
+                "{what} {} is not after the previous message's ({}): the times must increase; {fix}",
+                seconds(*t_ns),
+                seconds(*last_ns)
+            ),
+        })
     }
 }
 
@@ -439,128 +477,147 @@ pub fn read_bag(
     let mut temperatures: [Vec<(i64, f64)>; 3] = Default::default();
     let mut all_topics = BTreeMap::new();
     let mut labels = None;
-    for (n, file) in files.iter().enumerate() {
-        let buf = std::fs::read(file).map_err(|source| BagError::Io {
-            path: file.clone(),
-            source,
-        })?;
-        let mcap_error = |reason: String| BagError::Mcap {
-            path: file.clone(),
-            reason,
-        };
-        if buf.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
-            return Err(mcap_error(
-                "a zstd-compressed file (rosbag2's file compression): decompress it first (`zstd -d`, or `ros2 bag decompress`), then import the .mcap file".into(),
-            ));
-        }
-        if !buf.starts_with(mcap::MAGIC) {
-            return Err(mcap_error(
-                "not an MCAP file (only rosbag2's MCAP storage is read; convert a .db3 bag with `ros2 bag convert`)".into(),
-            ));
-        }
-        if !buf.ends_with(mcap::MAGIC) {
-            return Err(mcap_error(format!(
-                "truncated: the file ends at byte {} without its closing magic (an interrupted recording or copy); `ros2 bag reindex` or `mcap recover` may rescue it",
-                buf.len()
-            )));
-        }
-        crate::messages::check_uncompressed_chunks(&buf).map_err(|e| mcap_error(e.to_string()))?;
-        if n == 0 {
-            labels = read_labels(file, &buf).map_err(mcap_error)?;
-        }
-        crate::messages::for_each_message(&buf, |channel, log_ns, data, _| {
-            let topic = channel.topic.as_str();
-            if !all_topics.contains_key(topic) {
-                all_topics.insert(
-                    topic.to_owned(),
-                    channel.schema.clone().unwrap_or_else(|| "no schema".into()),
-                );
-            }
-            let is_gyro = topic == topics.gyro;
-            let axis = axis_topics.iter().position(|t| t == topic);
-            if !is_gyro && axis.is_none() {
-                return Ok(());
-            }
-            let reader = match axis {
-                Some(a) if !is_gyro => &mut temperature_readers[a],
-                _ => &mut gyro_reader,
-            };
-            let decoded = if is_gyro {
-                decode_imu(data).map(Decoded::Gyro)
-            } else {
-                decode_temperature(data)
-                    .map(|(s, f, c)| Decoded::Temperature(axis.unwrap_or(0), s, f, c))
-            };
-            let message_error = |index: usize, reason: String| BagError::Message {
+    // The topic whose time first failed to increase: its error comes first, once the rest of the
+    // bag has told whether the other clock increases.
+    let mut first_backstep: Option<String> = None;
+    let read = (|| -> Result<(), BagError> {
+        for (n, file) in files.iter().enumerate() {
+            let buf = std::fs::read(file).map_err(|source| BagError::Io {
                 path: file.clone(),
-                topic: topic.to_owned(),
-                index,
+                source,
+            })?;
+            let mcap_error = |reason: String| BagError::Mcap {
+                path: file.clone(),
                 reason,
             };
-            // The schema first: a message of another type would decode to nonsense.
-            let decoded = match decoded {
-                Ok(d) => d,
-                Err(reason) => {
-                    if data.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
-                        return Err(message_error(
-                            reader.count,
-                            "a zstd-compressed message (rosbag2's message compression): decompress the bag first (`ros2 bag decompress`, or `ros2 bag convert` without compression)".into(),
-                        ));
-                    }
-                    if let Some(reason) = check_channel(channel, reader.expected) {
-                        return Err(BagError::Topic {
-                            path: file.clone(),
-                            topic: topic.to_owned(),
-                            reason,
-                        });
-                    }
-                    return Err(message_error(reader.count, reason));
-                }
-            };
-            let (stamp, frame) = match &decoded {
-                Decoded::Gyro(m) => (m.stamp_ns, m.frame_id.as_str()),
-                Decoded::Temperature(_, s, f, _) => (*s, f.as_str()),
-            };
-            let log_ns = i64::try_from(log_ns).map_err(|_| {
-                message_error(
-                    reader.count,
-                    format!("log time {log_ns} ns is beyond the i64 clock"),
-                )
-            })?;
-            let times = match clock {
-                BagClock::Header => (stamp, log_ns),
-                BagClock::Log => (log_ns, stamp),
-            };
-            let index = reader.next(file, channel, times, clock, frame)?;
-            match decoded {
-                Decoded::Gyro(m) => {
-                    if m.rate_covariance_0 == -1.0 {
-                        return Err(message_error(
-                            index,
-                            "angular_velocity_covariance[0] is −1: the driver says this message carries no angular velocity (REP-145); publish the gyro's rates, or name the topic that has them with `--gyro-topic`".into(),
-                        ));
-                    }
-                    if let Some(axis) = m.rate.iter().position(|v| !v.is_finite()) {
-                        return Err(message_error(
-                            index,
-                            format!(
-                                "angular_velocity.{} is {}",
-                                ["x", "y", "z"][axis],
-                                m.rate[axis]
-                            ),
-                        ));
-                    }
-                    gyro.push((times.0, m.rate));
-                }
-                Decoded::Temperature(a, _, _, celsius) => temperatures[a].push((times.0, celsius)),
+            if buf.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
+                return Err(mcap_error(
+                    "a zstd-compressed file (rosbag2's file compression): decompress it first (`zstd -d`, or `ros2 bag decompress`), then import the .mcap file".into(),
+                ));
             }
-            Ok(())
-        })
-        .map_err(|e| match e {
-            Ok(mcap) => mcap_error(mcap.to_string()),
-            Err(e) => e,
-        })?;
+            if !buf.starts_with(mcap::MAGIC) {
+                return Err(mcap_error(
+                    "not an MCAP file (only rosbag2's MCAP storage is read; convert a .db3 bag with `ros2 bag convert`)".into(),
+                ));
+            }
+            if !buf.ends_with(mcap::MAGIC) {
+                return Err(mcap_error(format!(
+                    "truncated: the file ends at byte {} without its closing magic (an interrupted recording or copy); `ros2 bag reindex` or `mcap recover` may rescue it",
+                    buf.len()
+                )));
+            }
+            crate::messages::check_uncompressed_chunks(&buf)
+                .map_err(|e| mcap_error(e.to_string()))?;
+            if n == 0 {
+                labels = read_labels(file, &buf).map_err(mcap_error)?;
+            }
+            crate::messages::for_each_message(&buf, |channel, log_ns, data, _| {
+                let topic = channel.topic.as_str();
+                if !all_topics.contains_key(topic) {
+                    all_topics.insert(
+                        topic.to_owned(),
+                        channel.schema.clone().unwrap_or_else(|| "no schema".into()),
+                    );
+                }
+                let is_gyro = topic == topics.gyro;
+                let axis = axis_topics.iter().position(|t| t == topic);
+                if !is_gyro && axis.is_none() {
+                    return Ok(());
+                }
+                let reader = match axis {
+                    Some(a) if !is_gyro => &mut temperature_readers[a],
+                    _ => &mut gyro_reader,
+                };
+                let decoded = if is_gyro {
+                    decode_imu(data).map(Decoded::Gyro)
+                } else {
+                    decode_temperature(data)
+                        .map(|(s, f, c)| Decoded::Temperature(axis.unwrap_or(0), s, f, c))
+                };
+                let message_error = |index: usize, reason: String| BagError::Message {
+                    path: file.clone(),
+                    topic: topic.to_owned(),
+                    index,
+                    reason,
+                };
+                // The schema first: a message of another type would decode to nonsense.
+                let decoded = match decoded {
+                    Ok(d) => d,
+                    Err(reason) => {
+                        if data.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
+                            return Err(message_error(
+                                reader.count,
+                                "a zstd-compressed message (rosbag2's message compression): decompress the bag first (`ros2 bag decompress`, or `ros2 bag convert` without compression)".into(),
+                            ));
+                        }
+                        if let Some(reason) = check_channel(channel, reader.expected) {
+                            return Err(BagError::Topic {
+                                path: file.clone(),
+                                topic: topic.to_owned(),
+                                reason,
+                            });
+                        }
+                        return Err(message_error(reader.count, reason));
+                    }
+                };
+                let (stamp, frame) = match &decoded {
+                    Decoded::Gyro(m) => (m.stamp_ns, m.frame_id.as_str()),
+                    Decoded::Temperature(_, s, f, _) => (*s, f.as_str()),
+                };
+                let log_ns = i64::try_from(log_ns).map_err(|_| {
+                    message_error(
+                        reader.count,
+                        format!("log time {log_ns} ns is beyond the i64 clock"),
+                    )
+                })?;
+                let times = match clock {
+                    BagClock::Header => (stamp, log_ns),
+                    BagClock::Log => (log_ns, stamp),
+                };
+                let index = reader.next(file, channel, times, frame)?;
+            if reader.backstep.is_some() && first_backstep.is_none() {
+                first_backstep = Some(topic.to_owned());
+            }
+                match decoded {
+                    Decoded::Gyro(m) => {
+                        if m.rate_covariance_0 == -1.0 {
+                            return Err(message_error(
+                                index,
+                                "angular_velocity_covariance[0] is −1: the driver says this message carries no angular velocity (REP-145); publish the gyro's rates, or name the topic that has them with `--gyro-topic`".into(),
+                            ));
+                        }
+                        if let Some(axis) = m.rate.iter().position(|v| !v.is_finite()) {
+                            return Err(message_error(
+                                index,
+                                format!(
+                                    "angular_velocity.{} is {}",
+                                    ["x", "y", "z"][axis],
+                                    m.rate[axis]
+                                ),
+                            ));
+                        }
+                        gyro.push((times.0, m.rate));
+                    }
+                    Decoded::Temperature(a, _, _, celsius) => temperatures[a].push((times.0, celsius)),
+                }
+                Ok(())
+            })
+            .map_err(|e| match e {
+                Ok(mcap) => mcap_error(mcap.to_string()),
+                Err(e) => e,
+            })?;
+        }
+        Ok(())
+    })();
+    let readers = || std::iter::once(&gyro_reader).chain(&temperature_readers);
+    if let Some(error) = first_backstep
+        .as_ref()
+        .and_then(|topic| readers().find(|r| r.topic == *topic))
+        .and_then(|r| r.backstep_error(clock))
+    {
+        return Err(error);
     }
+    read?;
     let listing = || {
         if all_topics.is_empty() {
             "the bag has no messages".to_owned()

@@ -50,6 +50,20 @@ pub struct Section {
     pub files: Vec<(PathBuf, Vec<u8>)>,
 }
 
+/// What became of one unit's extended model, in the line `gyrodrift diagnose --extend` prints:
+/// why nothing was extended (no term proposed, none admitted and why) or what was admitted.
+pub fn extended_verdict(fitted: &FittedUnit, closed: &Closed<'_>) -> String {
+    extended::verdict(&file_stem(fitted, closed), closed)
+}
+
+/// Files are named by unit and half, without the heading's spaces and commas.
+fn file_stem(fitted: &FittedUnit, closed: &Closed<'_>) -> String {
+    match closed.half {
+        Some(half) => format!("{}-half{}", fitted.unit_id, half + 1),
+        None => fitted.unit_id.clone(),
+    }
+}
+
 /// Renders one unit's closed loop: `label` heads it (the unit, and the half when cross-fitted),
 /// `settings` are the loop's fit settings, `floor` the noise floor beside the errors.
 pub fn unit_section(
@@ -64,11 +78,7 @@ pub fn unit_section(
     let mut md = String::new();
     let mut console = String::new();
     let mut files = Vec::new();
-    // Files are named by unit and half, without the heading's spaces and commas.
-    let stem = match closed.half {
-        Some(half) => format!("{}-half{}", fitted.unit_id, half + 1),
-        None => fitted.unit_id.clone(),
-    };
+    let stem = file_stem(fitted, closed);
     let (activations, axes, roles) = (&closed.series, &closed.axes, &closed.roles);
     let _ = writeln!(md, "# Unit {unit}\n");
     {
