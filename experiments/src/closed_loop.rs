@@ -141,7 +141,28 @@ pub fn segments(dir: &Path) -> anyhow::Result<Vec<Segment>> {
         .collect())
 }
 
-fn is(set_point: f64, value: f64) -> bool {
+/// The noise floor per held-out activation: the zero-drift twin's (recordings in `twin_dir`) field
+/// activations at the validation set point, uncorrected, less the unit's constant bias (the mean
+/// over all its activations) — what a perfect model would leave — as (drift, RMS) per axis.
+pub fn validation_field_floor(
+    twin_dir: &Path,
+    settings: &FitSettings,
+) -> anyhow::Result<Vec<[(f64, f64); 3]>> {
+    let twin = segments(twin_dir)?;
+    let field: Vec<&Segment> = twin
+        .iter()
+        .filter(|s| {
+            s.labels.series_kind == SeriesKind::Field
+                && is(VALIDATION, s.labels.nominal_set_point_celsius())
+        })
+        .collect();
+    Ok(evaluate::noise_floor_per_activation(
+        &field,
+        settings.lowpass_window_s,
+    ))
+}
+
+pub(crate) fn is(set_point: f64, value: f64) -> bool {
     (set_point - value).abs() < 1e-6
 }
 
@@ -537,17 +558,7 @@ pub fn run(
             .map(|r| (r.by_history_drift_dps[a], r.by_history_rms_dps[a]))
             .collect()
     });
-    // Noise floor: the zero-drift twin's field activations at +33 °C, uncorrected, less the unit's
-    // constant bias (the mean over all its activations): what a perfect model would leave.
-    let twin = segments(&twin_dir)?;
-    let twin_field: Vec<&Segment> = twin
-        .iter()
-        .filter(|s| {
-            s.labels.series_kind == SeriesKind::Field
-                && is(VALIDATION, s.labels.nominal_set_point_celsius())
-        })
-        .collect();
-    let twin_floor = evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_s);
+    let twin_floor = validation_field_floor(&twin_dir, settings)?;
     let floor = evaluate::mean_floor(&twin_floor);
     let twin_drift: [Vec<f64>; 3] =
         std::array::from_fn(|a| twin_floor.iter().map(|p| p[a].0).collect());

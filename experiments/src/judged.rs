@@ -6,21 +6,16 @@
 use std::path::Path;
 
 use drift_diagnose::closing::Closed;
-use drift_evaluate::evaluate;
 use drift_fit::fit::FittedUnit;
 use drift_fit::FitSettings;
-use drift_recording::paper::VALIDATION_SET_POINT_CELSIUS as VALIDATION;
-use drift_recording::{Segment, SeriesKind, RECORDINGS_DIR};
+
+use drift_recording::RECORDINGS_DIR;
 use serde::{Deserialize, Serialize};
 
-use crate::closed_loop::segments;
+use crate::closed_loop::{is, validation_field_floor, VALIDATION};
 
 /// The axes' names, as the loop's admissions name them.
 pub const AXES: [&str; 3] = ["X", "Y", "Z"];
-
-fn is(set_point: f64, value: f64) -> bool {
-    (set_point - value).abs() < 1e-6
-}
 
 /// One candidate as the loop ranked it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -85,15 +80,7 @@ pub fn judged_axes(
         .into_iter()
         .filter(|r| r.series_kind == "field" && is(VALIDATION, r.set_point_celsius))
         .collect();
-    let twin = segments(&floor_dir.join(RECORDINGS_DIR))?;
-    let twin_field: Vec<&Segment> = twin
-        .iter()
-        .filter(|s| {
-            s.labels.series_kind == SeriesKind::Field
-                && is(VALIDATION, s.labels.nominal_set_point_celsius())
-        })
-        .collect();
-    let floor = evaluate::noise_floor_per_activation(&twin_field, settings.lowpass_window_s);
+    let floor = validation_field_floor(&floor_dir.join(RECORDINGS_DIR), settings)?;
     let on_axis = |a: usize, admitted: bool| -> Vec<String> {
         closed
             .extended
