@@ -323,6 +323,20 @@ fn import_fails(bag: &Path, out: &Path, extra: &[&str]) -> String {
     text
 }
 
+/// Imports `bag` into `out` by the recorder's log times, which must succeed; the recording written.
+fn import_by_log_time(bag: &Path, out: &Path) -> Recording {
+    ok(&[
+        "import",
+        "rosbag",
+        bag.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--timestamps",
+        "log",
+    ]);
+    read_recording(&out.join("recordings/ros2.mcap")).unwrap()
+}
+
 #[test]
 fn bags_that_are_not_what_the_options_say_are_refused_by_file_topic_and_message() {
     let dir = tempfile::tempdir().unwrap();
@@ -399,15 +413,7 @@ fn bags_that_are_not_what_the_options_say_are_refused_by_file_topic_and_message(
         "{text}"
     );
     // By log time the same bag imports.
-    ok(&[
-        "import",
-        "rosbag",
-        bag.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--timestamps",
-        "log",
-    ]);
+    import_by_log_time(&bag, &out);
     std::fs::remove_dir_all(&out).unwrap();
     // A bag cut short.
     let bytes = std::fs::read(&good).unwrap();
@@ -588,16 +594,7 @@ fn a_header_clock_that_restarts_is_refused_pointing_to_log_times() {
             && text.contains("the driver's clock went back (it restarts at boot, or was set): import with `--timestamps log`"),
         "{text}"
     );
-    ok(&[
-        "import",
-        "rosbag",
-        bag.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--timestamps",
-        "log",
-    ]);
-    let r = read_recording(&out.join("recordings/ros2.mcap")).unwrap();
+    let r = import_by_log_time(&bag, &out);
     assert_eq!(r.segments.len(), 1);
     assert_eq!(r.segments[0].len(), 300);
 }

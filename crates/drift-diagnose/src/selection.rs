@@ -37,12 +37,13 @@ fn threshold_at(table: &[(usize, f64)], activations: usize) -> f64 {
 }
 
 /// The size threshold an effect's gain must reach, by how many activations the axis is diagnosed
-/// on, once the unit's own thermal response is in the baseline. Pairs as [`SIZE_THRESHOLDS`], and
-/// the same values: the independent simulator's. On null worlds of `drift_sim::world` with a
+/// on, once the unit's own thermal response is in the baseline: [`SIZE_THRESHOLDS`] itself, the
+/// independent simulator's values, kept a name of its own so the steps can be calibrated apart. On
+/// null worlds of `drift_sim::world` with a
 /// diagnosis campaign shaped like an analyst's they leave 4 of 90 axes with a significant effect
 /// (experiments/README.md, *Full size, the unit's own thermal response selected first*); those
 /// worlds judged the values and did not set them.
-pub const EFFECT_SIZE_THRESHOLDS: [(usize, f64); 2] = [(100, 0.10), (0, 0.14)];
+pub const EFFECT_SIZE_THRESHOLDS: [(usize, f64); 2] = SIZE_THRESHOLDS;
 
 /// The size threshold for an effect on an axis diagnosed on `activations` activations
 /// ([`EFFECT_SIZE_THRESHOLDS`]).

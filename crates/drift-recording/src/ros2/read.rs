@@ -575,9 +575,9 @@ pub fn read_bag(
                     BagClock::Log => (log_ns, stamp),
                 };
                 let index = reader.next(file, channel, times, frame)?;
-            if reader.backstep.is_some() && first_backstep.is_none() {
-                first_backstep = Some(topic.to_owned());
-            }
+                if reader.backstep.is_some() && first_backstep.is_none() {
+                    first_backstep = Some(topic.to_owned());
+                }
                 match decoded {
                     Decoded::Gyro(m) => {
                         if m.rate_covariance_0 == -1.0 {
